@@ -1,0 +1,81 @@
+#pragma once
+// Field visitors. Every component lists its state once, in
+//   template <class V> void visitFields(V& v) { v("mass", mass); v("position", x); ... }
+// and that single list drives checkpoint writing/reading and the finiteness guard, so a new
+// field cannot be forgotten by one of them.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <type_traits>
+
+#include "ecs/binary_io.h"
+
+namespace monolith {
+
+template <class T>
+struct IsEigenDense : std::is_base_of<Eigen::DenseBase<T>, T> {};
+
+struct FieldWriter {
+  BinaryWriter& out;
+  template <class T>
+  void operator()(const char*, const T& value) {
+    if constexpr (std::is_same_v<T, std::string>) {
+      out.string(value);
+    } else if constexpr (std::is_same_v<T, Eigen::Quaterniond>) {
+      out.raw(value.coeffs().data(), 4 * sizeof(double));
+    } else if constexpr (IsEigenDense<T>::value) {
+      static_assert(T::SizeAtCompileTime > 0, "fields must be fixed-size Eigen objects");
+      out.raw(value.data(), sizeof(typename T::Scalar) * T::SizeAtCompileTime);
+    } else {
+      out.pod(value);
+    }
+  }
+};
+
+struct FieldReader {
+  BinaryReader& in;
+  template <class T>
+  void operator()(const char*, T& value) {
+    if constexpr (std::is_same_v<T, std::string>) {
+      value = in.string();
+    } else if constexpr (std::is_same_v<T, Eigen::Quaterniond>) {
+      in.raw(value.coeffs().data(), 4 * sizeof(double));
+    } else if constexpr (IsEigenDense<T>::value) {
+      in.raw(value.data(), sizeof(typename T::Scalar) * T::SizeAtCompileTime);
+    } else {
+      value = in.template pod<T>();
+    }
+  }
+};
+
+// The first non-finite or absurdly large floating-point value, with the field's name and
+// the index inside the field (for vectors/matrices).
+struct FieldViolation {
+  std::string field;
+  int index = 0;
+  double value = 0;
+};
+
+struct FieldSanityChecker {
+  double maxAbs;
+  std::optional<FieldViolation> found;
+  void check(const char* name, int index, double v) {
+    if (found) return;
+    if (!std::isfinite(v) || std::abs(v) > maxAbs) found = FieldViolation{name, index, v};
+  }
+  template <class T>
+  void operator()(const char* name, const T& value) {
+    if constexpr (std::is_same_v<T, Eigen::Quaterniond>) {
+      for (int i = 0; i < 4; ++i) check(name, i, value.coeffs()[i]);
+    } else if constexpr (IsEigenDense<T>::value) {
+      if constexpr (std::is_floating_point_v<typename T::Scalar>)
+        for (int i = 0; i < int(T::SizeAtCompileTime); ++i) check(name, i, value.data()[i]);
+    } else if constexpr (std::is_floating_point_v<T>) {
+      check(name, 0, value);
+    }
+  }
+};
+
+}  // namespace monolith

@@ -1,0 +1,166 @@
+// The built-in component parsers and system types. Component configs are validated here with
+// located errors (ecs/config.h); the physics lives in systems/.
+#include <cmath>
+#include <sstream>
+
+#include "components/forces.h"
+#include "components/rigid_body.h"
+#include "components/shape.h"
+#include "ecs/registry.h"
+#include "systems/advance_positions.h"
+#include "systems/advance_velocity.h"
+#include "systems/rigid_diagnostics.h"
+#include "systems/rigid_forces.h"
+
+namespace monolith {
+
+namespace {
+
+template <int d>
+void parseShape(World<d>& world, Entity e, const Config& c) {
+  Shape<d> shape;
+  const std::string sphereName = d == 3 ? "sphere" : "disk";
+  const std::string type = c.oneOf("type", {"box", sphereName}, "");
+  if (type == "box") {
+    shape.type = ShapeType::Box;
+    shape.halfExtents = c.vector("half_extents", d, Bound::Positive);
+  } else {
+    shape.type = ShapeType::Sphere;
+    shape.radius = c.number("radius", Bound::Positive);
+  }
+  world.add(e, shape);
+}
+
+// Body-frame inertia from the config ("inertia": principal moments, a full matrix, or in 2-D a
+// number), else from the shape. Checked: symmetric positive definite, and physically
+// realizable (each principal moment at most the sum of the other two).
+template <int d>
+InertiaMat<d> parseInertia(World<d>& world, Entity e, const Config& c, double mass) {
+  InertiaMat<d> I;
+  if (!c.has("inertia")) {
+    const Shape<d>* shape = world.template get<Shape<d>>(e);
+    if (!shape)
+      c.failAt("inertia", "an inertia, or a \"shape\" component on the entity to derive it from", "neither");
+    return shape->inertia(mass);
+  }
+  if constexpr (d == 2) {
+    I(0) = c.number("inertia", Bound::Positive);
+    return I;
+  } else {
+    const Json& raw = c.raw()["inertia"];
+    if (raw.is_array() && raw.size() == 3 && raw[0].is_array()) {
+      I = c.matrix("inertia", 3, 3);
+      if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * I.cwiseAbs().maxCoeff())
+        c.failAt("inertia", "a symmetric 3x3 matrix", "a non-symmetric matrix");
+    } else if (raw.is_array() && raw.size() == 3) {
+      I = c.vector("inertia", 3, Bound::Any).asDiagonal();
+    } else {
+      c.failAt("inertia", "principal moments [Ixx, Iyy, Izz] or a 3x3 matrix", describeJson(raw));
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(I);
+    const Eigen::Vector3d m = eig.eigenvalues();
+    std::ostringstream got;
+    got << "principal moments " << m.transpose();
+    if (!(m.minCoeff() > 1e-12 * std::max(1.0, m.maxCoeff())))
+      c.failAt("inertia", "a positive-definite (non-singular) inertia", got.str());
+    if (m(2) > (m(0) + m(1)) * (1 + 1e-12))
+      c.failAt("inertia", "a physically realizable inertia (largest moment <= sum of the other two)", got.str());
+    return I;
+  }
+}
+
+template <int d>
+void parseRigidBody(World<d>& world, Entity e, const Config& c) {
+  RigidBody<d> b;
+  b.isStatic = c.boolean("static", false);
+  b.mass = b.isStatic ? c.number("mass", 1.0, Bound::Positive) : c.number("mass", Bound::Positive);
+  b.inertiaBody = parseInertia(world, e, c, b.mass);
+  b.refresh();
+  b.x = c.vector("position", Eigen::VectorXd::Zero(d));
+  if constexpr (d == 3) {
+    if (c.has("orientation")) {
+      const Eigen::VectorXd q = c.vector("orientation", 4);
+      if (q.norm() < 1e-12) c.failAt("orientation", "a non-zero quaternion [w, x, y, z]", "a zero quaternion");
+      b.orientation = Eigen::Quaterniond(q(0), q(1), q(2), q(3)).normalized();
+    }
+  } else {
+    b.orientation = c.number("angle", 0.0);
+  }
+  b.v = c.vector("velocity", Eigen::VectorXd::Zero(d));
+  AngularVec<d> w;
+  w = c.vector("angular_velocity", Eigen::VectorXd::Zero(d == 3 ? 3 : 1));
+  if (b.isStatic) {
+    if (b.v.squaredNorm() > 0 || w.squaredNorm() > 0)
+      c.failAt("velocity", "no velocity on a static body (static bodies never move)", "a non-zero velocity");
+  } else {
+    b.setOmega(w);
+  }
+  world.add(e, b);
+  if (!b.isStatic) world.add(e, RigidForces<d>{});
+}
+
+template <int d>
+void parseExternalForce(World<d>& world, Entity e, const Config& c) {
+  ExternalForce<d> f;
+  f.force = c.vector("force", Eigen::VectorXd::Zero(d));
+  f.torque = c.vector("torque", Eigen::VectorXd::Zero(d == 3 ? 3 : 1));
+  world.add(e, f);
+}
+
+template <int d>
+void registerDimension(Registry& r) {
+  // Order matters: components parse in this order (shape before rigid_body).
+  r.addComponentOf<d, Shape<d>>(d == 3 ? "geometry: box {half_extents} or sphere {radius}"
+                                       : "geometry: box {half_extents} or disk {radius}",
+                                parseShape<d>);
+  r.addComponentOf<d, RigidBody<d>>(
+      "rigid body: mass, inertia (or from shape), position, orientation/angle, velocity, angular_velocity, static",
+      parseRigidBody<d>);
+  r.addComponentOf<d, ExternalForce<d>>("constant world-frame force and torque on a rigid body", parseExternalForce<d>);
+  r.addComponentOf<d, RigidForces<d>>("(internal) force/torque accumulator of a dynamic rigid body", nullptr);
+
+  r.addSystem<d>({"clear_rigid_forces", "zero the force accumulators before each force evaluation",
+                  [] { return atBothForceStages<ClearRigidForces<d>, d>(); }, ""});
+  r.addSystem<d>({"gravity", "m g on dynamic rigid bodies", [] { return atBothForceStages<GravityForce<d>, d>(); }, ""});
+  r.addSystem<d>({"external_forces", "constant external force/torque components",
+                  [] { return atBothForceStages<ExternalForces<d>, d>(); }, ""});
+  r.addSystem<d>({"advance_rigid_velocity_half", "Step I (Sec. 4.3): v^{n+1/2} = v^n + dt/2 a(x^n)",
+                  [] {
+                    std::vector<std::unique_ptr<System<d>>> v;
+                    v.push_back(std::make_unique<RigidHalfKick<d>>(Stage::AdvanceVelocityHalf));
+                    return v;
+                  },
+                  ""});
+  r.addSystem<d>({"advance_rigid_positions",
+                  "Step IV (Sec. 4.6): positions, orientation rule (4.4.1/App. A) and energy fix (2.2)",
+                  [] {
+                    std::vector<std::unique_ptr<System<d>>> v;
+                    v.push_back(std::make_unique<AdvanceRigidPositions<d>>());
+                    return v;
+                  },
+                  ""});
+  r.addSystem<d>({"advance_rigid_velocity", "Step V (Sec. 4.7): v^{n+1} = v^{n+1/2} + dt/2 a(x^{n+1})",
+                  [] {
+                    std::vector<std::unique_ptr<System<d>>> v;
+                    v.push_back(std::make_unique<RigidHalfKick<d>>(Stage::AdvanceVelocity));
+                    return v;
+                  },
+                  ""});
+  r.addSystem<d>({"rigid_diagnostics", "energies and momenta of the rigid bodies",
+                  [] {
+                    std::vector<std::unique_ptr<System<d>>> v;
+                    v.push_back(std::make_unique<RigidDiagnostics<d>>());
+                    return v;
+                  },
+                  ""});
+}
+
+}  // namespace
+
+void registerBuiltins(Registry& registry) {
+  registry.setOrigin("built-in");
+  registerDimension<2>(registry);
+  registerDimension<3>(registry);
+}
+
+}  // namespace monolith

@@ -1,0 +1,127 @@
+#include "scenarios/checkpoint.h"
+
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+
+#include "scenarios/vtk_writer.h"
+
+namespace monolith {
+
+namespace {
+constexpr char kMagic[] = "MONOLITH-CKPT";
+constexpr std::uint32_t kEndianProbe = 0x01020304u;
+}  // namespace
+
+template <int d>
+void serializeWorld(const World<d>& world, BinaryWriter& out) {
+  const EntityRegistry& entities = world.entityRegistry();
+  out.vector(entities.generations());
+  out.vector(entities.aliveFlags());
+  out.vector(entities.freeList());
+  out.pod<std::uint64_t>(entities.slotCount());
+  for (std::uint32_t i = 0; i < entities.slotCount(); ++i) out.string(world.name(Entity{i, 0}));
+  std::uint64_t nonEmpty = 0;
+  for (const auto& [name, pool] : world.pools()) nonEmpty += pool->size() > 0 ? 1 : 0;
+  out.pod(nonEmpty);
+  for (const auto& [name, pool] : world.pools()) {
+    if (pool->size() == 0) continue;  // an empty pool and a missing one are the same state
+    out.string(name);
+    pool->serialize(out);
+  }
+}
+
+template <int d>
+void deserializeWorld(World<d>& world, BinaryReader& in, const Registry& registry) {
+  auto generations = in.vector<std::uint32_t>();
+  auto alive = in.vector<std::uint8_t>();
+  auto freeList = in.vector<std::uint32_t>();
+  const auto slots = in.pod<std::uint64_t>();
+  if (slots != generations.size()) in.fail("entity table sizes differ");
+  std::vector<std::string> names(slots);
+  for (auto& n : names) n = in.string();
+  world.entityRegistryMutable().restore(std::move(generations), std::move(alive), std::move(freeList));
+  world.namesMutable() = std::move(names);
+  world.rebuildNameIndex();
+  for (const auto& [name, pool] : world.pools()) pool->clear();
+  const auto poolCount = in.pod<std::uint64_t>();
+  for (std::uint64_t k = 0; k < poolCount; ++k) {
+    const std::string name = in.string();
+    const auto* type = registry.findComponent<d>(name);
+    if (!type)
+      throw std::runtime_error("checkpoint holds component '" + name +
+                               "' that no built-in type or loaded plugin provides (load the plugin the run used)");
+    type->ensurePool(world);
+    world.poolNamed(name)->deserialize(in);
+  }
+}
+
+template <int d>
+std::uint64_t stateHash(const World<d>& world) {
+  BinaryWriter out;
+  serializeWorld(world, out);
+  return fnv1a(out.bytes().data(), out.bytes().size());
+}
+
+template <int d>
+void writeCheckpoint(const std::string& path, const CheckpointHeader& header, const World<d>& world) {
+  BinaryWriter out;
+  out.raw(kMagic, sizeof kMagic);
+  out.pod(kCheckpointFormat);
+  out.pod(kEndianProbe);
+  out.pod<std::uint32_t>(sizeof(double));
+  out.pod<std::int32_t>(d);
+  out.pod<std::int64_t>(header.step);
+  out.pod(header.time);
+  out.string(header.sceneFile);
+  out.string(header.sceneJson);
+  serializeWorld(world, out);
+  writeFileAtomically(path, std::string(out.bytes().begin(), out.bytes().end()));
+}
+
+CheckpointFile readCheckpoint(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("checkpoint '" + path + "': no such file or it cannot be read");
+  CheckpointFile f;
+  f.bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  BinaryReader r(f.bytes.data(), f.bytes.size(), "checkpoint '" + path + "'");
+  char magic[sizeof kMagic];
+  if (f.bytes.size() < sizeof kMagic) r.fail("file too short to be a checkpoint");
+  r.raw(magic, sizeof magic);
+  if (std::memcmp(magic, kMagic, sizeof kMagic) != 0) r.fail("not a Monolith checkpoint (bad magic)");
+  const auto format = r.pod<std::uint32_t>();
+  if (format != kCheckpointFormat)
+    throw std::runtime_error("checkpoint '" + path + "': format " + std::to_string(format) + ", this monolith reads format " +
+                             std::to_string(kCheckpointFormat));
+  if (r.pod<std::uint32_t>() != kEndianProbe || r.pod<std::uint32_t>() != sizeof(double))
+    throw std::runtime_error("checkpoint '" + path + "': written on a machine with another byte order or double size");
+  f.header.dimension = r.pod<std::int32_t>();
+  f.header.step = static_cast<long>(r.pod<std::int64_t>());
+  f.header.time = r.pod<double>();
+  f.header.sceneFile = r.string();
+  f.header.sceneJson = r.string();
+  if (f.header.dimension != 2 && f.header.dimension != 3) r.fail("dimension is not 2 or 3");
+  f.worldOffset = f.bytes.size() - r.remaining();
+  return f;
+}
+
+template <int d>
+void restoreCheckpointWorld(const CheckpointFile& file, World<d>& world, const Registry& registry) {
+  BinaryReader r(file.bytes.data() + file.worldOffset, file.bytes.size() - file.worldOffset, "checkpoint world state");
+  deserializeWorld(world, r, registry);
+  if (!r.atEnd()) r.fail("trailing bytes after the world state");
+}
+
+template void serializeWorld<2>(const World<2>&, BinaryWriter&);
+template void serializeWorld<3>(const World<3>&, BinaryWriter&);
+template void deserializeWorld<2>(World<2>&, BinaryReader&, const Registry&);
+template void deserializeWorld<3>(World<3>&, BinaryReader&, const Registry&);
+template std::uint64_t stateHash<2>(const World<2>&);
+template std::uint64_t stateHash<3>(const World<3>&);
+template void writeCheckpoint<2>(const std::string&, const CheckpointHeader&, const World<2>&);
+template void writeCheckpoint<3>(const std::string&, const CheckpointHeader&, const World<3>&);
+template void restoreCheckpointWorld<2>(const CheckpointFile&, World<2>&, const Registry&);
+template void restoreCheckpointWorld<3>(const CheckpointFile&, World<3>&, const Registry&);
+
+}  // namespace monolith

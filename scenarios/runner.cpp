@@ -1,0 +1,305 @@
+#include "scenarios/runner.h"
+
+#include <sys/stat.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include <tbb/global_control.h>
+
+#include "ecs/scheduler.h"
+#include "scenarios/checkpoint.h"
+#include "scenarios/metrics_writer.h"
+#include "scenarios/progress.h"
+#include "scenarios/vtk_writer.h"
+
+namespace monolith {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string sceneStem(const std::string& file) {
+  return fs::path(file).stem().string().empty() ? "scene" : fs::path(file).stem().string();
+}
+
+// One run directory per run: runs/<scene>, else runs/<scene>-2, -3, ...
+std::string chooseOutDir(const SceneSpec& scene, const RunOptions& options) {
+  if (!options.outDir.empty()) return options.outDir;
+  if (!scene.outputDirectory.empty()) return scene.outputDirectory;
+  const std::string base = "runs/" + sceneStem(scene.file);
+  if (!fs::exists(base)) return base;
+  for (int k = 2;; ++k)
+    if (!fs::exists(base + "-" + std::to_string(k))) return base + "-" + std::to_string(k);
+}
+
+std::string frameName(const char* kind, long step) {
+  std::ostringstream s;
+  s << "frames/" << kind << "_" << std::setw(6) << std::setfill('0') << step << ".vtp";
+  return s.str();
+}
+
+std::string hex(std::uint64_t h) {
+  std::ostringstream s;
+  s << std::hex << std::setw(16) << std::setfill('0') << h;
+  return s.str();
+}
+
+template <int d>
+class Run {
+ public:
+  Run(const SceneSpec& scene, Registry& registry, const RunOptions& options, const CheckpointFile* resume)
+      : scene_(scene), registry_(registry), options_(options), resume_(resume) {}
+
+  RunResult execute();
+
+ private:
+  void writeFrame(long step);
+  std::string checkpointPath(long step) const;
+  bool guard(long step, std::string& diagnosis) const;
+  void writeSummary(const std::string& status, const std::string& diagnosis, long stepsDone,
+                    const std::map<std::string, double>& finalDiagnostics);
+
+  const SceneSpec& scene_;
+  Registry& registry_;
+  RunOptions options_;
+  const CheckpointFile* resume_;
+  World<d> world_;
+  std::unique_ptr<Scheduler<d>> scheduler_;
+  std::string outDir_;
+  std::unique_ptr<PvdCollection> bodiesPvd_, geometryPvd_;
+  std::vector<std::string> checkpoints_;
+  double wallTotal_ = 0;
+  int threads_ = 1;
+};
+
+template <int d>
+void Run<d>::writeFrame(long step) {
+  if (!options_.writeFrames || scene_.frameEvery == 0) return;
+  const double t = step * scene_.dt;
+  const std::string bodies = frameName("bodies", step), geometry = frameName("geometry", step);
+  writeRigidBodyFrame(world_, outDir_ + "/" + bodies);
+  writeRigidGeometryFrame(world_, outDir_ + "/" + geometry);
+  bodiesPvd_->add(t, bodies);
+  geometryPvd_->add(t, geometry);
+  bodiesPvd_->write();
+  geometryPvd_->write();
+}
+
+template <int d>
+std::string Run<d>::checkpointPath(long step) const {
+  std::ostringstream s;
+  s << outDir_ << "/checkpoints/step_" << std::setw(8) << std::setfill('0') << step << ".ckpt";
+  return s.str();
+}
+
+// The blow-up guard: every floating-point field of every component must be finite and below
+// the scene's guard.max_abs_value.
+template <int d>
+bool Run<d>::guard(long step, std::string& diagnosis) const {
+  for (const auto& [name, pool] : world_.pools()) {
+    if (auto v = pool->firstViolation(scene_.guardMaxAbs)) {
+      std::ostringstream m;
+      m << "unstable at step " << step << " (t = " << step * scene_.dt << "): entity " << world_.label(v->entity)
+        << ", component " << v->component << ", field " << v->field.field << "[" << v->field.index
+        << "] = " << v->field.value
+        << (std::isfinite(v->field.value) ? " exceeds guard.max_abs_value = " + std::to_string(scene_.guardMaxAbs)
+                                          : " is not finite");
+      diagnosis = m.str();
+      return false;
+    }
+  }
+  return true;
+}
+
+template <int d>
+void Run<d>::writeSummary(const std::string& status, const std::string& diagnosis, long stepsDone,
+                          const std::map<std::string, double>& finalDiagnostics) {
+  Json s;
+  s["scene"] = scene_.file;
+  s["description"] = scene_.description;
+  s["version"] = MONOLITH_VERSION;
+  s["dimension"] = d;
+  s["threads"] = threads_;
+  s["dt"] = scene_.dt;
+  s["steps"] = scene_.steps;
+  s["steps_completed"] = stepsDone;
+  s["time"] = stepsDone * scene_.dt;
+  s["total_wall_seconds"] = wallTotal_;
+  s["status"] = status;
+  if (!diagnosis.empty()) s["diagnosis"] = diagnosis;
+  s["state_hash"] = hex(stateHash(world_));
+  Json finals = Json::object();
+  for (const auto& [k, v] : finalDiagnostics) finals[k] = std::isfinite(v) ? Json(v) : Json(std::to_string(v));
+  s["final_diagnostics"] = finals;
+  Json systems = Json::array();
+  for (const auto* sys : scheduler_->systems()) systems.push_back({{"name", sys->name()}, {"stage", stageName(sys->stage())}});
+  s["systems"] = systems;
+  s["skipped_systems"] = scheduler_->skipped();
+  s["checkpoints"] = checkpoints_;
+  s["entities"] = world_.entityCount();
+  writeFileAtomically(outDir_ + "/summary.json", s.dump(2) + "\n");
+}
+
+template <int d>
+RunResult Run<d>::execute() {
+  RunResult result;
+  populateWorld(scene_, registry_, world_);
+  long firstStep = 0;
+  if (resume_) {
+    restoreCheckpointWorld(*resume_, world_, registry_);
+    firstStep = resume_->header.step;
+  }
+  threads_ = options_.threads > 0 ? options_.threads : scene_.threads;
+  // Process-wide cap on parallelism for this run (default 2 threads, --threads N).
+  tbb::global_control cap(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads_));
+  scheduler_ = std::make_unique<Scheduler<d>>(registry_.instantiateSystems<d>(), world_, threads_);
+  outDir_ = chooseOutDir(scene_, options_);
+  result.outDir = outDir_;
+  fs::create_directories(outDir_ + "/frames");
+  const long checkpointEvery = options_.checkpointEvery >= 0 ? options_.checkpointEvery : scene_.checkpointEvery;
+  if (checkpointEvery > 0) fs::create_directories(outDir_ + "/checkpoints");
+  {
+    std::ofstream graph(outDir_ + "/step_graph.dot");
+    graph << scheduler_->dot();
+  }
+
+  bodiesPvd_ = std::make_unique<PvdCollection>(outDir_ + "/bodies.pvd");
+  geometryPvd_ = std::make_unique<PvdCollection>(outDir_ + "/geometry.pvd");
+  if (resume_) {
+    bodiesPvd_->load();
+    geometryPvd_->load();
+    bodiesPvd_->truncateAfter(firstStep * scene_.dt * (1 + 1e-12));
+    geometryPvd_->truncateAfter(firstStep * scene_.dt * (1 + 1e-12));
+  }
+  MetricsWriter metrics(outDir_ + "/metrics.csv", resume_ ? firstStep : -1);
+  if (!resume_) writeFrame(0);
+
+  std::vector<Stage> stages;
+  for (Stage s : kAllStages)
+    for (const auto* sys : scheduler_->systems())
+      if (sys->stage() == s) {
+        stages.push_back(s);
+        break;
+      }
+
+  Progress progress(scene_.steps, firstStep, options_.progress);
+  std::map<std::string, double> lastDiagnostics;
+  std::string lastGoodCheckpoint;
+  for (long n = firstStep; n < scene_.steps; ++n) {
+    StepContext ctx;
+    ctx.dt = scene_.dt;
+    ctx.time = n * scene_.dt;  // t^n from the index: no drift, identical after a resume
+    ctx.step = n;
+    const auto t0 = Clock::now();
+    scheduler_->step(world_, ctx);
+    const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+    wallTotal_ += wall;
+    const long done = n + 1;
+
+    std::string diagnosis;
+    bool ok = guard(done, diagnosis);
+    for (const auto& [k, v] : ctx.diagnostics.values())
+      if (ok && !std::isfinite(v)) {
+        ok = false;
+        diagnosis = "unstable at step " + std::to_string(done) + ": diagnostic " + k + " is not finite";
+      }
+    metrics.row(done, done * scene_.dt, scene_.dt, ctx.diagnostics.values(), stages, scheduler_->stageSeconds(), wall);
+    if (!ok) {
+      progress.finish("stopped: unstable");
+      if (!lastGoodCheckpoint.empty()) diagnosis += "; last good checkpoint: " + lastGoodCheckpoint;
+      else diagnosis += "; no checkpoint was written (use --checkpoint-every K)";
+      writeSummary("unstable", diagnosis, done, ctx.diagnostics.values());
+      result.exitCode = kExitUnstable;
+      result.message = diagnosis;
+      result.stepsCompleted = done;
+      result.wallSeconds = wallTotal_;
+      return result;  // the bad state is neither framed nor checkpointed
+    }
+    lastDiagnostics = ctx.diagnostics.values();
+    if (scene_.frameEvery > 0 && done % scene_.frameEvery == 0) writeFrame(done);
+    if (checkpointEvery > 0 && done % checkpointEvery == 0) {
+      const std::string path = checkpointPath(done);
+      writeCheckpoint(path, CheckpointHeader{d, done, done * scene_.dt, fs::absolute(scene_.file).string(), scene_.json.dump()}, world_);
+      checkpoints_.push_back(path);
+      lastGoodCheckpoint = path;
+    }
+    progress.update(done);
+  }
+  progress.finish("done: " + std::to_string(scene_.steps - firstStep) + " steps");
+  writeSummary("completed", "", scene_.steps, lastDiagnostics);
+  result.stepsCompleted = scene_.steps;
+  result.stateHash = stateHash(world_);
+  result.wallSeconds = wallTotal_;
+  return result;
+}
+
+template <int d>
+RunResult runWithDimension(const SceneSpec& scene, Registry& registry, const RunOptions& options,
+                           const CheckpointFile* resume) {
+  Run<d> run(scene, registry, options, resume);
+  return run.execute();
+}
+
+RunResult dispatch(const SceneSpec& scene, Registry& registry, PluginLoader& plugins, const RunOptions& options,
+                   const CheckpointFile* resume) {
+  RunResult r;
+  try {
+    loadScenePlugins(scene, plugins, registry);
+    return scene.dimension == 2 ? runWithDimension<2>(scene, registry, options, resume)
+                                : runWithDimension<3>(scene, registry, options, resume);
+  } catch (const SceneError& e) {
+    r.exitCode = kExitInvalidScene;
+    r.message = e.what();
+  } catch (const PluginError& e) {
+    r.exitCode = kExitInvalidScene;
+    r.message = e.what();
+  } catch (const std::exception& e) {
+    r.exitCode = kExitFailure;
+    r.message = e.what();
+  }
+  return r;
+}
+
+}  // namespace
+
+RunResult runScene(const SceneSpec& scene, Registry& registry, PluginLoader& plugins, const RunOptions& options) {
+  return dispatch(scene, registry, plugins, options, nullptr);
+}
+
+RunResult resumeRun(const std::string& checkpointPath, Registry& registry, PluginLoader& plugins, RunOptions options) {
+  RunResult r;
+  CheckpointFile file;
+  SceneSpec scene;
+  try {
+    file = readCheckpoint(checkpointPath);
+    scene = parseScene(file.header.sceneJson, file.header.sceneFile);
+  } catch (const SceneError& e) {
+    r.exitCode = kExitInvalidScene;
+    r.message = std::string("checkpoint '") + checkpointPath + "': embedded scene: " + e.what();
+    return r;
+  } catch (const std::exception& e) {
+    r.exitCode = kExitInvalidScene;
+    r.message = e.what();
+    return r;
+  }
+  if (scene.dimension != file.header.dimension) {
+    r.exitCode = kExitInvalidScene;
+    r.message = "checkpoint '" + checkpointPath + "': dimension differs from its scene";
+    return r;
+  }
+  if (options.outDir.empty()) {  // continue in the run directory the checkpoint belongs to
+    const fs::path p = fs::absolute(checkpointPath);
+    options.outDir = p.parent_path().filename() == "checkpoints" ? p.parent_path().parent_path().string()
+                                                                 : p.parent_path().string();
+  }
+  return dispatch(scene, registry, plugins, options, &file);
+}
+
+}  // namespace monolith

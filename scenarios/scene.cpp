@@ -1,0 +1,241 @@
+#include "scenarios/scene.h"
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "components/forces.h"
+#include "components/rigid_body.h"
+#include "ecs/plugin.h"
+
+namespace monolith {
+
+namespace {
+
+std::string directoryOf(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? std::string(".") : path.substr(0, slash == 0 ? 1 : slash);
+}
+
+std::string resolvePath(const std::string& directory, const std::string& p) {
+  if (p.empty() || p[0] == '/') return p;
+  return directory + "/" + p;
+}
+
+// Turns nlohmann's byte offset into line:column and names invalid number literals.
+[[noreturn]] void throwSyntaxError(const std::string& text, const std::string& file, const Json::parse_error& e) {
+  std::size_t byte = e.byte > 0 ? e.byte - 1 : 0;
+  if (byte > text.size()) byte = text.size();
+  std::size_t line = 1, column = 1;
+  for (std::size_t i = 0; i < byte; ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  // Word at the error, to explain the common mistake of writing NaN/Infinity.
+  std::size_t start = byte;
+  while (start > 0 && std::isalpha(static_cast<unsigned char>(text[start - 1]))) --start;
+  std::size_t end = start;
+  while (end < text.size() && std::isalpha(static_cast<unsigned char>(text[end]))) ++end;
+  const std::string word = text.substr(start, end - start);
+  std::string expected = "valid JSON (comments allowed)";
+  if (word == "NaN" || word == "nan" || word == "Infinity" || word == "inf" || word == "infinity")
+    expected = "a finite number (JSON has no NaN or Infinity)";
+  std::string what = e.what();
+  const auto colon = what.find("syntax error");
+  if (colon != std::string::npos) what = what.substr(colon);
+  throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(column), expected,
+                   word.empty() ? what : "'" + word + "' (" + what + ")");
+}
+
+Json parseOverrideValue(const std::string& value) {
+  try {
+    return Json::parse(value);
+  } catch (const Json::parse_error&) {
+    return Json(value);  // plain strings need no quotes on the command line
+  }
+}
+
+void applyOverride(Json& root, const Override& o, const std::string& file) {
+  std::vector<std::string> parts;
+  std::stringstream ss(o.first);
+  for (std::string part; std::getline(ss, part, '.');) parts.push_back(part);
+  if (parts.empty() || o.first.empty()) throw SceneError(file, "--set " + o.first, "key=value with a non-empty key", "");
+  Json* node = &root;
+  std::string path;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const std::string& part = parts[i];
+    const bool last = i + 1 == parts.size();
+    if (node->is_array()) {
+      std::size_t index = node->size();
+      if (!part.empty() && std::all_of(part.begin(), part.end(), ::isdigit)) {
+        index = std::stoul(part);
+      } else {
+        for (std::size_t k = 0; k < node->size(); ++k)
+          if ((*node)[k].is_object() && (*node)[k].value("name", std::string()) == part) index = k;
+      }
+      if (index >= node->size())
+        throw SceneError(file, "--set " + o.first, "an index or entity name that exists at '" + path + "'",
+                         "'" + part + "'");
+      path += "[" + part + "]";
+      node = &(*node)[index];
+    } else {
+      if (!node->is_object()) *node = Json::object();
+      path += (path.empty() ? "" : ".") + part;
+      node = &(*node)[part];
+    }
+    if (last) *node = parseOverrideValue(o.second);
+  }
+}
+
+}  // namespace
+
+SceneSpec parseScene(const std::string& text, const std::string& file, const std::vector<Override>& overrides) {
+  SceneSpec s;
+  s.file = file;
+  s.directory = directoryOf(file);
+  try {
+    s.json = Json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+  } catch (const Json::parse_error& e) {
+    throwSyntaxError(text, file, e);
+  }
+  if (!s.json.is_object()) throw SceneError(file, "", "a JSON object at the top level", describeJson(s.json));
+  for (const auto& o : overrides) applyOverride(s.json, o, file);
+
+  const Config top(s.json, file, "");
+  s.description = top.string("description", "");
+  s.dimension = static_cast<int>(top.integer("dimension", 2, 3));
+
+  const Config time = top.child("time");
+  s.dt = time.number("dt", Bound::Positive);
+  if (time.has("steps") && time.has("end")) time.failAt("end", "either \"end\" or \"steps\", not both", "both");
+  if (time.has("steps")) {
+    s.steps = time.integer("steps", 1, 1000000000L);
+  } else {
+    const double end = time.number("end", Bound::Positive);
+    const double n = end / s.dt;
+    s.steps = std::lround(n);
+    if (s.steps < 1 || std::abs(n - static_cast<double>(s.steps)) > 1e-6 * std::max(1.0, n))
+      time.failAt("end", "a whole number of steps of dt = " + std::to_string(s.dt) + " (end/dt = " + std::to_string(n) + ")",
+                  describeJson(time.raw()["end"]));
+  }
+  const double frameRate = time.number("frame_rate", 30.0, Bound::NonNegative);
+  s.frameEvery = frameRate > 0 ? std::max(1L, std::lround(1.0 / (frameRate * s.dt))) : 0;
+  time.finish();
+
+  s.threads = static_cast<int>(top.integer("threads", 2, 1, 256));
+
+  if (top.has("output")) {
+    const Config out = top.child("output");
+    s.outputDirectory = out.string("directory", "");
+    if (!out.boolean("frames", true)) s.frameEvery = 0;
+    out.finish();
+  }
+  if (top.has("checkpoint")) {
+    const Config ck = top.child("checkpoint");
+    s.checkpointEvery = ck.integer("every", 0, 0, 1000000000L);
+    ck.finish();
+  }
+  if (top.has("guard")) {
+    const Config guard = top.child("guard");
+    s.guardMaxAbs = guard.number("max_abs_value", s.guardMaxAbs, Bound::Positive);
+    guard.finish();
+  }
+  if (top.has("plugins")) {
+    top.markUsed("plugins");
+    const Json& list = s.json["plugins"];
+    if (!list.is_array()) top.failAt("plugins", "an array of plugin paths", describeJson(list));
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      if (!list[i].is_string() || list[i].get<std::string>().empty())
+        top.failAt("plugins[" + std::to_string(i) + "]", "a plugin path (string)", describeJson(list[i]));
+      s.plugins.push_back(resolvePath(s.directory, list[i].get<std::string>()));
+    }
+  }
+  // Validated with the world (they depend on the dimension): checked by populateWorld.
+  top.markUsed("gravity");
+  top.markUsed("solvers");
+  top.markUsed("entities");
+  if (!s.json.contains("entities")) top.failAt("entities", "an array of entities (required key is missing)", "");
+  if (!s.json["entities"].is_array()) top.failAt("entities", "an array of entities", describeJson(s.json["entities"]));
+  top.finish();
+  return s;
+}
+
+SceneSpec loadScene(const std::string& path, const std::vector<Override>& overrides) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path, "", "a readable scene file", "no such file or it cannot be read");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return parseScene(buffer.str(), path, overrides);
+}
+
+void loadScenePlugins(const SceneSpec& scene, PluginLoader& loader, Registry& registry) {
+  for (std::size_t i = 0; i < scene.plugins.size(); ++i) {
+    try {
+      loader.load(scene.plugins[i], registry);
+    } catch (const PluginError& e) {
+      throw SceneError(scene.file, "plugins[" + std::to_string(i) + "]", "a loadable Monolith plugin", e.what());
+    }
+  }
+}
+
+template <int d>
+void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& world) {
+  if (scene.dimension != d) throw std::logic_error("populateWorld: dimension mismatch");
+  const Config top(scene.json, scene.file, "");
+  if (scene.json.contains("gravity")) world.settings().gravity = top.vector("gravity", d);
+
+  if (scene.json.contains("solvers")) {
+    const Config solvers = top.child("solvers");
+    if (solvers.has("rigid_rotation")) {
+      const Config rr = solvers.child("rigid_rotation");
+      world.settings().rigidRotation.order = static_cast<int>(rr.integer("order", 2, 1, 3));
+      world.settings().rigidRotation.energyFix = rr.boolean("energy_fix", true);
+      rr.finish();
+    }
+    solvers.finish();
+  }
+
+  std::vector<std::string> componentNames;
+  for (const auto& c : registry.components<d>())
+    if (c.parse) componentNames.push_back(c.name);
+
+  const Config entities(scene.json["entities"], scene.file, "entities");
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < entities.arraySize(); ++i) {
+    const Config entity = entities.element(i);
+    if (!entity.raw().is_object()) entity.fail("an entity object", describeJson(entity.raw()));
+    const std::string name = entity.string("name", "");
+    if (!name.empty() && !names.insert(name).second)
+      entity.failAt("name", "a name not used by another entity", "\"" + name + "\" again");
+    // Every other key must name a component this dimension knows.
+    for (const auto& key : entity.keys()) {
+      if (key == "name") continue;
+      if (!registry.findComponent<d>(key) || !registry.findComponent<d>(key)->parse) {
+        const std::string guess = closestMatch(key, componentNames);
+        std::string known;
+        for (const auto& n : componentNames) known += (known.empty() ? "" : ", ") + n;
+        entity.failAt(key, "a component name for a " + std::to_string(d) + "-D scene (one of: " + known + ")",
+                      "\"" + key + "\"" + (guess.empty() ? "" : " (did you mean \"" + guess + "\"?)"));
+      }
+    }
+    const Entity e = world.create(name);
+    // Registry order, not file order: a component may rely on one registered before it
+    // (rigid_body derives its inertia from shape).
+    for (const auto& type : registry.components<d>()) {
+      if (!type.parse || !entity.raw().contains(type.name)) continue;
+      const Config config = entity.child(type.name);
+      type.parse(world, e, config);
+      config.finish();
+    }
+  }
+}
+
+template void populateWorld<2>(const SceneSpec&, const Registry&, World<2>&);
+template void populateWorld<3>(const SceneSpec&, const Registry&, World<3>&);
+
+}  // namespace monolith

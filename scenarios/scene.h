@@ -1,0 +1,49 @@
+#pragma once
+// Scene files (DESIGN.md §7): JSON with comments. loadScene() reads and validates the
+// top-level settings; populateWorld() validates and creates the entities through the
+// component factories of the registry. Every problem is a SceneError naming the file, the JSON
+// path and what was expected; nothing is simulated from a scene that fails validation.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ecs/config.h"
+#include "ecs/registry.h"
+#include "ecs/world.h"
+
+namespace monolith {
+
+struct SceneSpec {
+  std::string file;       // the path as given (used in messages)
+  std::string directory;  // relative paths in the scene are resolved against this
+  Json json;              // the scene after --set overrides
+  std::string description;
+  int dimension = 3;
+  double dt = 0;
+  long steps = 0;
+  long frameEvery = 1;  // write a frame every this many steps (0: no frames)
+  int threads = 2;
+  std::string outputDirectory;  // "" = derived from the scene name
+  std::vector<std::string> plugins;  // resolved paths
+  long checkpointEvery = 0;          // 0 = off
+  double guardMaxAbs = 1e12;         // blow-up guard: any state value beyond this is absurd
+};
+
+// One "--set key=value": key is a dotted path (entity names may stand for their index in
+// "entities", e.g. entities.ball.rigid_body.mass=2); value is JSON or else a plain string.
+using Override = std::pair<std::string, std::string>;
+
+// Parses the file (comments allowed), applies the overrides and validates the top level.
+SceneSpec loadScene(const std::string& path, const std::vector<Override>& overrides = {});
+// Same, from text already in memory (checkpoints carry their scene).
+SceneSpec parseScene(const std::string& text, const std::string& file, const std::vector<Override>& overrides = {});
+
+// Creates the scene's entities in `world` (which must be empty) and sets the world settings.
+template <int d>
+void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& world);
+
+// Loads the plugins the scene names into the registry (PluginError names the path).
+class PluginLoader;
+void loadScenePlugins(const SceneSpec& scene, PluginLoader& loader, Registry& registry);
+
+}  // namespace monolith
