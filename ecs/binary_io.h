@@ -84,7 +84,7 @@ class BinaryReader {
 };
 
 // FNV-1a over bytes: the state hash that determinism tests and summary.json compare.
-inline std::uint64_t fnv1a(const std::uint8_t* data, std::size_t size, std::uint64_t h = 1469598103934665603ull) {
+inline std::uint64_t fnv1a(const std::uint8_t* data, std::size_t size, std::uint64_t h = 14695981039346656037ull) {
   for (std::size_t i = 0; i < size; ++i) {
     h ^= data[i];
     h *= 1099511628211ull;

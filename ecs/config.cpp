@@ -37,6 +37,16 @@ std::string boundText(Bound b) {
   }
   return "a finite number";
 }
+// Reports a missing required key. When the object holds an unknown key that is a near miss of
+// it ("mas" for "mass"), that typo is the actual mistake: name it, not the missing key.
+[[noreturn]] void failMissing(const Config& c, const std::set<std::string>& used, const std::string& key,
+                              const std::string& expected) {
+  for (const auto& k : c.keys())
+    if (k != key && !used.count(k) && closestMatch(k, {key}) == key)
+      throw SceneError(c.file(), c.pathOf(k), "no key \"" + k + "\" here (unknown key; did you mean \"" + key + "\"?)",
+                       "");
+  c.failAt(key, expected + " (required key is missing)", "");
+}
 }  // namespace
 
 SceneError::SceneError(std::string file, std::string path, std::string expected, std::string got)
@@ -92,7 +102,7 @@ bool Config::has(const std::string& key) const { return node_->is_object() && no
 
 Config Config::child(const std::string& key) const {
   if (!node_->is_object()) fail("an object", describeJson(*node_));
-  if (!node_->contains(key)) failAt(key, "an object (required key is missing)", "");
+  if (!node_->contains(key)) failMissing(*this, *used_, key, "an object");
   used_->insert(key);
   const Json& c = (*node_)[key];
   if (!c.is_object()) failAt(key, "an object", describeJson(c));
@@ -125,7 +135,7 @@ double Config::checkedNumber(const std::string& key, const Json& v, Bound bound)
 }
 
 double Config::number(const std::string& key, Bound bound) const {
-  if (!has(key)) failAt(key, boundText(bound) + " (required key is missing)", "");
+  if (!has(key)) failMissing(*this, *used_, key, boundText(bound));
   used_->insert(key);
   return checkedNumber(key, (*node_)[key], bound);
 }
@@ -137,7 +147,7 @@ double Config::number(const std::string& key, double fallback, Bound bound) cons
 
 long Config::integer(const std::string& key, long min, long max) const {
   const std::string expected = "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
-  if (!has(key)) failAt(key, expected + " (required key is missing)", "");
+  if (!has(key)) failMissing(*this, *used_, key, expected);
   used_->insert(key);
   const Json& v = (*node_)[key];
   if (!v.is_number_integer()) {
@@ -167,7 +177,7 @@ bool Config::boolean(const std::string& key, bool fallback) const {
 }
 
 std::string Config::string(const std::string& key) const {
-  if (!has(key)) failAt(key, "a string (required key is missing)", "");
+  if (!has(key)) failMissing(*this, *used_, key, "a string");
   used_->insert(key);
   const Json& v = (*node_)[key];
   if (!v.is_string()) failAt(key, "a string", describeJson(v));
@@ -185,7 +195,7 @@ std::string Config::oneOf(const std::string& key, const std::vector<std::string>
   for (const auto& a : allowed) list += (list.empty() ? "\"" : ", \"") + a + "\"";
   used_->insert(key);
   if (!has(key)) {
-    if (fallback.empty()) failAt(key, "one of " + list + " (required key is missing)", "");
+    if (fallback.empty()) failMissing(*this, *used_, key, "one of " + list);
     return fallback;
   }
   used_->insert(key);
@@ -202,7 +212,7 @@ std::string Config::oneOf(const std::string& key, const std::vector<std::string>
 Eigen::VectorXd Config::vector(const std::string& key, int size, Bound bound) const {
   const std::string expected = "an array of " + std::to_string(size) + " finite numbers" +
                                (bound == Bound::Positive ? " > 0" : bound == Bound::NonNegative ? " >= 0" : "");
-  if (!has(key)) failAt(key, expected + " (required key is missing)", "");
+  if (!has(key)) failMissing(*this, *used_, key, expected);
   used_->insert(key);
   const Json& v = (*node_)[key];
   if (!v.is_array() || static_cast<int>(v.size()) != size) failAt(key, expected, describeJson(v));
@@ -225,7 +235,7 @@ Eigen::VectorXd Config::vector(const std::string& key, const Eigen::VectorXd& fa
 
 Eigen::MatrixXd Config::matrix(const std::string& key, int rows, int cols) const {
   const std::string expected = "an array of " + std::to_string(rows) + " rows of " + std::to_string(cols) + " finite numbers";
-  if (!has(key)) failAt(key, expected + " (required key is missing)", "");
+  if (!has(key)) failMissing(*this, *used_, key, expected);
   used_->insert(key);
   const Json& v = (*node_)[key];
   if (!v.is_array() || static_cast<int>(v.size()) != rows) failAt(key, expected, describeJson(v));

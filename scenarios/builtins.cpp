@@ -16,10 +16,26 @@ namespace monolith {
 
 namespace {
 
+// Angular quantities: a 3-vector in 3-D, a number (rotation about z) in 2-D; default zero.
+template <int d>
+AngularVec<d> angularConfig(const Config& c, const std::string& key) {
+  AngularVec<d> a = AngularVec<d>::Zero();
+  if constexpr (d == 3) a = c.vector(key, Eigen::VectorXd::Zero(3));
+  else a(0) = c.number(key, 0.0);
+  return a;
+}
+
 template <int d>
 void parseShape(World<d>& world, Entity e, const Config& c) {
   Shape<d> shape;
   const std::string sphereName = d == 3 ? "sphere" : "disk";
+  // The round shape of the other dimension is too far from this one's name for "did you
+  // mean": point at it explicitly.
+  const std::string otherName = d == 3 ? "disk" : "sphere";
+  if (c.has("type") && c.raw()["type"] == otherName)
+    c.failAt("type", "one of \"box\", \"" + sphereName + "\"",
+             describeJson(c.raw()["type"]) + " (a " + std::to_string(5 - d) + "-D shape; did you mean \"" + sphereName +
+                 "\"?)");
   const std::string type = c.oneOf("type", {"box", sphereName}, "");
   if (type == "box") {
     shape.type = ShapeType::Box;
@@ -87,11 +103,14 @@ void parseRigidBody(World<d>& world, Entity e, const Config& c) {
     b.orientation = c.number("angle", 0.0);
   }
   b.v = c.vector("velocity", Eigen::VectorXd::Zero(d));
-  AngularVec<d> w;
-  w = c.vector("angular_velocity", Eigen::VectorXd::Zero(d == 3 ? 3 : 1));
+  const AngularVec<d> w = angularConfig<d>(c, "angular_velocity");
   if (b.isStatic) {
-    if (b.v.squaredNorm() > 0 || w.squaredNorm() > 0)
+    if (b.v.squaredNorm() > 0)
       c.failAt("velocity", "no velocity on a static body (static bodies never move)", "a non-zero velocity");
+    // Reported at its own key: the message must point at the value to remove.
+    if (w.squaredNorm() > 0)
+      c.failAt("angular_velocity", "no angular velocity on a static body (static bodies never move)",
+               "a non-zero angular velocity");
   } else {
     b.setOmega(w);
   }
@@ -103,7 +122,7 @@ template <int d>
 void parseExternalForce(World<d>& world, Entity e, const Config& c) {
   ExternalForce<d> f;
   f.force = c.vector("force", Eigen::VectorXd::Zero(d));
-  f.torque = c.vector("torque", Eigen::VectorXd::Zero(d == 3 ? 3 : 1));
+  f.torque = angularConfig<d>(c, "torque");
   world.add(e, f);
 }
 
