@@ -58,8 +58,10 @@ class Probe final : public System<3> {
 // Two of these meet only if they run at the same time: each waits (bounded) for the other.
 class Rendezvous final : public System<3> {
  public:
-  Rendezvous(std::string name, std::string resource, std::atomic<int>* arrived, std::atomic<bool>* met)
-      : name_(std::move(name)), resource_(std::move(resource)), arrived_(arrived), met_(met) {}
+  Rendezvous(std::string name, std::string resource, std::atomic<int>* arrived, std::atomic<bool>* met,
+             int timeoutMillis)
+      : name_(std::move(name)), resource_(std::move(resource)), arrived_(arrived), met_(met),
+        timeoutMillis_(timeoutMillis) {}
   std::string name() const override { return name_; }
   Stage stage() const override { return Stage::Collisions; }
   std::vector<std::string> reads() const override { return {}; }
@@ -67,7 +69,7 @@ class Rendezvous final : public System<3> {
   bool needed(const World<3>&) const override { return true; }
   void run(World<3>&, StepContext&) override {
     ++*arrived_;  // "active": running right now
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(200);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeoutMillis_);
     while (std::chrono::steady_clock::now() < deadline) {
       if (arrived_->load() >= 2) {
         *met_ = true;
@@ -82,6 +84,7 @@ class Rendezvous final : public System<3> {
   std::string name_, resource_;
   std::atomic<int>* arrived_;
   std::atomic<bool>* met_;
+  int timeoutMillis_;
 };
 
 }  // namespace
@@ -146,8 +149,9 @@ TEST(Scheduler, IndependentSystemsRunConcurrentlyWithTwoThreads) {
   std::atomic<int> arrived{0};
   std::atomic<bool> met{false};
   std::vector<std::unique_ptr<System<3>>> systems;
-  systems.push_back(std::make_unique<Rendezvous>("left", "x", &arrived, &met));
-  systems.push_back(std::make_unique<Rendezvous>("right", "y", &arrived, &met));
+  // Generous timeout: it returns as soon as both run; a loaded machine may be slow to wake a worker.
+  systems.push_back(std::make_unique<Rendezvous>("left", "x", &arrived, &met, 5000));
+  systems.push_back(std::make_unique<Rendezvous>("right", "y", &arrived, &met, 5000));
   World<3> world;
   Scheduler<3> s(std::move(systems), world, 2);
   EXPECT_TRUE(s.edges().empty());
@@ -160,8 +164,8 @@ TEST(Scheduler, OneThreadRunsSerially) {
   std::atomic<int> arrived{0};
   std::atomic<bool> met{false};
   std::vector<std::unique_ptr<System<3>>> systems;
-  systems.push_back(std::make_unique<Rendezvous>("left", "x", &arrived, &met));
-  systems.push_back(std::make_unique<Rendezvous>("right", "y", &arrived, &met));
+  systems.push_back(std::make_unique<Rendezvous>("left", "x", &arrived, &met, 200));
+  systems.push_back(std::make_unique<Rendezvous>("right", "y", &arrived, &met, 200));
   World<3> world;
   Scheduler<3> s(std::move(systems), world, 1);
   StepContext ctx;
