@@ -1,6 +1,8 @@
 #include "scenarios/scene.h"
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -23,9 +25,8 @@ std::string resolvePath(const std::string& directory, const std::string& p) {
   return directory + "/" + p;
 }
 
-// Turns nlohmann's byte offset into line:column and names invalid number literals.
-[[noreturn]] void throwSyntaxError(const std::string& text, const std::string& file, const Json::parse_error& e) {
-  std::size_t byte = e.byte > 0 ? e.byte - 1 : 0;
+// "line L, column C" of a byte offset into the text.
+std::string lineColumn(const std::string& text, std::size_t byte) {
   if (byte > text.size()) byte = text.size();
   std::size_t line = 1, column = 1;
   for (std::size_t i = 0; i < byte; ++i) {
@@ -36,6 +37,20 @@ std::string resolvePath(const std::string& directory, const std::string& p) {
       ++column;
     }
   }
+  return "line " + std::to_string(line) + ", column " + std::to_string(column);
+}
+
+// Short form of a number for messages (std::to_string would print 1e-9 as 0.000000).
+std::string formatNumber(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
+// Turns nlohmann's byte offset into line:column and names invalid number literals.
+[[noreturn]] void throwSyntaxError(const std::string& text, const std::string& file, const Json::parse_error& e) {
+  std::size_t byte = e.byte > 0 ? e.byte - 1 : 0;
+  if (byte > text.size()) byte = text.size();
   // Word at the error, to explain the common mistake of writing NaN/Infinity.
   std::size_t start = byte;
   while (start > 0 && std::isalpha(static_cast<unsigned char>(text[start - 1]))) --start;
@@ -48,9 +63,68 @@ std::string resolvePath(const std::string& directory, const std::string& p) {
   std::string what = e.what();
   const auto colon = what.find("syntax error");
   if (colon != std::string::npos) what = what.substr(colon);
-  throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(column), expected,
-                   word.empty() ? what : "'" + word + "' (" + what + ")");
+  throw SceneError(file, lineColumn(text, byte), expected, word.empty() ? what : "'" + word + "' (" + what + ")");
 }
+
+// nlohmann reports a literal beyond the range of a double (1e999) as out_of_range without a
+// position; the literal is in the message, so locate its first occurrence in the text.
+[[noreturn]] void throwNumberOverflow(const std::string& text, const std::string& file, const Json::out_of_range& e) {
+  const std::string what = e.what();
+  const auto open = what.find('\''), close = what.rfind('\'');
+  const std::string literal = open != std::string::npos && close > open ? what.substr(open + 1, close - open - 1) : "";
+  const auto at = literal.empty() ? std::string::npos : text.find(literal);
+  throw SceneError(file, at == std::string::npos ? std::string() : lineColumn(text, at),
+                   "a finite number (the literal is too large for a double)",
+                   literal.empty() ? what : "'" + literal + "'");
+}
+
+// Parser callback that tracks the JSON path and rejects a key given twice in one object:
+// nlohmann would silently keep the last value, hiding the first one from validation.
+class DuplicateKeyCheck {
+ public:
+  explicit DuplicateKeyCheck(std::string file) : file_(std::move(file)) {}
+  bool operator()(int, Json::parse_event_t event, Json& parsed) {
+    switch (event) {
+      case Json::parse_event_t::object_start:
+      case Json::parse_event_t::array_start:
+        if (!frames_.empty() && !frames_.back().object) ++frames_.back().index;
+        frames_.push_back(Frame{event == Json::parse_event_t::object_start, {}, "", -1});
+        break;
+      case Json::parse_event_t::object_end:
+      case Json::parse_event_t::array_end:
+        if (!frames_.empty()) frames_.pop_back();
+        break;
+      case Json::parse_event_t::key: {
+        Frame& top = frames_.back();
+        top.key = parsed.get<std::string>();
+        if (!top.keys.insert(top.key).second)
+          throw SceneError(file_, path(), "a key given only once in its object",
+                           "\"" + top.key + "\" given twice (the last value would silently win)");
+        break;
+      }
+      case Json::parse_event_t::value:
+        if (!frames_.empty() && !frames_.back().object) ++frames_.back().index;
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool object;
+    std::set<std::string> keys;
+    std::string key;
+    long index;
+  };
+  std::string path() const {
+    std::string p;
+    for (const auto& f : frames_)
+      p += f.object ? (p.empty() ? "" : ".") + f.key : "[" + std::to_string(f.index) + "]";
+    return p;
+  }
+  std::string file_;
+  std::vector<Frame> frames_;
+};
 
 Json parseOverrideValue(const std::string& value) {
   try {
@@ -73,7 +147,7 @@ void applyOverride(Json& root, const Override& o, const std::string& file) {
     if (node->is_array()) {
       std::size_t index = node->size();
       if (!part.empty() && std::all_of(part.begin(), part.end(), ::isdigit)) {
-        index = std::stoul(part);
+        if (part.size() < 10) index = std::stoul(part);  // longer cannot exist (and could overflow stoul)
       } else {
         for (std::size_t k = 0; k < node->size(); ++k)
           if ((*node)[k].is_object() && (*node)[k].value("name", std::string()) == part) index = k;
@@ -88,7 +162,14 @@ void applyOverride(Json& root, const Override& o, const std::string& file) {
       path += (path.empty() ? "" : ".") + part;
       node = &(*node)[part];
     }
-    if (last) *node = parseOverrideValue(o.second);
+    if (last) {
+      try {
+        *node = parseOverrideValue(o.second);
+      } catch (const Json::out_of_range&) {  // 1e999: beyond a double, not a plain string
+        throw SceneError(file, "--set " + o.first, "a finite number (the literal is too large for a double)",
+                         "'" + o.second + "'");
+      }
+    }
   }
 }
 
@@ -99,9 +180,11 @@ SceneSpec parseScene(const std::string& text, const std::string& file, const std
   s.file = file;
   s.directory = directoryOf(file);
   try {
-    s.json = Json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    s.json = Json::parse(text, DuplicateKeyCheck(file), /*allow_exceptions=*/true, /*ignore_comments=*/true);
   } catch (const Json::parse_error& e) {
     throwSyntaxError(text, file, e);
+  } catch (const Json::out_of_range& e) {
+    throwNumberOverflow(text, file, e);
   }
   if (!s.json.is_object()) throw SceneError(file, "", "a JSON object at the top level", describeJson(s.json));
   for (const auto& o : overrides) applyOverride(s.json, o, file);
@@ -113,18 +196,34 @@ SceneSpec parseScene(const std::string& text, const std::string& file, const std
   const Config time = top.child("time");
   s.dt = time.number("dt", Bound::Positive);
   if (time.has("steps") && time.has("end")) time.failAt("end", "either \"end\" or \"steps\", not both", "both");
+  const long maxSteps = 1000000000L;
+  if (!time.has("steps") && !time.has("end")) {
+    // A misspelt "steps" or "end" is the likelier mistake: report it as the unknown key it is.
+    time.markUsed("steps");
+    time.markUsed("end");
+    time.markUsed("frame_rate");
+    time.finish();
+    time.fail("a \"steps\" or an \"end\" key (neither is given)", "");
+  }
   if (time.has("steps")) {
-    s.steps = time.integer("steps", 1, 1000000000L);
+    s.steps = time.integer("steps", 1, maxSteps);
   } else {
     const double end = time.number("end", Bound::Positive);
     const double n = end / s.dt;
+    // Checked before lround, which is undefined beyond the range of long.
+    if (!(n <= static_cast<double>(maxSteps) + 0.5))
+      time.failAt("end", "at most " + std::to_string(maxSteps) + " steps of dt = " + formatNumber(s.dt) +
+                             " (end/dt = " + formatNumber(n) + ")",
+                  describeJson(time.raw()["end"]));
     s.steps = std::lround(n);
     if (s.steps < 1 || std::abs(n - static_cast<double>(s.steps)) > 1e-6 * std::max(1.0, n))
-      time.failAt("end", "a whole number of steps of dt = " + std::to_string(s.dt) + " (end/dt = " + std::to_string(n) + ")",
+      time.failAt("end",
+                  "a whole number of steps of dt = " + formatNumber(s.dt) + " (end/dt = " + formatNumber(n) + ")",
                   describeJson(time.raw()["end"]));
   }
   const double frameRate = time.number("frame_rate", 30.0, Bound::NonNegative);
-  s.frameEvery = frameRate > 0 ? std::max(1L, std::lround(1.0 / (frameRate * s.dt))) : 0;
+  // Capped before lround, which is undefined beyond the range of long (a tiny frame rate).
+  s.frameEvery = frameRate > 0 ? std::max(1L, std::lround(std::min(1.0 / (frameRate * s.dt), 1e15))) : 0;
   time.finish();
 
   s.threads = static_cast<int>(top.integer("threads", 2, 1, 256));
@@ -166,8 +265,14 @@ SceneSpec parseScene(const std::string& text, const std::string& file, const std
 }
 
 SceneSpec loadScene(const std::string& path, const std::vector<Override>& overrides) {
+  // An ifstream opens a directory without error and reads nothing: say what it is instead of
+  // reporting a syntax error in an empty file.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw SceneError(path, "", "a scene file", "a directory");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path, "", "a readable scene file", "no such file or it cannot be read");
+  if (!in)
+    throw SceneError(path, "", "a readable scene file",
+                     std::filesystem::exists(path, ec) ? "a file that cannot be read (permissions?)" : "no such file");
   std::stringstream buffer;
   buffer << in.rdbuf();
   return parseScene(buffer.str(), path, overrides);
@@ -187,14 +292,17 @@ template <int d>
 void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& world) {
   if (scene.dimension != d) throw std::logic_error("populateWorld: dimension mismatch");
   const Config top(scene.json, scene.file, "");
-  if (scene.json.contains("gravity")) world.settings().gravity = top.vector("gravity", d);
+  // Settings and entities are kept only when the whole scene is valid: a caller that catches
+  // the SceneError is never left with a half-built world it could simulate by mistake.
+  WorldSettings<d> settings = world.settings();
+  if (scene.json.contains("gravity")) settings.gravity = top.vector("gravity", d);
 
   if (scene.json.contains("solvers")) {
     const Config solvers = top.child("solvers");
     if (solvers.has("rigid_rotation")) {
       const Config rr = solvers.child("rigid_rotation");
-      world.settings().rigidRotation.order = static_cast<int>(rr.integer("order", 2, 1, 3));
-      world.settings().rigidRotation.energyFix = rr.boolean("energy_fix", true);
+      settings.rigidRotation.order = static_cast<int>(rr.integer("order", 2, 1, 3));
+      settings.rigidRotation.energyFix = rr.boolean("energy_fix", true);
       rr.finish();
     }
     solvers.finish();
@@ -206,33 +314,41 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
 
   const Config entities(scene.json["entities"], scene.file, "entities");
   std::set<std::string> names;
-  for (std::size_t i = 0; i < entities.arraySize(); ++i) {
-    const Config entity = entities.element(i);
-    if (!entity.raw().is_object()) entity.fail("an entity object", describeJson(entity.raw()));
-    const std::string name = entity.string("name", "");
-    if (!name.empty() && !names.insert(name).second)
-      entity.failAt("name", "a name not used by another entity", "\"" + name + "\" again");
-    // Every other key must name a component this dimension knows.
-    for (const auto& key : entity.keys()) {
-      if (key == "name") continue;
-      if (!registry.findComponent<d>(key) || !registry.findComponent<d>(key)->parse) {
-        const std::string guess = closestMatch(key, componentNames);
-        std::string known;
-        for (const auto& n : componentNames) known += (known.empty() ? "" : ", ") + n;
-        entity.failAt(key, "a component name for a " + std::to_string(d) + "-D scene (one of: " + known + ")",
-                      "\"" + key + "\"" + (guess.empty() ? "" : " (did you mean \"" + guess + "\"?)"));
+  std::vector<Entity> created;
+  try {
+    for (std::size_t i = 0; i < entities.arraySize(); ++i) {
+      const Config entity = entities.element(i);
+      if (!entity.raw().is_object()) entity.fail("an entity object", describeJson(entity.raw()));
+      const std::string name = entity.string("name", "");
+      if (!name.empty() && !names.insert(name).second)
+        entity.failAt("name", "a name not used by another entity", "\"" + name + "\" again");
+      // Every other key must name a component this dimension knows.
+      for (const auto& key : entity.keys()) {
+        if (key == "name") continue;
+        if (!registry.findComponent<d>(key) || !registry.findComponent<d>(key)->parse) {
+          const std::string guess = closestMatch(key, componentNames);
+          std::string known;
+          for (const auto& n : componentNames) known += (known.empty() ? "" : ", ") + n;
+          entity.failAt(key, "a component name for a " + std::to_string(d) + "-D scene (one of: " + known + ")",
+                        "\"" + key + "\"" + (guess.empty() ? "" : " (did you mean \"" + guess + "\"?)"));
+        }
+      }
+      const Entity e = world.create(name);
+      created.push_back(e);
+      // Registry order, not file order: a component may rely on one registered before it
+      // (rigid_body derives its inertia from shape).
+      for (const auto& type : registry.components<d>()) {
+        if (!type.parse || !entity.raw().contains(type.name)) continue;
+        const Config config = entity.child(type.name);
+        type.parse(world, e, config);
+        config.finish();
       }
     }
-    const Entity e = world.create(name);
-    // Registry order, not file order: a component may rely on one registered before it
-    // (rigid_body derives its inertia from shape).
-    for (const auto& type : registry.components<d>()) {
-      if (!type.parse || !entity.raw().contains(type.name)) continue;
-      const Config config = entity.child(type.name);
-      type.parse(world, e, config);
-      config.finish();
-    }
+  } catch (...) {
+    for (const Entity e : created) world.destroy(e);
+    throw;
   }
+  world.settings() = settings;
 }
 
 template void populateWorld<2>(const SceneSpec&, const Registry&, World<2>&);
