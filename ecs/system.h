@@ -14,6 +14,7 @@ namespace monolith {
 template <int d>
 class System {
  public:
+  static constexpr int dimension = d;
   virtual ~System() = default;
   virtual std::string name() const = 0;
   virtual Stage stage() const = 0;

@@ -126,6 +126,14 @@ void parseExternalForce(World<d>& world, Entity e, const Config& c) {
   world.add(e, f);
 }
 
+// A system type with a single instance.
+template <class S, class... Args>
+auto single(Args... args) {
+  std::vector<std::unique_ptr<System<S::dimension>>> v;
+  v.push_back(std::make_unique<S>(args...));
+  return v;
+}
+
 template <int d>
 void registerDimension(Registry& r) {
   // Order matters: components parse in this order (shape before rigid_body).
@@ -144,34 +152,14 @@ void registerDimension(Registry& r) {
   r.addSystem<d>({"external_forces", "constant external force/torque components",
                   [] { return atBothForceStages<ExternalForces<d>, d>(); }, ""});
   r.addSystem<d>({"advance_rigid_velocity_half", "Step I (Sec. 4.3): v^{n+1/2} = v^n + dt/2 a(x^n)",
-                  [] {
-                    std::vector<std::unique_ptr<System<d>>> v;
-                    v.push_back(std::make_unique<RigidHalfKick<d>>(Stage::AdvanceVelocityHalf));
-                    return v;
-                  },
-                  ""});
+                  [] { return single<RigidHalfKick<d>>(Stage::AdvanceVelocityHalf); }, ""});
   r.addSystem<d>({"advance_rigid_positions",
                   "Step IV (Sec. 4.6): positions, orientation rule (4.4.1/App. A) and energy fix (2.2)",
-                  [] {
-                    std::vector<std::unique_ptr<System<d>>> v;
-                    v.push_back(std::make_unique<AdvanceRigidPositions<d>>());
-                    return v;
-                  },
-                  ""});
+                  [] { return single<AdvanceRigidPositions<d>>(); }, ""});
   r.addSystem<d>({"advance_rigid_velocity", "Step V (Sec. 4.7): v^{n+1} = v^{n+1/2} + dt/2 a(x^{n+1})",
-                  [] {
-                    std::vector<std::unique_ptr<System<d>>> v;
-                    v.push_back(std::make_unique<RigidHalfKick<d>>(Stage::AdvanceVelocity));
-                    return v;
-                  },
-                  ""});
+                  [] { return single<RigidHalfKick<d>>(Stage::AdvanceVelocity); }, ""});
   r.addSystem<d>({"rigid_diagnostics", "energies and momenta of the rigid bodies",
-                  [] {
-                    std::vector<std::unique_ptr<System<d>>> v;
-                    v.push_back(std::make_unique<RigidDiagnostics<d>>());
-                    return v;
-                  },
-                  ""});
+                  [] { return single<RigidDiagnostics<d>>(); }, ""});
 }
 
 }  // namespace

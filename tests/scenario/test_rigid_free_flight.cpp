@@ -158,3 +158,22 @@ TEST(Determinism, ManyBodiesBitwiseIdenticalOnOneAndTwoThreads) {
     ASSERT_EQ(d1, d2) << "diagnostics differ after step " << n + 1;
   }
 }
+
+TEST(Scheduling, SystemsWithoutTheirComponentsAreNotScheduled) {
+  const Registry registry = builtins();
+  // spin_sliver: no gravity, no external force: those systems must not even be in the graph.
+  Simulation<3> sliver(loadScene(kScenes + "spin_sliver.json"), registry);
+  const auto& skipped = sliver.scheduler().skipped();
+  for (const char* name : {"gravity@n", "gravity@n+1", "external_forces@n", "external_forces@n+1"}) {
+    EXPECT_EQ(sliver.scheduler().indexOf(name), -1) << name;
+    EXPECT_NE(std::find(skipped.begin(), skipped.end(), name), skipped.end()) << name;
+  }
+  EXPECT_NE(sliver.scheduler().indexOf("advance_rigid_positions"), -1);
+  // A scene of static bodies only: nothing moves, so no stepping system is scheduled.
+  const char* text = R"({"dimension": 3, "time": {"dt": 0.1, "steps": 1}, "gravity": [0, -9.81, 0],
+    "entities": [{"shape": {"type": "box", "half_extents": [1, 1, 1]}, "rigid_body": {"static": true}}]})";
+  Simulation<3> statics(parseScene(text, "static.json"), registry);
+  EXPECT_EQ(statics.scheduler().indexOf("advance_rigid_positions"), -1);
+  EXPECT_EQ(statics.scheduler().indexOf("gravity@n"), -1);
+  EXPECT_EQ(statics.scheduler().systems().size(), 1u) << "only rigid_diagnostics remains";
+}
