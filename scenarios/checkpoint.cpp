@@ -38,7 +38,10 @@ void deserializeWorld(World<d>& world, BinaryReader& in, const Registry& registr
   auto alive = in.vector<std::uint8_t>();
   auto freeList = in.vector<std::uint32_t>();
   const auto slots = in.pod<std::uint64_t>();
-  if (slots != generations.size()) in.fail("entity table sizes differ");
+  if (slots != generations.size() || alive.size() != generations.size()) in.fail("entity table sizes differ");
+  // A free-list slot out of range or alive would corrupt the next World::create().
+  for (const std::uint32_t i : freeList)
+    if (i >= slots || alive[i]) in.fail("entity free list names slot " + std::to_string(i) + " that is not a free slot");
   std::vector<std::string> names(slots);
   for (auto& n : names) n = in.string();
   world.entityRegistryMutable().restore(std::move(generations), std::move(alive), std::move(freeList));
@@ -53,7 +56,15 @@ void deserializeWorld(World<d>& world, BinaryReader& in, const Registry& registr
       throw std::runtime_error("checkpoint holds component '" + name +
                                "' that no built-in type or loaded plugin provides (load the plugin the run used)");
     type->ensurePool(world);
-    world.poolNamed(name)->deserialize(in);
+    PoolBase* pool = world.poolNamed(name);
+    pool->deserialize(in);
+    // Corrupt handles would otherwise pass silently and later index the entity table out of
+    // range: every component must belong to a live entity of the restored table.
+    const EntityRegistry& table = world.entityRegistry();
+    for (const Entity e : pool->entities())
+      if (!table.alive(e))
+        in.fail("component '" + name + "' of entity #" + std::to_string(e.index) + " (generation " +
+                std::to_string(e.generation) + ") that is not alive in the entity table");
   }
 }
 
@@ -98,6 +109,8 @@ CheckpointFile readCheckpoint(const std::string& path) {
     throw std::runtime_error("checkpoint '" + path + "': written on a machine with another byte order or double size");
   f.header.dimension = r.pod<std::int32_t>();
   f.header.step = static_cast<long>(r.pod<std::int64_t>());
+  // A corrupt (negative) step would make the resumed loop run ~2^63 steps instead of failing.
+  if (f.header.step < 0) r.fail("negative step count " + std::to_string(f.header.step));
   f.header.time = r.pod<double>();
   f.header.sceneFile = r.string();
   f.header.sceneJson = r.string();

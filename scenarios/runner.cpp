@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iomanip>
 #include <sstream>
+#include <stdexcept>
 
 #include <tbb/global_control.h>
 
@@ -24,6 +25,12 @@ namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// A checkpoint whose world state cannot be restored: rejected input (exit 3), not a runtime
+// failure (exit 1), like a checkpoint whose header is bad.
+struct CheckpointRejected : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 std::string sceneStem(const std::string& file) {
   return fs::path(file).stem().string().empty() ? "scene" : fs::path(file).stem().string();
@@ -144,7 +151,9 @@ void Run<d>::writeSummary(const std::string& status, const std::string& diagnosi
   s["skipped_systems"] = scheduler_->skipped();
   s["checkpoints"] = checkpoints_;
   s["entities"] = world_.entityCount();
-  writeFileAtomically(outDir_ + "/summary.json", s.dump(2) + "\n");
+  // Replace, not throw, on invalid UTF-8: a scene path may hold any bytes on POSIX, and a throw
+  // here would lose summary.json after the whole run (exit 1).
+  writeFileAtomically(outDir_ + "/summary.json", s.dump(2, ' ', false, Json::error_handler_t::replace) + "\n");
 }
 
 template <int d>
@@ -153,7 +162,16 @@ RunResult Run<d>::execute() {
   populateWorld(scene_, registry_, world_);
   long firstStep = 0;
   if (resume_) {
-    restoreCheckpointWorld(*resume_, world_, registry_);
+    try {
+      restoreCheckpointWorld(*resume_, world_, registry_);
+    } catch (const std::exception& e) {
+      throw CheckpointRejected(e.what());
+    }
+    // Corrupt payload bytes can decode to NaN/inf, which would make a solver throw (exit 1)
+    // instead of the checkpoint being rejected.
+    std::string diagnosis;
+    if (!guard(resume_->header.step, diagnosis))
+      throw CheckpointRejected("restored state fails the blow-up guard: " + diagnosis);
     firstStep = resume_->header.step;
   }
   threads_ = options_.threads > 0 ? options_.threads : scene_.threads;
@@ -198,19 +216,30 @@ RunResult Run<d>::execute() {
     ctx.time = n * scene_.dt;  // t^n from the index: no drift, identical after a resume
     ctx.step = n;
     const auto t0 = Clock::now();
-    scheduler_->step(world_, ctx);
+    std::string diagnosis;
+    bool stepAborted = false;
+    try {
+      scheduler_->step(world_, ctx);
+    } catch (const std::exception& e) {
+      // A solver may throw on the non-finite values of a blow-up before the guard sees them
+      // (the energy fix on an infinite angular momentum): that is an instability (exit 4 with
+      // a diagnosis), not an internal error (exit 1), when the guard finds the bad value.
+      if (guard(n + 1, diagnosis)) throw;
+      diagnosis += std::string(" (step aborted: ") + e.what() + ")";
+      stepAborted = true;
+    }
     const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
     wallTotal_ += wall;
     const long done = n + 1;
 
-    std::string diagnosis;
-    bool ok = guard(done, diagnosis);
+    bool ok = !stepAborted && guard(done, diagnosis);
     for (const auto& [k, v] : ctx.diagnostics.values())
       if (ok && !std::isfinite(v)) {
         ok = false;
         diagnosis = "unstable at step " + std::to_string(done) + ": diagnostic " + k + " is not finite";
       }
-    metrics.row(done, done * scene_.dt, scene_.dt, ctx.diagnostics.values(), stages, scheduler_->stageSeconds(), wall);
+    if (!stepAborted)  // an aborted step has no complete diagnostics to report
+      metrics.row(done, done * scene_.dt, scene_.dt, ctx.diagnostics.values(), stages, scheduler_->stageSeconds(), wall);
     if (!ok) {
       progress.finish("stopped: unstable");
       if (!lastGoodCheckpoint.empty()) diagnosis += "; last good checkpoint: " + lastGoodCheckpoint;
@@ -248,7 +277,7 @@ RunResult runWithDimension(const SceneSpec& scene, Registry& registry, const Run
 }
 
 RunResult dispatch(const SceneSpec& scene, Registry& registry, PluginLoader& plugins, const RunOptions& options,
-                   const CheckpointFile* resume) {
+                   const CheckpointFile* resume, const std::string& checkpointPath = "") {
   RunResult r;
   try {
     loadScenePlugins(scene, plugins, registry);
@@ -260,6 +289,9 @@ RunResult dispatch(const SceneSpec& scene, Registry& registry, PluginLoader& plu
   } catch (const PluginError& e) {
     r.exitCode = kExitInvalidScene;
     r.message = e.what();
+  } catch (const CheckpointRejected& e) {
+    r.exitCode = kExitInvalidScene;
+    r.message = "checkpoint '" + checkpointPath + "': " + e.what();
   } catch (const std::exception& e) {
     r.exitCode = kExitFailure;
     r.message = e.what();
@@ -294,12 +326,19 @@ RunResult resumeRun(const std::string& checkpointPath, Registry& registry, Plugi
     r.message = "checkpoint '" + checkpointPath + "': dimension differs from its scene";
     return r;
   }
+  // A step beyond the scene's end (corrupt header) would silently "complete" without stepping.
+  if (file.header.step > scene.steps) {
+    r.exitCode = kExitInvalidScene;
+    r.message = "checkpoint '" + checkpointPath + "': step " + std::to_string(file.header.step) +
+                " is beyond the scene's " + std::to_string(scene.steps) + " steps";
+    return r;
+  }
   if (options.outDir.empty()) {  // continue in the run directory the checkpoint belongs to
     const fs::path p = fs::absolute(checkpointPath);
     options.outDir = p.parent_path().filename() == "checkpoints" ? p.parent_path().parent_path().string()
                                                                  : p.parent_path().string();
   }
-  return dispatch(scene, registry, plugins, options, &file);
+  return dispatch(scene, registry, plugins, options, &file, checkpointPath);
 }
 
 }  // namespace monolith

@@ -1,0 +1,403 @@
+// Checkpoint/restart through the CLI: a run of 2N steps and a run of N steps + resume + N steps
+// must agree bit for bit; damaged checkpoints are rejected cleanly (exit 3, a message naming the
+// checkpoint, nothing simulated); resuming in place keeps the earlier metrics rows.
+//
+// Everything compared here is compared exactly (strings/bytes, not tolerances): a resumed run
+// restores the state bitwise and t^n = n dt comes from the step index, so any difference at all
+// is a restart bug.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+struct CommandResult {
+  int exitCode = -1;
+  std::string out, err;
+};
+
+std::string shellQuote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void writeFile(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << text;
+}
+
+// A fresh directory per test under /tmp/monolith_tests_<pid>, removed afterwards.
+class TempDir {
+ public:
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    path_ = fs::temp_directory_path() / ("monolith_tests_" + std::to_string(::getpid())) /
+            (std::string(info->test_suite_name()) + "_" + info->name());
+    fs::remove_all(path_);
+    fs::create_directories(path_ / "logs");
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+    fs::remove(path_.parent_path(), ec);  // only succeeds once the last test's directory is gone
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+// Runs argv with stdout/stderr captured; `timeout` turns a hang into a failure (exit 124): a
+// corrupt step count once made `resume` loop for ~2^63 steps.
+CommandResult run(const std::vector<std::string>& argv, const fs::path& logDir) {
+  static int counter = 0;
+  const std::string id = std::to_string(counter++);
+  const fs::path out = logDir / ("cmd" + id + ".out"), err = logDir / ("cmd" + id + ".err");
+  std::string cmd = "timeout 120";
+  for (const auto& a : argv) cmd += " " + shellQuote(a);
+  cmd += " </dev/null >" + shellQuote(out.string()) + " 2>" + shellQuote(err.string());
+  const int status = std::system(cmd.c_str());
+  CommandResult r;
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string l; std::getline(ss, l);) out.push_back(l);
+  return out;
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  for (std::string f; std::getline(ss, f, ',');) out.push_back(f);
+  return out;
+}
+
+// metrics.csv as header + rows keyed by step (a duplicated step is a failure).
+struct Metrics {
+  std::vector<std::string> header;
+  std::vector<long> steps;  // in file order
+  std::map<long, std::string> rawRows;
+  std::map<long, std::vector<std::string>> rows;
+};
+Metrics readMetrics(const fs::path& p) {
+  Metrics m;
+  const auto ls = lines(slurp(p));
+  EXPECT_FALSE(ls.empty()) << p;
+  if (ls.empty()) return m;
+  m.header = split(ls[0]);
+  for (std::size_t i = 1; i < ls.size(); ++i) {
+    const auto fields = split(ls[i]);
+    EXPECT_EQ(fields.size(), m.header.size()) << p << " line " << i + 1;
+    const long step = std::stol(fields.at(0));
+    EXPECT_EQ(m.rows.count(step), 0u) << p << ": step " << step << " appears twice";
+    m.steps.push_back(step);
+    m.rows[step] = fields;
+    m.rawRows[step] = ls[i];
+  }
+  return m;
+}
+
+// Wall-clock columns differ between any two runs; everything else must be identical.
+bool isTimingColumn(const std::string& name) {
+  return name == "wall_seconds" || name.rfind("stage_", 0) == 0;
+}
+
+void expectSameRowsExceptTiming(const Metrics& a, const Metrics& b, long fromStep, long toStep) {
+  ASSERT_EQ(a.header, b.header);
+  for (long s = fromStep; s <= toStep; ++s) {
+    ASSERT_TRUE(a.rows.count(s) && b.rows.count(s)) << "step " << s << " missing";
+    for (std::size_t c = 0; c < a.header.size(); ++c) {
+      if (!isTimingColumn(a.header[c])) {
+        EXPECT_EQ(a.rows.at(s)[c], b.rows.at(s)[c]) << "step " << s << ", column " << a.header[c];
+      }
+    }
+  }
+}
+
+std::string frame(long step) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "frames/bodies_%06ld.vtp", step);
+  return buf;
+}
+std::string geometryFrame(long step) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "frames/geometry_%06ld.vtp", step);
+  return buf;
+}
+std::string checkpoint(long step) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "checkpoints/step_%08ld.ckpt", step);
+  return buf;
+}
+
+// spin_sliver's torque-free sliver (intermediate-axis spin: a sensitive, chaotic rotation) plus
+// a second box falling and tumbling under gravity.
+constexpr const char* kScene = R"json({
+  "description": "spin_sliver plus a falling, tumbling box (checkpoint/restart test)",
+  "dimension": 3,
+  "time": { "dt": 0.03333333333333333, "steps": 300, "frame_rate": 30 },
+  "gravity": [0, 0, -9.81],
+  "solvers": { "rigid_rotation": { "order": 2, "energy_fix": true } },
+  "entities": [
+    { "name": "sliver", "shape": { "type": "box", "half_extents": [0.05, 0.5, 1.5] },
+      "rigid_body": { "mass": 1.0, "angular_velocity": [0.1, 10.0, 0.1] } },
+    { "name": "faller", "shape": { "type": "box", "half_extents": [0.3, 0.2, 0.1] },
+      "rigid_body": { "mass": 2.5, "position": [2, 0, 10], "velocity": [0.5, 0, 1],
+                      "angular_velocity": [1, -2, 0.5] } }
+  ]
+})json";
+
+constexpr long N = 15;
+
+struct Fixture {
+  TempDir tmp;
+  fs::path scene, logs;
+  Fixture() : scene(tmp.path() / "two_bodies.json"), logs(tmp.path() / "logs") { writeFile(scene, kScene); }
+  // 2N steps with a checkpoint every N.
+  CommandResult straightRun(const fs::path& out) {
+    return run({MONOLITH_CLI, "run", scene.string(), "--out", out.string(), "--set", "time.steps=" + std::to_string(2 * N),
+                "--checkpoint-every", std::to_string(N), "--quiet"},
+               logs);
+  }
+};
+
+TEST(CheckpointRestart, StraightAndResumedRunsAgreeBitwise) {
+  Fixture f;
+  const fs::path A = f.tmp.path() / "A", B = f.tmp.path() / "B";
+  const CommandResult a = f.straightRun(A);
+  ASSERT_EQ(a.exitCode, 0) << a.err;
+  ASSERT_TRUE(fs::exists(A / checkpoint(N)));
+  ASSERT_TRUE(fs::exists(A / checkpoint(2 * N)));
+
+  const CommandResult b = run({MONOLITH_CLI, "resume", (A / checkpoint(N)).string(), "--out", B.string(), "--quiet"}, f.logs);
+  ASSERT_EQ(b.exitCode, 0) << b.err;
+
+  const Json sa = Json::parse(slurp(A / "summary.json")), sb = Json::parse(slurp(B / "summary.json"));
+  EXPECT_EQ(sa["status"], "completed");
+  EXPECT_EQ(sb["status"], "completed");
+  EXPECT_EQ(sa["steps_completed"], 2 * N);
+  EXPECT_EQ(sb["steps_completed"], 2 * N);
+  EXPECT_EQ(sa["state_hash"], sb["state_hash"]);  // bitwise equal final state
+
+  // The second half did move the bodies (else equal frames would prove nothing) ...
+  EXPECT_NE(slurp(A / frame(N)), slurp(A / frame(2 * N)));
+  // ... and every frame written after the restart is byte-identical to the straight run's.
+  for (long s = N + 1; s <= 2 * N; ++s) {
+    ASSERT_TRUE(fs::exists(B / frame(s))) << frame(s);
+    EXPECT_EQ(slurp(A / frame(s)), slurp(B / frame(s))) << frame(s);
+    EXPECT_EQ(slurp(A / geometryFrame(s)), slurp(B / geometryFrame(s))) << geometryFrame(s);
+  }
+
+  const Metrics ma = readMetrics(A / "metrics.csv"), mb = readMetrics(B / "metrics.csv");
+  EXPECT_EQ(ma.steps.size(), std::size_t(2 * N));
+  ASSERT_FALSE(mb.steps.empty());
+  EXPECT_EQ(mb.steps.front(), N + 1);  // a fresh directory holds only the resumed steps
+  EXPECT_EQ(mb.steps.back(), 2 * N);
+  expectSameRowsExceptTiming(ma, mb, N + 1, 2 * N);
+}
+
+// --- damaged checkpoints -------------------------------------------------------------------
+
+// Byte offsets of a format-1 checkpoint (layout in scenarios/checkpoint.h): magic (14 bytes),
+// u32 format, u32 endianness probe, u32 sizeof(double), i32 dimension, i64 step, f64 time,
+// string scene file, string scene JSON (u64 length + bytes), then the world: vector
+// generations, vector alive flags, vector free list (u64 length + items), u64 slot count, one
+// name string per slot, u64 pool count, then per pool: name string, u64 count, and per
+// component u32 entity index, u32 generation, fields (rigid_body starts with f64 mass).
+struct Layout {
+  std::size_t format = 14, dimension = 26, step = 30, sceneFile = 46, sceneJson = 0, world = 0, firstPool = 0,
+              firstRecord = 0;
+  std::string firstPoolName;
+};
+
+std::uint64_t u64At(const std::string& b, std::size_t at) {
+  std::uint64_t v = 0;
+  std::memcpy(&v, b.data() + at, sizeof v);
+  return v;
+}
+template <class T>
+void put(std::string& b, std::size_t at, T v) {
+  std::memcpy(&b[at], &v, sizeof v);
+}
+
+Layout parseLayout(const std::string& b) {
+  Layout l;
+  l.sceneJson = l.sceneFile + 8 + u64At(b, l.sceneFile);
+  l.world = l.sceneJson + 8 + u64At(b, l.sceneJson);
+  std::size_t p = l.world;
+  const std::uint64_t slots = u64At(b, p);
+  p += 8 + 4 * slots;                // generations (u32)
+  p += 8 + u64At(b, p);              // alive flags (u8)
+  p += 8 + 4 * u64At(b, p);          // free list (u32)
+  p += 8;                            // slot count
+  for (std::uint64_t i = 0; i < slots; ++i) p += 8 + u64At(b, p);  // names
+  p += 8;                            // pool count
+  l.firstPool = p;
+  l.firstPoolName = b.substr(p + 8, u64At(b, p));
+  l.firstRecord = p + 8 + l.firstPoolName.size() + 8;
+  return l;
+}
+
+TEST(CheckpointRestart, DamagedCheckpointsAreRejectedCleanly) {
+  Fixture f;
+  const fs::path A = f.tmp.path() / "A";
+  const CommandResult a = f.straightRun(A);
+  ASSERT_EQ(a.exitCode, 0) << a.err;
+  const std::string good = slurp(A / checkpoint(N));
+  const Layout l = parseLayout(good);
+  // Sanity of the layout this test relies on (if the format changes, update the offsets).
+  ASSERT_EQ(good.substr(0, 13), "MONOLITH-CKPT");
+  ASSERT_EQ(u64At(good, l.step), std::uint64_t(N));
+  ASSERT_EQ(good[l.sceneJson + 8], '{');
+  ASSERT_EQ(l.firstPoolName, "rigid_body");
+
+  std::map<std::string, std::string> damaged;
+  for (std::size_t n : {std::size_t(0), std::size_t(10), std::size_t(13), std::size_t(20), l.step + 4,
+                        l.sceneJson + 20, l.world + 3, l.firstRecord + 4, (l.firstRecord + good.size()) / 2,
+                        good.size() - 8, good.size() - 1})
+    damaged["truncated_" + std::to_string(n)] = good.substr(0, n);
+  {
+    std::string b = good;
+    b[0] ^= 0x20;
+    damaged["bad_magic"] = b;
+    b = good;
+    put<std::uint32_t>(b, l.format, 99);
+    damaged["future_format"] = b;
+    b = good;
+    put<std::int32_t>(b, l.dimension, 7);
+    damaged["dimension_7"] = b;
+    b = good;
+    put<std::int32_t>(b, l.dimension, 2);  // valid, but the embedded scene is 3-D
+    damaged["dimension_mismatch"] = b;
+    b = good;
+    put<std::int64_t>(b, l.step, -5);
+    damaged["negative_step"] = b;
+    b = good;
+    put<std::int64_t>(b, l.step, -(std::int64_t(1) << 60));  // used to hang: the loop ran ~2^60 steps
+    damaged["huge_negative_step"] = b;
+    b = good;
+    put<std::int64_t>(b, l.step, 1000000);  // beyond the scene's 2N steps
+    damaged["step_beyond_end"] = b;
+    b = good;
+    b[l.sceneJson + 8] = '#';  // the embedded scene is no longer JSON
+    damaged["scene_json"] = b;
+    b = good;
+    put<std::uint64_t>(b, l.world, std::uint64_t(1) << 40);  // absurd entity-table length
+    damaged["entity_table_length"] = b;
+    b = good;
+    put<std::uint32_t>(b, l.firstRecord + 4, 7);  // component of an entity generation that never lived
+    damaged["stale_entity_handle"] = b;
+    b = good;
+    put<double>(b, l.firstRecord + 8, std::nan(""));  // the first body's mass
+    damaged["nan_mass"] = b;
+    damaged["trailing_bytes"] = good + std::string("garbage");
+  }
+
+  for (const auto& [label, bytes] : damaged) {
+    SCOPED_TRACE(label);
+    const fs::path bad = f.tmp.path() / ("bad_" + label + ".ckpt"), out = f.tmp.path() / ("out_" + label);
+    writeFile(bad, bytes);
+    const CommandResult r = run({MONOLITH_CLI, "resume", bad.string(), "--out", out.string(), "--quiet"}, f.logs);
+    EXPECT_EQ(r.exitCode, 3) << r.err;
+    EXPECT_NE(r.err.find("checkpoint"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(bad.filename().string()), std::string::npos) << "message should name the file: " << r.err;
+    EXPECT_EQ(r.err.find("terminate"), std::string::npos) << r.err;  // no uncaught exception
+    EXPECT_FALSE(fs::exists(out)) << "rejected before writing anything";
+  }
+
+  const fs::path missing = f.tmp.path() / "no_such.ckpt";
+  const CommandResult r = run({MONOLITH_CLI, "resume", missing.string(), "--quiet"}, f.logs);
+  EXPECT_EQ(r.exitCode, 3);
+  EXPECT_NE(r.err.find("checkpoint"), std::string::npos) << r.err;
+
+  // The undamaged file still resumes (the rejections above are about the damage).
+  const CommandResult ok = run({MONOLITH_CLI, "resume", (A / checkpoint(N)).string(), "--out",
+                                (f.tmp.path() / "out_good").string(), "--quiet"},
+                               f.logs);
+  EXPECT_EQ(ok.exitCode, 0) << ok.err;
+}
+
+// Resuming without --out continues in the checkpoint's own run directory: metrics rows up to
+// the checkpoint are kept as they were, later rows (from the interrupted attempt) are replaced.
+TEST(CheckpointRestart, ResumeInPlaceKeepsEarlierRowsAndContinues) {
+  Fixture f;
+  const fs::path C = f.tmp.path() / "C";
+  const CommandResult a = f.straightRun(C);
+  ASSERT_EQ(a.exitCode, 0) << a.err;
+  const std::string originalSummary = slurp(C / "summary.json");
+  const Metrics original = readMetrics(C / "metrics.csv");
+  std::map<long, std::string> originalFrames;
+  for (long s = 0; s <= 2 * N; ++s) originalFrames[s] = slurp(C / frame(s));
+
+  // Simulate a crash at step N + 7: metrics and frames end there.
+  const long crash = N + 7;
+  {
+    const auto ls = lines(slurp(C / "metrics.csv"));
+    std::string kept;
+    for (long i = 0; i <= crash; ++i) kept += ls.at(i) + "\n";  // header + rows 1..crash
+    writeFile(C / "metrics.csv", kept);
+    for (long s = crash + 1; s <= 2 * N; ++s) {
+      fs::remove(C / frame(s));
+      fs::remove(C / geometryFrame(s));
+    }
+  }
+
+  const CommandResult r = run({MONOLITH_CLI, "resume", (C / checkpoint(N)).string(), "--quiet"}, f.logs);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find(C.filename().string()), std::string::npos) << r.out;
+
+  const Metrics m = readMetrics(C / "metrics.csv");  // also fails on a duplicated step
+  ASSERT_EQ(m.steps.size(), std::size_t(2 * N));
+  for (long s = 1; s <= 2 * N; ++s) EXPECT_EQ(m.steps[s - 1], s);
+  // Rows <= N are the original lines, byte for byte (wall_seconds included: not re-run).
+  for (long s = 1; s <= N; ++s) EXPECT_EQ(m.rawRows.at(s), original.rawRows.at(s)) << "step " << s;
+  expectSameRowsExceptTiming(original, m, N + 1, 2 * N);
+  EXPECT_EQ(lines(slurp(C / "metrics.csv")).front().rfind("step,", 0), 0u);
+
+  // Frames deleted by the "crash" are written again, identical to the first attempt's.
+  for (long s = 0; s <= 2 * N; ++s) EXPECT_EQ(slurp(C / frame(s)), originalFrames[s]) << frame(s);
+  // The collection lists every frame once, in time order.
+  const std::string pvd = slurp(C / "bodies.pvd");
+  std::vector<std::string> files;
+  const std::regex ds("file=\"([^\"]+)\"");
+  for (auto it = std::sregex_iterator(pvd.begin(), pvd.end(), ds); it != std::sregex_iterator(); ++it)
+    files.push_back((*it)[1]);
+  ASSERT_EQ(files.size(), std::size_t(2 * N + 1));
+  for (long s = 0; s <= 2 * N; ++s) EXPECT_EQ(files[s], frame(s));
+
+  const Json before = Json::parse(originalSummary), after = Json::parse(slurp(C / "summary.json"));
+  EXPECT_EQ(after["status"], "completed");
+  EXPECT_EQ(after["steps_completed"], 2 * N);
+  EXPECT_EQ(after["state_hash"], before["state_hash"]);
+}
+
+}  // namespace
