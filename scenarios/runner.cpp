@@ -12,7 +12,7 @@
 
 #include <tbb/global_control.h>
 
-#include "ecs/scheduler.h"
+#include "scenarios/simulation.h"
 #include "scenarios/checkpoint.h"
 #include "scenarios/metrics_writer.h"
 #include "scenarios/progress.h"
@@ -77,8 +77,9 @@ class Run {
   Registry& registry_;
   RunOptions options_;
   const CheckpointFile* resume_;
-  World<d> world_;
-  std::unique_ptr<Scheduler<d>> scheduler_;
+  std::unique_ptr<Simulation<d>> sim_;  // world + scheduler, stepped exactly as in tests/benchmarks
+  World<d>& world() { return sim_->world(); }
+  const World<d>& world() const { return sim_->world(); }
   std::string outDir_;
   std::unique_ptr<PvdCollection> bodiesPvd_, geometryPvd_;
   std::vector<std::string> checkpoints_;
@@ -91,8 +92,8 @@ void Run<d>::writeFrame(long step) {
   if (!options_.writeFrames || scene_.frameEvery == 0) return;
   const double t = step * scene_.dt;
   const std::string bodies = frameName("bodies", step), geometry = frameName("geometry", step);
-  writeRigidBodyFrame(world_, outDir_ + "/" + bodies);
-  writeRigidGeometryFrame(world_, outDir_ + "/" + geometry);
+  writeRigidBodyFrame(world(), outDir_ + "/" + bodies);
+  writeRigidGeometryFrame(world(), outDir_ + "/" + geometry);
   bodiesPvd_->add(t, bodies);
   geometryPvd_->add(t, geometry);
   bodiesPvd_->write();
@@ -110,10 +111,10 @@ std::string Run<d>::checkpointPath(long step) const {
 // the scene's guard.max_abs_value.
 template <int d>
 bool Run<d>::guard(long step, std::string& diagnosis) const {
-  for (const auto& [name, pool] : world_.pools()) {
+  for (const auto& [name, pool] : world().pools()) {
     if (auto v = pool->firstViolation(scene_.guardMaxAbs)) {
       std::ostringstream m;
-      m << "unstable at step " << step << " (t = " << step * scene_.dt << "): entity " << world_.label(v->entity)
+      m << "unstable at step " << step << " (t = " << step * scene_.dt << "): entity " << world().label(v->entity)
         << ", component " << v->component << ", field " << v->field.field << "[" << v->field.index
         << "] = " << v->field.value
         << (std::isfinite(v->field.value) ? " exceeds guard.max_abs_value = " + std::to_string(scene_.guardMaxAbs)
@@ -141,16 +142,16 @@ void Run<d>::writeSummary(const std::string& status, const std::string& diagnosi
   s["total_wall_seconds"] = wallTotal_;
   s["status"] = status;
   if (!diagnosis.empty()) s["diagnosis"] = diagnosis;
-  s["state_hash"] = hex(stateHash(world_));
+  s["state_hash"] = hex(stateHash(world()));
   Json finals = Json::object();
   for (const auto& [k, v] : finalDiagnostics) finals[k] = std::isfinite(v) ? Json(v) : Json(std::to_string(v));
   s["final_diagnostics"] = finals;
   Json systems = Json::array();
-  for (const auto* sys : scheduler_->systems()) systems.push_back({{"name", sys->name()}, {"stage", stageName(sys->stage())}});
+  for (const auto* sys : sim_->scheduler().systems()) systems.push_back({{"name", sys->name()}, {"stage", stageName(sys->stage())}});
   s["systems"] = systems;
-  s["skipped_systems"] = scheduler_->skipped();
+  s["skipped_systems"] = sim_->scheduler().skipped();
   s["checkpoints"] = checkpoints_;
-  s["entities"] = world_.entityCount();
+  s["entities"] = world().entityCount();
   // Replace, not throw, on invalid UTF-8: a scene path may hold any bytes on POSIX, and a throw
   // here would lose summary.json after the whole run (exit 1).
   writeFileAtomically(outDir_ + "/summary.json", s.dump(2, ' ', false, Json::error_handler_t::replace) + "\n");
@@ -159,11 +160,14 @@ void Run<d>::writeSummary(const std::string& status, const std::string& diagnosi
 template <int d>
 RunResult Run<d>::execute() {
   RunResult result;
-  populateWorld(scene_, registry_, world_);
+  threads_ = options_.threads > 0 ? options_.threads : scene_.threads;
+  // Process-wide cap on parallelism for this run (default 2 threads, --threads N).
+  tbb::global_control cap(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads_));
+  sim_ = std::make_unique<Simulation<d>>(scene_, registry_, threads_);
   long firstStep = 0;
   if (resume_) {
     try {
-      restoreCheckpointWorld(*resume_, world_, registry_);
+      restoreCheckpointWorld(*resume_, world(), registry_);
     } catch (const std::exception& e) {
       throw CheckpointRejected(e.what());
     }
@@ -173,11 +177,9 @@ RunResult Run<d>::execute() {
     if (!guard(resume_->header.step, diagnosis))
       throw CheckpointRejected("restored state fails the blow-up guard: " + diagnosis);
     firstStep = resume_->header.step;
+    sim_->setStepsDone(firstStep);
+    sim_->reschedule();  // the restored world may need other systems than the scene's start
   }
-  threads_ = options_.threads > 0 ? options_.threads : scene_.threads;
-  // Process-wide cap on parallelism for this run (default 2 threads, --threads N).
-  tbb::global_control cap(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads_));
-  scheduler_ = std::make_unique<Scheduler<d>>(registry_.instantiateSystems<d>(), world_, threads_);
   outDir_ = chooseOutDir(scene_, options_);
   result.outDir = outDir_;
   fs::create_directories(outDir_ + "/frames");
@@ -185,7 +187,7 @@ RunResult Run<d>::execute() {
   if (checkpointEvery > 0) fs::create_directories(outDir_ + "/checkpoints");
   {
     std::ofstream graph(outDir_ + "/step_graph.dot");
-    graph << scheduler_->dot();
+    graph << sim_->scheduler().dot();
   }
 
   bodiesPvd_ = std::make_unique<PvdCollection>(outDir_ + "/bodies.pvd");
@@ -201,7 +203,7 @@ RunResult Run<d>::execute() {
 
   std::vector<Stage> stages;
   for (Stage s : kAllStages)
-    for (const auto* sys : scheduler_->systems())
+    for (const auto* sys : sim_->scheduler().systems())
       if (sys->stage() == s) {
         stages.push_back(s);
         break;
@@ -211,15 +213,12 @@ RunResult Run<d>::execute() {
   std::map<std::string, double> lastDiagnostics;
   std::string lastGoodCheckpoint;
   for (long n = firstStep; n < scene_.steps; ++n) {
-    StepContext ctx;
-    ctx.dt = scene_.dt;
-    ctx.time = n * scene_.dt;  // t^n from the index: no drift, identical after a resume
-    ctx.step = n;
     const auto t0 = Clock::now();
+    const std::map<std::string, double>* diagnostics = &lastDiagnostics;
     std::string diagnosis;
     bool stepAborted = false;
     try {
-      scheduler_->step(world_, ctx);
+      diagnostics = &sim_->step();
     } catch (const std::exception& e) {
       // A solver may throw on the non-finite values of a blow-up before the guard sees them
       // (the energy fix on an infinite angular momentum): that is an instability (exit 4 with
@@ -233,29 +232,29 @@ RunResult Run<d>::execute() {
     const long done = n + 1;
 
     bool ok = !stepAborted && guard(done, diagnosis);
-    for (const auto& [k, v] : ctx.diagnostics.values())
+    for (const auto& [k, v] : *diagnostics)
       if (ok && !std::isfinite(v)) {
         ok = false;
         diagnosis = "unstable at step " + std::to_string(done) + ": diagnostic " + k + " is not finite";
       }
     if (!stepAborted)  // an aborted step has no complete diagnostics to report
-      metrics.row(done, done * scene_.dt, scene_.dt, ctx.diagnostics.values(), stages, scheduler_->stageSeconds(), wall);
+      metrics.row(done, done * scene_.dt, scene_.dt, *diagnostics, stages, sim_->scheduler().stageSeconds(), wall);
     if (!ok) {
       progress.finish("stopped: unstable");
       if (!lastGoodCheckpoint.empty()) diagnosis += "; last good checkpoint: " + lastGoodCheckpoint;
       else diagnosis += "; no checkpoint was written (use --checkpoint-every K)";
-      writeSummary("unstable", diagnosis, done, ctx.diagnostics.values());
+      writeSummary("unstable", diagnosis, done, *diagnostics);
       result.exitCode = kExitUnstable;
       result.message = diagnosis;
       result.stepsCompleted = done;
       result.wallSeconds = wallTotal_;
       return result;  // the bad state is neither framed nor checkpointed
     }
-    lastDiagnostics = ctx.diagnostics.values();
+    if (diagnostics != &lastDiagnostics) lastDiagnostics = *diagnostics;
     if (scene_.frameEvery > 0 && done % scene_.frameEvery == 0) writeFrame(done);
     if (checkpointEvery > 0 && done % checkpointEvery == 0) {
       const std::string path = checkpointPath(done);
-      writeCheckpoint(path, CheckpointHeader{d, done, done * scene_.dt, fs::absolute(scene_.file).string(), scene_.json.dump()}, world_);
+      writeCheckpoint(path, CheckpointHeader{d, done, done * scene_.dt, fs::absolute(scene_.file).string(), scene_.json.dump()}, world());
       checkpoints_.push_back(path);
       lastGoodCheckpoint = path;
     }
@@ -264,7 +263,7 @@ RunResult Run<d>::execute() {
   progress.finish("done: " + std::to_string(scene_.steps - firstStep) + " steps");
   writeSummary("completed", "", scene_.steps, lastDiagnostics);
   result.stepsCompleted = scene_.steps;
-  result.stateHash = stateHash(world_);
+  result.stateHash = stateHash(world());
   result.wallSeconds = wallTotal_;
   return result;
 }

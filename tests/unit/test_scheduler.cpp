@@ -71,7 +71,7 @@ class Rendezvous final : public System<3> {
     ++*arrived_;  // "active": running right now
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeoutMillis_);
     while (std::chrono::steady_clock::now() < deadline) {
-      if (arrived_->load() >= 2) {
+      if (arrived_->load() >= 2 || met_->load()) {  // the other may already have left
         *met_ = true;
         break;
       }
