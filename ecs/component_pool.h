@@ -32,8 +32,10 @@ class PoolBase {
   virtual void remove(Entity e) = 0;
   virtual void clear() = 0;
   virtual void serialize(BinaryWriter& out) const = 0;
-  // Reads components written by serialize() (replacing the pool's content).
-  virtual void deserialize(BinaryReader& in) = 0;
+  // Reads components written by serialize() (replacing the pool's content). Entity indices
+  // must be below `slotCount` (the restored entity table): a corrupt index must not make the
+  // sparse table allocate gigabytes.
+  virtual void deserialize(BinaryReader& in, std::size_t slotCount) = 0;
   virtual std::optional<ComponentViolation> firstViolation(double maxAbs) const = 0;
 };
 
@@ -105,13 +107,15 @@ class Pool final : public PoolBase {
     }
   }
 
-  void deserialize(BinaryReader& in) override {
+  void deserialize(BinaryReader& in, std::size_t slotCount) override {
     clear();
     const auto n = in.pod<std::uint64_t>();
+    if (n > slotCount) in.fail("pool '" + name_ + "' holds more components than there are entities");
     for (std::uint64_t i = 0; i < n; ++i) {
       Entity e;
       e.index = in.pod<std::uint32_t>();
       e.generation = in.pod<std::uint32_t>();
+      if (e.index >= slotCount) in.fail("pool '" + name_ + "' names entity #" + std::to_string(e.index) + " beyond the entity table");
       T value{};
       FieldReader r{in};
       value.visitFields(r);

@@ -57,7 +57,7 @@ void deserializeWorld(World<d>& world, BinaryReader& in, const Registry& registr
                                "' that no built-in type or loaded plugin provides (load the plugin the run used)");
     type->ensurePool(world);
     PoolBase* pool = world.poolNamed(name);
-    pool->deserialize(in);
+    pool->deserialize(in, world.entityRegistry().slotCount());
     // Corrupt handles would otherwise pass silently and later index the entity table out of
     // range: every component must belong to a live entity of the restored table.
     const EntityRegistry& table = world.entityRegistry();
@@ -87,7 +87,9 @@ void writeCheckpoint(const std::string& path, const CheckpointHeader& header, co
   out.pod(header.time);
   out.string(header.sceneFile);
   out.string(header.sceneJson);
+  out.pod<std::int64_t>(header.checkpointEvery);
   serializeWorld(world, out);
+  out.pod(fnv1a(out.bytes().data(), out.bytes().size()));
   writeFileAtomically(path, std::string(out.bytes().begin(), out.bytes().end()));
 }
 
@@ -105,6 +107,13 @@ CheckpointFile readCheckpoint(const std::string& path) {
   if (format != kCheckpointFormat)
     throw std::runtime_error("checkpoint '" + path + "': format " + std::to_string(format) + ", this monolith reads format " +
                              std::to_string(kCheckpointFormat));
+  constexpr std::size_t kChecksumBytes = sizeof(std::uint64_t);
+  if (f.bytes.size() < sizeof kMagic + 4 + kChecksumBytes) r.fail("file too short to be a checkpoint");
+  std::uint64_t stored = 0;
+  std::memcpy(&stored, f.bytes.data() + f.bytes.size() - kChecksumBytes, kChecksumBytes);
+  if (fnv1a(f.bytes.data(), f.bytes.size() - kChecksumBytes) != stored)
+    throw std::runtime_error("checkpoint '" + path + "': checksum mismatch: the file is corrupted or truncated");
+  f.worldEnd = f.bytes.size() - kChecksumBytes;
   if (r.pod<std::uint32_t>() != kEndianProbe || r.pod<std::uint32_t>() != sizeof(double))
     throw std::runtime_error("checkpoint '" + path + "': written on a machine with another byte order or double size");
   f.header.dimension = r.pod<std::int32_t>();
@@ -114,14 +123,17 @@ CheckpointFile readCheckpoint(const std::string& path) {
   f.header.time = r.pod<double>();
   f.header.sceneFile = r.string();
   f.header.sceneJson = r.string();
+  f.header.checkpointEvery = static_cast<long>(r.pod<std::int64_t>());
+  if (f.header.checkpointEvery < 0) r.fail("negative checkpoint interval");
   if (f.header.dimension != 2 && f.header.dimension != 3) r.fail("dimension is not 2 or 3");
   f.worldOffset = f.bytes.size() - r.remaining();
+  if (f.worldOffset > f.worldEnd) r.fail("header runs into the checksum");
   return f;
 }
 
 template <int d>
 void restoreCheckpointWorld(const CheckpointFile& file, World<d>& world, const Registry& registry) {
-  BinaryReader r(file.bytes.data() + file.worldOffset, file.bytes.size() - file.worldOffset, "checkpoint world state");
+  BinaryReader r(file.bytes.data() + file.worldOffset, file.worldEnd - file.worldOffset, "checkpoint world state");
   deserializeWorld(world, r, registry);
   if (!r.atEnd()) r.fail("trailing bytes after the world state");
 }

@@ -2,9 +2,10 @@
 // Checkpoints: the full state of a run in a versioned binary file, written atomically
 // (temporary file + rename), so a crash never leaves a half-written checkpoint behind.
 //
-// Layout (format 1): magic "MONOLITH-CKPT", u32 format, u32 endianness probe 0x01020304,
+// Layout (format 2): magic "MONOLITH-CKPT", u32 format, u32 endianness probe 0x01020304,
 // u32 sizeof(double), i32 dimension, i64 step (steps completed), f64 time, string scene file,
-// string scene JSON (after --set overrides), world state (see serializeWorld).
+// string scene JSON (after --set overrides), i64 checkpoint interval of the run, world state
+// (see serializeWorld), u64 FNV-1a of every byte before it (a flipped bit anywhere is caught).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -14,7 +15,7 @@
 
 namespace monolith {
 
-inline constexpr std::uint32_t kCheckpointFormat = 1;
+inline constexpr std::uint32_t kCheckpointFormat = 2;
 
 // Entity table (generations, alive flags, free list, names) and every pool, in name order.
 template <int d>
@@ -34,6 +35,7 @@ struct CheckpointHeader {
   double time = 0;
   std::string sceneFile;
   std::string sceneJson;
+  long checkpointEvery = 0;  // the run's interval, kept by `monolith resume`
 };
 
 template <int d>
@@ -43,7 +45,7 @@ void writeCheckpoint(const std::string& path, const CheckpointHeader& header, co
 struct CheckpointFile {
   CheckpointHeader header;
   std::vector<std::uint8_t> bytes;
-  std::size_t worldOffset = 0;
+  std::size_t worldOffset = 0, worldEnd = 0;
 };
 CheckpointFile readCheckpoint(const std::string& path);
 template <int d>

@@ -84,6 +84,7 @@ class Run {
   std::unique_ptr<PvdCollection> bodiesPvd_, geometryPvd_;
   std::vector<std::string> checkpoints_;
   double wallTotal_ = 0;
+  long checkpointEvery_ = 0;
   int threads_ = 1;
 };
 
@@ -183,7 +184,11 @@ RunResult Run<d>::execute() {
   outDir_ = chooseOutDir(scene_, options_);
   result.outDir = outDir_;
   fs::create_directories(outDir_ + "/frames");
-  const long checkpointEvery = options_.checkpointEvery >= 0 ? options_.checkpointEvery : scene_.checkpointEvery;
+  // --checkpoint-every, else the interval of the run being resumed, else the scene's.
+  const long checkpointEvery = options_.checkpointEvery >= 0 ? options_.checkpointEvery
+                               : resume_                     ? resume_->header.checkpointEvery
+                                                             : scene_.checkpointEvery;
+  checkpointEvery_ = checkpointEvery;
   if (checkpointEvery > 0) fs::create_directories(outDir_ + "/checkpoints");
   {
     std::ofstream graph(outDir_ + "/step_graph.dot");
@@ -254,7 +259,7 @@ RunResult Run<d>::execute() {
     if (scene_.frameEvery > 0 && done % scene_.frameEvery == 0) writeFrame(done);
     if (checkpointEvery > 0 && done % checkpointEvery == 0) {
       const std::string path = checkpointPath(done);
-      writeCheckpoint(path, CheckpointHeader{d, done, done * scene_.dt, fs::absolute(scene_.file).string(), scene_.json.dump()}, world());
+      writeCheckpoint(path, CheckpointHeader{d, done, done * scene_.dt, fs::absolute(scene_.file).string(), scene_.json.dump(), checkpointEvery_}, world());
       checkpoints_.push_back(path);
       lastGoodCheckpoint = path;
     }

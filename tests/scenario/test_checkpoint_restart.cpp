@@ -6,6 +6,8 @@
 // restores the state bitwise and t^n = n dt comes from the step index, so any difference at all
 // is a restart bug.
 #include <gtest/gtest.h>
+
+#include "ecs/binary_io.h"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -227,9 +229,10 @@ TEST(CheckpointRestart, StraightAndResumedRunsAgreeBitwise) {
 
 // --- damaged checkpoints -------------------------------------------------------------------
 
-// Byte offsets of a format-1 checkpoint (layout in scenarios/checkpoint.h): magic (14 bytes),
+// Byte offsets of a format-2 checkpoint (layout in scenarios/checkpoint.h): magic (14 bytes),
 // u32 format, u32 endianness probe, u32 sizeof(double), i32 dimension, i64 step, f64 time,
-// string scene file, string scene JSON (u64 length + bytes), then the world: vector
+// string scene file, string scene JSON (u64 length + bytes), i64 checkpoint interval, then the
+// world (and a trailing u64 FNV-1a checksum): vector
 // generations, vector alive flags, vector free list (u64 length + items), u64 slot count, one
 // name string per slot, u64 pool count, then per pool: name string, u64 count, and per
 // component u32 entity index, u32 generation, fields (rigid_body starts with f64 mass).
@@ -238,6 +241,14 @@ struct Layout {
               firstRecord = 0;
   std::string firstPoolName;
 };
+
+// Recomputes the trailing checksum, so that a deliberately damaged field reaches the deeper
+// checks (a real corruption is caught by the checksum first: see "flipped_byte").
+std::string reseal(std::string b) {
+  const std::uint64_t h = monolith::fnv1a(reinterpret_cast<const std::uint8_t*>(b.data()), b.size() - 8);
+  std::memcpy(&b[b.size() - 8], &h, 8);
+  return b;
+}
 
 std::uint64_t u64At(const std::string& b, std::size_t at) {
   std::uint64_t v = 0;
@@ -252,7 +263,7 @@ void put(std::string& b, std::size_t at, T v) {
 Layout parseLayout(const std::string& b) {
   Layout l;
   l.sceneJson = l.sceneFile + 8 + u64At(b, l.sceneFile);
-  l.world = l.sceneJson + 8 + u64At(b, l.sceneJson);
+  l.world = l.sceneJson + 8 + u64At(b, l.sceneJson) + 8;
   std::size_t p = l.world;
   const std::uint64_t slots = u64At(b, p);
   p += 8 + 4 * slots;                // generations (u32)
@@ -291,35 +302,38 @@ TEST(CheckpointRestart, DamagedCheckpointsAreRejectedCleanly) {
     damaged["bad_magic"] = b;
     b = good;
     put<std::uint32_t>(b, l.format, 99);
-    damaged["future_format"] = b;
+    damaged["future_format"] = reseal(b);
     b = good;
     put<std::int32_t>(b, l.dimension, 7);
-    damaged["dimension_7"] = b;
+    damaged["dimension_7"] = reseal(b);
     b = good;
     put<std::int32_t>(b, l.dimension, 2);  // valid, but the embedded scene is 3-D
-    damaged["dimension_mismatch"] = b;
+    damaged["dimension_mismatch"] = reseal(b);
     b = good;
     put<std::int64_t>(b, l.step, -5);
-    damaged["negative_step"] = b;
+    damaged["negative_step"] = reseal(b);
     b = good;
     put<std::int64_t>(b, l.step, -(std::int64_t(1) << 60));  // used to hang: the loop ran ~2^60 steps
-    damaged["huge_negative_step"] = b;
+    damaged["huge_negative_step"] = reseal(b);
     b = good;
     put<std::int64_t>(b, l.step, 1000000);  // beyond the scene's 2N steps
-    damaged["step_beyond_end"] = b;
+    damaged["step_beyond_end"] = reseal(b);
     b = good;
     b[l.sceneJson + 8] = '#';  // the embedded scene is no longer JSON
-    damaged["scene_json"] = b;
+    damaged["scene_json"] = reseal(b);
     b = good;
     put<std::uint64_t>(b, l.world, std::uint64_t(1) << 40);  // absurd entity-table length
-    damaged["entity_table_length"] = b;
+    damaged["entity_table_length"] = reseal(b);
     b = good;
     put<std::uint32_t>(b, l.firstRecord + 4, 7);  // component of an entity generation that never lived
-    damaged["stale_entity_handle"] = b;
+    damaged["stale_entity_handle"] = reseal(b);
     b = good;
     put<double>(b, l.firstRecord + 8, std::nan(""));  // the first body's mass
-    damaged["nan_mass"] = b;
+    damaged["nan_mass"] = reseal(b);
     damaged["trailing_bytes"] = good + std::string("garbage");
+    b = good;
+    b[l.firstRecord + 9] ^= 0x01;  // one flipped bit in the first body's mass, checksum not resealed
+    damaged["flipped_byte"] = b;
   }
 
   for (const auto& [label, bytes] : damaged) {

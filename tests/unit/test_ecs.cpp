@@ -79,7 +79,7 @@ TEST(Pool, SerializeRoundTripIsBitwise) {
   pool.serialize(out);
   Pool<Position3> back("test_position");
   BinaryReader in(out.bytes().data(), out.bytes().size(), "test");
-  back.deserialize(in);
+  back.deserialize(in, 8);
   EXPECT_TRUE(in.atEnd());
   ASSERT_EQ(back.size(), 2u);
   EXPECT_EQ(back.entities()[0], (Entity{3, 2}));
@@ -96,7 +96,17 @@ TEST(Pool, TruncatedDataIsAnErrorNotACrash) {
   pool.serialize(out);
   BinaryReader in(out.bytes().data(), out.bytes().size() - 3, "truncated");
   Pool<Position3> back("test_position");
-  EXPECT_THROW(back.deserialize(in), std::runtime_error);
+  EXPECT_THROW(back.deserialize(in, 1), std::runtime_error);
+}
+
+TEST(Pool, EntityIndexBeyondTheTableIsRejected) {
+  Pool<Position3> pool("test_position");
+  pool.add(Entity{5, 0}, Position3{});
+  BinaryWriter out;
+  pool.serialize(out);
+  BinaryReader in(out.bytes().data(), out.bytes().size(), "test");
+  Pool<Position3> back("test_position");
+  EXPECT_THROW(back.deserialize(in, 5), std::runtime_error) << "slot 5 does not exist in a 5-slot table";
 }
 
 TEST(Pool, SanityCheckNamesFieldAndIndex) {
