@@ -8,14 +8,12 @@
 #include <gtest/gtest.h>
 
 #include "ecs/binary_io.h"
-#include <sys/wait.h>
-#include <unistd.h>
+#include "support/cli_harness.h"
 
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -27,74 +25,10 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
+using namespace monolith::test;
 
-struct CommandResult {
-  int exitCode = -1;
-  std::string out, err;
-};
-
-std::string shellQuote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void writeFile(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-}
-
-// A fresh directory per test under /tmp/monolith_tests_<pid>, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("monolith_tests_" + std::to_string(::getpid())) /
-            (std::string(info->test_suite_name()) + "_" + info->name());
-    fs::remove_all(path_);
-    fs::create_directories(path_ / "logs");
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-    fs::remove(path_.parent_path(), ec);  // only succeeds once the last test's directory is gone
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-// Runs argv with stdout/stderr captured; `timeout` turns a hang into a failure (exit 124): a
-// corrupt step count once made `resume` loop for ~2^63 steps.
-CommandResult run(const std::vector<std::string>& argv, const fs::path& logDir) {
-  static int counter = 0;
-  const std::string id = std::to_string(counter++);
-  const fs::path out = logDir / ("cmd" + id + ".out"), err = logDir / ("cmd" + id + ".err");
-  std::string cmd = "timeout 120";
-  for (const auto& a : argv) cmd += " " + shellQuote(a);
-  cmd += " </dev/null >" + shellQuote(out.string()) + " 2>" + shellQuote(err.string());
-  const int status = std::system(cmd.c_str());
-  CommandResult r;
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
-
-std::vector<std::string> lines(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream ss(text);
-  for (std::string l; std::getline(ss, l);) out.push_back(l);
-  return out;
-}
+// Checkpoint runs are small: a hung `resume` should fail within 2 minutes, not the default 5.
+constexpr int kCommandTimeoutSeconds = 120;
 
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> out;
@@ -183,12 +117,12 @@ constexpr long N = 15;
 struct Fixture {
   TempDir tmp;
   fs::path scene, logs;
-  Fixture() : scene(tmp.path() / "two_bodies.json"), logs(tmp.path() / "logs") { writeFile(scene, kScene); }
+  Fixture() : scene(tmp.path() / "two_bodies.json"), logs(tmp.logs()) { writeFile(scene, kScene); }
   // 2N steps with a checkpoint every N.
   CommandResult straightRun(const fs::path& out) {
     return run({MONOLITH_CLI, "run", scene.string(), "--out", out.string(), "--set", "time.steps=" + std::to_string(2 * N),
                 "--checkpoint-every", std::to_string(N), "--quiet"},
-               logs);
+               logs, kCommandTimeoutSeconds);
   }
 };
 
@@ -200,7 +134,8 @@ TEST(CheckpointRestart, StraightAndResumedRunsAgreeBitwise) {
   ASSERT_TRUE(fs::exists(A / checkpoint(N)));
   ASSERT_TRUE(fs::exists(A / checkpoint(2 * N)));
 
-  const CommandResult b = run({MONOLITH_CLI, "resume", (A / checkpoint(N)).string(), "--out", B.string(), "--quiet"}, f.logs);
+  const CommandResult b = run({MONOLITH_CLI, "resume", (A / checkpoint(N)).string(), "--out", B.string(), "--quiet"},
+                              f.logs, kCommandTimeoutSeconds);
   ASSERT_EQ(b.exitCode, 0) << b.err;
 
   const Json sa = Json::parse(slurp(A / "summary.json")), sb = Json::parse(slurp(B / "summary.json"));
@@ -340,7 +275,8 @@ TEST(CheckpointRestart, DamagedCheckpointsAreRejectedCleanly) {
     SCOPED_TRACE(label);
     const fs::path bad = f.tmp.path() / ("bad_" + label + ".ckpt"), out = f.tmp.path() / ("out_" + label);
     writeFile(bad, bytes);
-    const CommandResult r = run({MONOLITH_CLI, "resume", bad.string(), "--out", out.string(), "--quiet"}, f.logs);
+    const CommandResult r =
+        run({MONOLITH_CLI, "resume", bad.string(), "--out", out.string(), "--quiet"}, f.logs, kCommandTimeoutSeconds);
     EXPECT_EQ(r.exitCode, 3) << r.err;
     EXPECT_NE(r.err.find("checkpoint"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find(bad.filename().string()), std::string::npos) << "message should name the file: " << r.err;
@@ -349,14 +285,14 @@ TEST(CheckpointRestart, DamagedCheckpointsAreRejectedCleanly) {
   }
 
   const fs::path missing = f.tmp.path() / "no_such.ckpt";
-  const CommandResult r = run({MONOLITH_CLI, "resume", missing.string(), "--quiet"}, f.logs);
+  const CommandResult r = run({MONOLITH_CLI, "resume", missing.string(), "--quiet"}, f.logs, kCommandTimeoutSeconds);
   EXPECT_EQ(r.exitCode, 3);
   EXPECT_NE(r.err.find("checkpoint"), std::string::npos) << r.err;
 
   // The undamaged file still resumes (the rejections above are about the damage).
   const CommandResult ok = run({MONOLITH_CLI, "resume", (A / checkpoint(N)).string(), "--out",
                                 (f.tmp.path() / "out_good").string(), "--quiet"},
-                               f.logs);
+                               f.logs, kCommandTimeoutSeconds);
   EXPECT_EQ(ok.exitCode, 0) << ok.err;
 }
 
@@ -385,7 +321,8 @@ TEST(CheckpointRestart, ResumeInPlaceKeepsEarlierRowsAndContinues) {
     }
   }
 
-  const CommandResult r = run({MONOLITH_CLI, "resume", (C / checkpoint(N)).string(), "--quiet"}, f.logs);
+  const CommandResult r =
+      run({MONOLITH_CLI, "resume", (C / checkpoint(N)).string(), "--quiet"}, f.logs, kCommandTimeoutSeconds);
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find(C.filename().string()), std::string::npos) << r.out;
 

@@ -2,18 +2,16 @@
 // good checkpoint, no frames of the bad state) and the CLI contract (exit codes, `systems`,
 // progress lines, the metrics.csv schema), all through the monolith executable.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
+
+#include "support/cli_harness.h"
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -21,77 +19,9 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
-
-struct CommandResult {
-  int exitCode = -1;
-  std::string out, err;
-};
-
-std::string shellQuote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void writeFile(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-}
-
-std::vector<std::string> lines(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream ss(text);
-  for (std::string l; std::getline(ss, l);) out.push_back(l);
-  return out;
-}
+using namespace monolith::test;
 
 bool contains(const std::string& haystack, const std::string& needle) { return haystack.find(needle) != std::string::npos; }
-
-// A fresh directory per test under /tmp/monolith_tests_<pid>, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("monolith_tests_" + std::to_string(::getpid())) /
-            (std::string(info->test_suite_name()) + "_" + info->name());
-    fs::remove_all(path_);
-    fs::create_directories(path_ / "logs");
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-    fs::remove(path_.parent_path(), ec);  // only succeeds once the last test's directory is gone
-  }
-  const fs::path& path() const { return path_; }
-  fs::path logs() const { return path_ / "logs"; }
-
- private:
-  fs::path path_;
-};
-
-// Runs argv with stdout/stderr redirected to files (so stderr is not a TTY); `timeout` turns a
-// hang into a failure (exit 124).
-CommandResult run(const std::vector<std::string>& argv, const fs::path& logDir) {
-  static int counter = 0;
-  const std::string id = std::to_string(counter++);
-  const fs::path out = logDir / ("cmd" + id + ".out"), err = logDir / ("cmd" + id + ".err");
-  std::string cmd = "timeout 300";
-  for (const auto& a : argv) cmd += " " + shellQuote(a);
-  cmd += " </dev/null >" + shellQuote(out.string()) + " 2>" + shellQuote(err.string());
-  const int status = std::system(cmd.c_str());
-  CommandResult r;
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
 
 std::string spinSliver() { return std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/spin_sliver.json"; }
 

@@ -7,17 +7,15 @@
 // x^n = x0 + v0 t + g t^2/2), no contacts, and rotating bodies with isotropic inertia (sphere,
 // cube, disk), whose angular velocity is constant and whose orientation is exp(w t).
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
+
+#include "support/cli_harness.h"
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -25,70 +23,11 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
+using namespace monolith::test;
 
 // Rounding of a handful of steps on O(1..10) values is ~1e-14; 1e-12 leaves a wide margin and
 // still catches any real error (a first-order integrator is off by g dt^2/2 ~ 0.05 here).
 constexpr double kTol = 1e-12;
-
-struct CommandResult {
-  int exitCode = -1;
-  std::string out, err;
-};
-
-std::string shellQuote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// A fresh directory per test under /tmp/monolith_tests_<pid>, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("monolith_tests_" + std::to_string(::getpid())) /
-            (std::string(info->test_suite_name()) + "_" + info->name());
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-    fs::remove(path_.parent_path(), ec);  // only succeeds once the last test's directory is gone
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-// Runs argv with stdout/stderr captured; `timeout` turns a hang into a failure (exit 124).
-CommandResult run(const std::vector<std::string>& argv, const fs::path& logDir) {
-  static int counter = 0;
-  const std::string id = std::to_string(counter++);
-  const fs::path out = logDir / ("cmd" + id + ".out"), err = logDir / ("cmd" + id + ".err");
-  std::string cmd = "timeout 300";
-  for (const auto& a : argv) cmd += " " + shellQuote(a);
-  cmd += " <" + shellQuote("/dev/null") + " >" + shellQuote(out.string()) + " 2>" + shellQuote(err.string());
-  const int status = std::system(cmd.c_str());
-  CommandResult r;
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
-
-void writeFile(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary);
-  out << text;
-}
 
 std::string vtkPython() {
   const char* p = std::getenv("MONOLITH_VTK_PYTHON");
@@ -177,7 +116,7 @@ TEST(VtkOutput, BodiesGeometryAndCollection3D) {
   TempDir tmp;
   const fs::path scene = tmp.path() / "three_bodies.json", out = tmp.path() / "run";
   writeFile(scene, kScene3d);
-  const CommandResult r = run({MONOLITH_CLI, "run", scene.string(), "--out", out.string(), "--quiet"}, tmp.path());
+  const CommandResult r = run({MONOLITH_CLI, "run", scene.string(), "--out", out.string(), "--quiet"}, tmp.logs());
   ASSERT_EQ(r.exitCode, 0) << r.err;
 
   const double dt = 0.1, t = 4 * dt;
@@ -190,7 +129,7 @@ TEST(VtkOutput, BodiesGeometryAndCollection3D) {
                  g4 = out / "frames/geometry_000004.vtp", bp = out / "bodies.pvd", gp = out / "geometry.pvd";
   Json j;
   std::string skip;
-  if (!readWithVtk({b0, b4, g4, bp, gp}, tmp.path(), j, skip)) GTEST_SKIP() << skip;
+  if (!readWithVtk({b0, b4, g4, bp, gp}, tmp.logs(), j, skip)) GTEST_SKIP() << skip;
 
   // Frame 0 is the initial state: values written with 17 significant digits read back exactly.
   const Json& f0 = j["files"][b0.string()];
@@ -286,12 +225,12 @@ TEST(VtkOutput, StringArrayNamesReadBackExactly) {
       { "name": "x", "shape": { "type": "sphere", "radius": 1 }, "rigid_body": { "mass": 1 } }
     ]
   })");
-  const CommandResult r = run({MONOLITH_CLI, "run", scene.string(), "--out", out.string(), "--quiet"}, tmp.path());
+  const CommandResult r = run({MONOLITH_CLI, "run", scene.string(), "--out", out.string(), "--quiet"}, tmp.logs());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const fs::path frame = out / "frames/bodies_000001.vtp";
   Json j;
   std::string skip;
-  if (!readWithVtk({frame}, tmp.path(), j, skip)) GTEST_SKIP() << skip;
+  if (!readWithVtk({frame}, tmp.logs(), j, skip)) GTEST_SKIP() << skip;
   const Json& names = j["files"][frame.string()]["point_data"]["name"];
   EXPECT_EQ(names["tuples"], 5);
   const std::vector<std::string> want = {"", "two words", "caf\xc3\xa9 \xe2\x86\x92 \xcf\x89", "", "x"};
@@ -313,12 +252,12 @@ TEST(VtkOutput, TwoDimensionalSceneLiesInTheXYPlane) {
         "rigid_body": { "mass": 3.0, "position": [3, 1], "velocity": [0, 0.5] } }
     ]
   })");
-  const CommandResult r = run({MONOLITH_CLI, "run", scene.string(), "--out", out.string(), "--quiet"}, tmp.path());
+  const CommandResult r = run({MONOLITH_CLI, "run", scene.string(), "--out", out.string(), "--quiet"}, tmp.logs());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const fs::path bf = out / "frames/bodies_000004.vtp", gf = out / "frames/geometry_000004.vtp";
   Json j;
   std::string skip;
-  if (!readWithVtk({bf, gf, out / "bodies.pvd"}, tmp.path(), j, skip)) GTEST_SKIP() << skip;
+  if (!readWithVtk({bf, gf, out / "bodies.pvd"}, tmp.logs(), j, skip)) GTEST_SKIP() << skip;
 
   const double t = 4 * 0.05;
   const Eigen::Vector3d g(0, -9.81, 0);
