@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "ecs/binary_io.h"
 
@@ -16,6 +17,10 @@ namespace monolith {
 
 template <class T>
 struct IsEigenDense : std::is_base_of<Eigen::DenseBase<T>, T> {};
+template <class T>
+struct IsStdVector : std::false_type {};
+template <class T, class A>
+struct IsStdVector<std::vector<T, A>> : std::true_type {};
 
 struct FieldWriter {
   BinaryWriter& out;
@@ -23,6 +28,8 @@ struct FieldWriter {
   void operator()(const char*, const T& value) {
     if constexpr (std::is_same_v<T, std::string>) {
       out.string(value);
+    } else if constexpr (IsStdVector<T>::value) {
+      out.vector(value);  // bulk arrays (grid faces, cells, particles): one component, many values
     } else if constexpr (std::is_same_v<T, Eigen::Quaterniond>) {
       out.raw(value.coeffs().data(), 4 * sizeof(double));
     } else if constexpr (IsEigenDense<T>::value) {
@@ -40,6 +47,8 @@ struct FieldReader {
   void operator()(const char*, T& value) {
     if constexpr (std::is_same_v<T, std::string>) {
       value = in.string();
+    } else if constexpr (IsStdVector<T>::value) {
+      value = in.template vector<typename T::value_type>();
     } else if constexpr (std::is_same_v<T, Eigen::Quaterniond>) {
       in.raw(value.coeffs().data(), 4 * sizeof(double));
     } else if constexpr (IsEigenDense<T>::value) {
@@ -67,7 +76,10 @@ struct FieldSanityChecker {
   }
   template <class T>
   void operator()(const char* name, const T& value) {
-    if constexpr (std::is_same_v<T, Eigen::Quaterniond>) {
+    if constexpr (IsStdVector<T>::value) {
+      if constexpr (std::is_floating_point_v<typename T::value_type>)
+        for (std::size_t i = 0; i < value.size(); ++i) check(name, static_cast<int>(i), value[i]);
+    } else if constexpr (std::is_same_v<T, Eigen::Quaterniond>) {
       for (int i = 0; i < 4; ++i) check(name, i, value.coeffs()[i]);
     } else if constexpr (IsEigenDense<T>::value) {
       if constexpr (std::is_floating_point_v<typename T::Scalar>)

@@ -7,15 +7,17 @@ namespace monolith {
 
 class Progress {
  public:
-  Progress(long total, long first, bool enabled);
-  void update(long done);
+  // Progress in simulated time from `start` to `end`; totalSteps > 0 when the count is known.
+  Progress(double end, double start, long totalSteps, bool enabled);
+  void update(double time, long step);
   void finish(const std::string& status);
 
  private:
-  long total_, first_;
+  double end_, start_;
+  long totalSteps_;
   bool enabled_, tty_;
   int lastDecile_ = -1;
-  std::chrono::steady_clock::time_point start_, lastDraw_;
+  std::chrono::steady_clock::time_point started_, lastDraw_;
 };
 
 }  // namespace monolith

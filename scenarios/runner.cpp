@@ -90,8 +90,8 @@ class Run {
 
 template <int d>
 void Run<d>::writeFrame(long step) {
-  if (!options_.writeFrames || scene_.frameEvery == 0) return;
-  const double t = step * scene_.dt;
+  if (!options_.writeFrames || (scene_.frameEvery == 0 && scene_.frameInterval == 0)) return;
+  const double t = sim_->time();
   const std::string bodies = frameName("bodies", step), geometry = frameName("geometry", step);
   writeRigidBodyFrame(world(), outDir_ + "/" + bodies);
   writeRigidGeometryFrame(world(), outDir_ + "/" + geometry);
@@ -115,7 +115,7 @@ bool Run<d>::guard(long step, std::string& diagnosis) const {
   for (const auto& [name, pool] : world().pools()) {
     if (auto v = pool->firstViolation(scene_.guardMaxAbs)) {
       std::ostringstream m;
-      m << "unstable at step " << step << " (t = " << step * scene_.dt << "): entity " << world().label(v->entity)
+      m << "unstable at step " << step << " (t = " << sim_->time() << "): entity " << world().label(v->entity)
         << ", component " << v->component << ", field " << v->field.field << "[" << v->field.index
         << "] = " << v->field.value
         << (std::isfinite(v->field.value) ? " exceeds guard.max_abs_value = " + std::to_string(scene_.guardMaxAbs)
@@ -139,7 +139,8 @@ void Run<d>::writeSummary(const std::string& status, const std::string& diagnosi
   s["dt"] = scene_.dt;
   s["steps"] = scene_.steps;
   s["steps_completed"] = stepsDone;
-  s["time"] = stepsDone * scene_.dt;
+  s["time"] = sim_->time();
+  s["cfl"] = scene_.cfl;
   s["total_wall_seconds"] = wallTotal_;
   s["status"] = status;
   if (!diagnosis.empty()) s["diagnosis"] = diagnosis;
@@ -178,7 +179,7 @@ RunResult Run<d>::execute() {
     if (!guard(resume_->header.step, diagnosis))
       throw CheckpointRejected("restored state fails the blow-up guard: " + diagnosis);
     firstStep = resume_->header.step;
-    sim_->setStepsDone(firstStep);
+    sim_->restoreClock(firstStep, resume_->header.time);
     sim_->reschedule();  // the restored world may need other systems than the scene's start
   }
   outDir_ = chooseOutDir(scene_, options_);
@@ -200,8 +201,8 @@ RunResult Run<d>::execute() {
   if (resume_) {
     bodiesPvd_->load();
     geometryPvd_->load();
-    bodiesPvd_->truncateAfter(firstStep * scene_.dt * (1 + 1e-12));
-    geometryPvd_->truncateAfter(firstStep * scene_.dt * (1 + 1e-12));
+    bodiesPvd_->truncateAfter(sim_->time() * (1 + 1e-12));
+    geometryPvd_->truncateAfter(sim_->time() * (1 + 1e-12));
   }
   MetricsWriter metrics(outDir_ + "/metrics.csv", resume_ ? firstStep : -1);
   if (!resume_) writeFrame(0);
@@ -214,10 +215,11 @@ RunResult Run<d>::execute() {
         break;
       }
 
-  Progress progress(scene_.steps, firstStep, options_.progress);
+  Progress progress(scene_.endTime, sim_->time(), scene_.steps, options_.progress);
   std::map<std::string, double> lastDiagnostics;
   std::string lastGoodCheckpoint;
-  for (long n = firstStep; n < scene_.steps; ++n) {
+  while (!sim_->finished()) {
+    const long n = sim_->stepsDone();
     const auto t0 = Clock::now();
     const std::map<std::string, double>* diagnostics = &lastDiagnostics;
     std::string diagnosis;
@@ -243,7 +245,7 @@ RunResult Run<d>::execute() {
         diagnosis = "unstable at step " + std::to_string(done) + ": diagnostic " + k + " is not finite";
       }
     if (!stepAborted)  // an aborted step has no complete diagnostics to report
-      metrics.row(done, done * scene_.dt, scene_.dt, *diagnostics, stages, sim_->scheduler().stageSeconds(), wall);
+      metrics.row(done, sim_->time(), sim_->lastDt(), *diagnostics, stages, sim_->scheduler().stageSeconds(), wall);
     if (!ok) {
       progress.finish("stopped: unstable");
       if (!lastGoodCheckpoint.empty()) diagnosis += "; last good checkpoint: " + lastGoodCheckpoint;
@@ -256,18 +258,18 @@ RunResult Run<d>::execute() {
       return result;  // the bad state is neither framed nor checkpointed
     }
     if (diagnostics != &lastDiagnostics) lastDiagnostics = *diagnostics;
-    if (scene_.frameEvery > 0 && done % scene_.frameEvery == 0) writeFrame(done);
+    if (sim_->frameDue()) writeFrame(done);
     if (checkpointEvery > 0 && done % checkpointEvery == 0) {
       const std::string path = checkpointPath(done);
-      writeCheckpoint(path, CheckpointHeader{d, done, done * scene_.dt, fs::absolute(scene_.file).string(), scene_.json.dump(), checkpointEvery_}, world());
+      writeCheckpoint(path, CheckpointHeader{d, done, sim_->time(), fs::absolute(scene_.file).string(), scene_.json.dump(), checkpointEvery_}, world());
       checkpoints_.push_back(path);
       lastGoodCheckpoint = path;
     }
-    progress.update(done);
+    progress.update(sim_->time(), done);
   }
-  progress.finish("done: " + std::to_string(scene_.steps - firstStep) + " steps");
-  writeSummary("completed", "", scene_.steps, lastDiagnostics);
-  result.stepsCompleted = scene_.steps;
+  progress.finish("done: " + std::to_string(sim_->stepsDone() - firstStep) + " steps");
+  writeSummary("completed", "", sim_->stepsDone(), lastDiagnostics);
+  result.stepsCompleted = sim_->stepsDone();
   result.stateHash = stateHash(world());
   result.wallSeconds = wallTotal_;
   return result;
@@ -331,7 +333,8 @@ RunResult resumeRun(const std::string& checkpointPath, Registry& registry, Plugi
     return r;
   }
   // A step beyond the scene's end (corrupt header) would silently "complete" without stepping.
-  if (file.header.step > scene.steps) {
+  if ((scene.cfl <= 0 && file.header.step > scene.steps) ||
+      (scene.cfl > 0 && file.header.time > scene.endTime * (1 + 1e-12))) {
     r.exitCode = kExitInvalidScene;
     r.message = "checkpoint '" + checkpointPath + "': step " + std::to_string(file.header.step) +
                 " is beyond the scene's " + std::to_string(scene.steps) + " steps";

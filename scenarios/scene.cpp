@@ -173,27 +173,8 @@ void applyOverride(Json& root, const Override& o, const std::string& file) {
   }
 }
 
-}  // namespace
-
-SceneSpec parseScene(const std::string& text, const std::string& file, const std::vector<Override>& overrides) {
-  SceneSpec s;
-  s.file = file;
-  s.directory = directoryOf(file);
-  try {
-    s.json = Json::parse(text, DuplicateKeyCheck(file), /*allow_exceptions=*/true, /*ignore_comments=*/true);
-  } catch (const Json::parse_error& e) {
-    throwSyntaxError(text, file, e);
-  } catch (const Json::out_of_range& e) {
-    throwNumberOverflow(text, file, e);
-  }
-  if (!s.json.is_object()) throw SceneError(file, "", "a JSON object at the top level", describeJson(s.json));
-  for (const auto& o : overrides) applyOverride(s.json, o, file);
-
-  const Config top(s.json, file, "");
-  s.description = top.string("description", "");
-  s.dimension = static_cast<int>(top.integer("dimension", 2, 3));
-
-  const Config time = top.child("time");
+// "time": {"dt", "steps" | "end", "frame_rate"}: a fixed step.
+void parseFixedTime(const Config& time, SceneSpec& s) {
   s.dt = time.number("dt", Bound::Positive);
   if (time.has("steps") && time.has("end")) time.failAt("end", "either \"end\" or \"steps\", not both", "both");
   const long maxSteps = 1000000000L;
@@ -224,6 +205,50 @@ SceneSpec parseScene(const std::string& text, const std::string& file, const std
   const double frameRate = time.number("frame_rate", 30.0, Bound::NonNegative);
   // Capped before lround, which is undefined beyond the range of long (a tiny frame rate).
   s.frameEvery = frameRate > 0 ? std::max(1L, std::lround(std::min(1.0 / (frameRate * s.dt), 1e15))) : 0;
+  s.endTime = static_cast<double>(s.steps) * s.dt;
+}
+
+// "time": {"cfl", "end", "dt" (largest step), "frame_rate"}: the step follows the CFL condition
+// dt = cfl * min over systems of their unit-CFL step (e.g. dx / max|u| of a fluid), clipped so
+// that every frame time and the end are hit exactly.
+void parseCflTime(const Config& time, SceneSpec& s) {
+  s.cfl = time.number("cfl", Bound::Positive);
+  if (s.cfl > 10) time.failAt("cfl", "a CFL number in (0, 10]", formatNumber(s.cfl));
+  if (time.has("steps")) time.failAt("steps", "no \"steps\" with \"cfl\" (the step count follows from the CFL condition)", "");
+  s.endTime = time.number("end", Bound::Positive);
+  const double frameRate = time.number("frame_rate", 30.0, Bound::NonNegative);
+  s.frameInterval = frameRate > 0 ? 1.0 / frameRate : 0.0;
+  s.dt = time.number("dt", s.frameInterval > 0 ? std::min(s.frameInterval, s.endTime) : s.endTime, Bound::Positive);
+  s.steps = 0;  // not known in advance
+  s.frameEvery = s.frameInterval > 0 ? 1 : 0;
+}
+
+}  // namespace
+
+SceneSpec parseScene(const std::string& text, const std::string& file, const std::vector<Override>& overrides) {
+  SceneSpec s;
+  s.file = file;
+  s.directory = directoryOf(file);
+  try {
+    s.json = Json::parse(text, DuplicateKeyCheck(file), /*allow_exceptions=*/true, /*ignore_comments=*/true);
+  } catch (const Json::parse_error& e) {
+    throwSyntaxError(text, file, e);
+  } catch (const Json::out_of_range& e) {
+    throwNumberOverflow(text, file, e);
+  }
+  if (!s.json.is_object()) throw SceneError(file, "", "a JSON object at the top level", describeJson(s.json));
+  for (const auto& o : overrides) applyOverride(s.json, o, file);
+
+  const Config top(s.json, file, "");
+  s.description = top.string("description", "");
+  s.dimension = static_cast<int>(top.integer("dimension", 2, 3));
+
+  const Config time = top.child("time");
+  if (time.has("cfl")) {
+    parseCflTime(time, s);
+  } else {
+    parseFixedTime(time, s);
+  }
   time.finish();
 
   s.threads = static_cast<int>(top.integer("threads", 2, 1, 256));
@@ -231,7 +256,10 @@ SceneSpec parseScene(const std::string& text, const std::string& file, const std
   if (top.has("output")) {
     const Config out = top.child("output");
     s.outputDirectory = out.string("directory", "");
-    if (!out.boolean("frames", true)) s.frameEvery = 0;
+    if (!out.boolean("frames", true)) {
+      s.frameEvery = 0;
+      s.frameInterval = 0;
+    }
     out.finish();
   }
   if (top.has("checkpoint")) {

@@ -20,8 +20,11 @@ struct SceneSpec {
   std::string description;
   int dimension = 3;
   double dt = 0;
-  long steps = 0;
-  long frameEvery = 1;  // write a frame every this many steps (0: no frames)
+  long steps = 0;        // fixed-dt scenes; 0 when the step follows the CFL condition
+  double endTime = 0;    // simulated time at the end
+  double cfl = 0;        // > 0: adaptive step, dt = cfl * (smallest unit-CFL step of the systems)
+  long frameEvery = 1;   // fixed dt: write a frame every this many steps (0: no frames)
+  double frameInterval = 0;  // CFL scenes: write a frame every this much simulated time
   int threads = 2;
   std::string outputDirectory;  // "" = derived from the scene name
   std::vector<std::string> plugins;  // resolved paths
