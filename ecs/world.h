@@ -26,11 +26,24 @@ struct RigidRotationSettings {
   bool energyFix = true;   // kinetic-energy orientation fix, Sec. 2.2.2-2.2.4
 };
 
+// How the fluid step of Ch. 5 is taken (scene "solvers": {"fluid": {...}}).
+struct FluidSolverSettings {
+  enum class Advection { SemiLagrangian, Eno3, None };  // None: unsteady Stokes flow (Sec. 5.7)
+  enum class Projection { Coupled, Chorin };            // (5.31) vs pressure/viscosity splitting
+  enum class Preconditioner { None, Jacobi, IC0, MIC0, Multigrid };
+  Advection advection = Advection::SemiLagrangian;
+  Projection projection = Projection::Coupled;
+  Preconditioner preconditioner = Preconditioner::MIC0;
+  double tolerance = 1e-8;   // relative residual of the Krylov solve
+  int maxIterations = 5000;
+};
+
 // Scene-wide physical settings shared by systems (read-only during a step).
 template <int d>
 struct WorldSettings {
   Vec<d> gravity = Vec<d>::Zero();
   RigidRotationSettings rigidRotation;
+  FluidSolverSettings fluid;
 };
 
 template <int d>

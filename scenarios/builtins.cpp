@@ -7,6 +7,7 @@
 #include "components/rigid_body.h"
 #include "components/shape.h"
 #include "ecs/registry.h"
+#include "scenarios/fluid_components.h"
 #include "systems/advance_positions.h"
 #include "systems/advance_velocity.h"
 #include "systems/rigid_diagnostics.h"
@@ -145,6 +146,7 @@ void registerDimension(Registry& r) {
       parseRigidBody<d>);
   r.addComponentOf<d, ExternalForce<d>>("constant world-frame force and torque on a rigid body", parseExternalForce<d>);
   r.addComponentOf<d, RigidForces<d>>("(internal) force/torque accumulator of a dynamic rigid body", nullptr);
+  registerFluidComponents<d>(r);
 
   r.addSystem<d>({"clear_rigid_forces", "zero the force accumulators before each force evaluation",
                   [] { return atBothForceStages<ClearRigidForces<d>, d>(); }, ""});

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
@@ -16,6 +17,9 @@
 #include "scenarios/checkpoint.h"
 #include "scenarios/metrics_writer.h"
 #include "scenarios/progress.h"
+#include "components/mac_grid.h"
+#include "components/rigid_body.h"
+#include "scenarios/vtk_grid_writer.h"
 #include "scenarios/vtk_writer.h"
 
 namespace monolith {
@@ -46,9 +50,9 @@ std::string chooseOutDir(const SceneSpec& scene, const RunOptions& options) {
     if (!fs::exists(base + "-" + std::to_string(k))) return base + "-" + std::to_string(k);
 }
 
-std::string frameName(const char* kind, long step) {
+std::string frameName(const std::string& kind, long step, const char* extension) {
   std::ostringstream s;
-  s << "frames/" << kind << "_" << std::setw(6) << std::setfill('0') << step << ".vtp";
+  s << "frames/" << kind << "_" << std::setw(6) << std::setfill('0') << step << extension;
   return s.str();
 }
 
@@ -81,7 +85,15 @@ class Run {
   World<d>& world() { return sim_->world(); }
   const World<d>& world() const { return sim_->world(); }
   std::string outDir_;
-  std::unique_ptr<PvdCollection> bodiesPvd_, geometryPvd_;
+  // One time series per kind of frame the scene has (rigid bodies, their geometry, the fluid).
+  struct FrameSeries {
+    std::string kind;
+    const char* extension;
+    std::function<void(const World<d>&, const std::string&)> write;
+    std::unique_ptr<PvdCollection> pvd;
+  };
+  std::vector<FrameSeries> series_;
+  void setUpFrameSeries();
   std::vector<std::string> checkpoints_;
   double wallTotal_ = 0;
   long checkpointEvery_ = 0;
@@ -92,13 +104,30 @@ template <int d>
 void Run<d>::writeFrame(long step) {
   if (!options_.writeFrames || (scene_.frameEvery == 0 && scene_.frameInterval == 0)) return;
   const double t = sim_->time();
-  const std::string bodies = frameName("bodies", step), geometry = frameName("geometry", step);
-  writeRigidBodyFrame(world(), outDir_ + "/" + bodies);
-  writeRigidGeometryFrame(world(), outDir_ + "/" + geometry);
-  bodiesPvd_->add(t, bodies);
-  geometryPvd_->add(t, geometry);
-  bodiesPvd_->write();
-  geometryPvd_->write();
+  for (auto& s : series_) {
+    const std::string file = frameName(s.kind, step, s.extension);
+    s.write(world(), outDir_ + "/" + file);
+    s.pvd->add(t, file);
+    s.pvd->write();
+  }
+}
+
+template <int d>
+void Run<d>::setUpFrameSeries() {
+  auto add = [&](std::string kind, const char* extension, std::function<void(const World<d>&, const std::string&)> write) {
+    FrameSeries s{kind, extension, std::move(write), std::make_unique<PvdCollection>(outDir_ + "/" + kind + ".pvd")};
+    if (resume_) {  // keep the frames written before the checkpoint, drop later ones
+      s.pvd->load();
+      s.pvd->truncateAfter(sim_->time() * (1 + 1e-12));
+    }
+    series_.push_back(std::move(s));
+  };
+  if (world().template count<RigidBody<d>>() > 0) {
+    add("bodies", ".vtp", [](const World<d>& w, const std::string& p) { writeRigidBodyFrame(w, p); });
+    add("geometry", ".vtp", [](const World<d>& w, const std::string& p) { writeRigidGeometryFrame(w, p); });
+  }
+  if (world().template count<MacGrid<d>>() > 0)
+    add("fluid", ".vti", [](const World<d>& w, const std::string& p) { writeMacGridFrame(w, p); });
 }
 
 template <int d>
@@ -196,14 +225,7 @@ RunResult Run<d>::execute() {
     graph << sim_->scheduler().dot();
   }
 
-  bodiesPvd_ = std::make_unique<PvdCollection>(outDir_ + "/bodies.pvd");
-  geometryPvd_ = std::make_unique<PvdCollection>(outDir_ + "/geometry.pvd");
-  if (resume_) {
-    bodiesPvd_->load();
-    geometryPvd_->load();
-    bodiesPvd_->truncateAfter(sim_->time() * (1 + 1e-12));
-    geometryPvd_->truncateAfter(sim_->time() * (1 + 1e-12));
-  }
+  setUpFrameSeries();
   MetricsWriter metrics(outDir_ + "/metrics.csv", resume_ ? firstStep : -1);
   if (!resume_) writeFrame(0);
 
@@ -218,6 +240,7 @@ RunResult Run<d>::execute() {
   Progress progress(scene_.endTime, sim_->time(), scene_.steps, options_.progress);
   std::map<std::string, double> lastDiagnostics;
   std::string lastGoodCheckpoint;
+  bool converged = false;
   while (!sim_->finished()) {
     const long n = sim_->stepsDone();
     const auto t0 = Clock::now();
@@ -266,9 +289,17 @@ RunResult Run<d>::execute() {
       lastGoodCheckpoint = path;
     }
     progress.update(sim_->time(), done);
+    if (!scene_.stopDiagnostic.empty()) {  // steady state: the scene's "stop" criterion
+      const auto it = diagnostics->find(scene_.stopDiagnostic);
+      if (it != diagnostics->end() && it->second < scene_.stopBelow) {
+        converged = true;
+        break;
+      }
+    }
   }
-  progress.finish("done: " + std::to_string(sim_->stepsDone() - firstStep) + " steps");
-  writeSummary("completed", "", sim_->stepsDone(), lastDiagnostics);
+  progress.finish((converged ? "converged: " : "done: ") + std::to_string(sim_->stepsDone() - firstStep) + " steps");
+  if (converged && sim_->frameDue() == false) writeFrame(sim_->stepsDone());  // the steady state itself
+  writeSummary(converged ? "converged" : "completed", "", sim_->stepsDone(), lastDiagnostics);
   result.stepsCompleted = sim_->stepsDone();
   result.stateHash = stateHash(world());
   result.wallSeconds = wallTotal_;

@@ -267,6 +267,12 @@ SceneSpec parseScene(const std::string& text, const std::string& file, const std
     s.checkpointEvery = ck.integer("every", 0, 0, 1000000000L);
     ck.finish();
   }
+  if (top.has("stop")) {
+    const Config stop = top.child("stop");
+    s.stopDiagnostic = stop.string("diagnostic");
+    s.stopBelow = stop.number("below", Bound::Positive);
+    stop.finish();
+  }
   if (top.has("guard")) {
     const Config guard = top.child("guard");
     s.guardMaxAbs = guard.number("max_abs_value", s.guardMaxAbs, Bound::Positive);
@@ -316,6 +322,25 @@ void loadScenePlugins(const SceneSpec& scene, PluginLoader& loader, Registry& re
   }
 }
 
+namespace {
+void parseFluidSolverSettings(const Config& c, FluidSolverSettings& f) {
+  using S = FluidSolverSettings;
+  const std::string advection = c.oneOf("advection", {"semi_lagrangian", "eno3", "none"}, "semi_lagrangian");
+  f.advection = advection == "eno3" ? S::Advection::Eno3 : advection == "none" ? S::Advection::None : S::Advection::SemiLagrangian;
+  f.projection = c.oneOf("projection", {"coupled", "chorin"}, "coupled") == "chorin" ? S::Projection::Chorin : S::Projection::Coupled;
+  const std::string pc = c.oneOf("preconditioner", {"none", "jacobi", "ic0", "mic0", "multigrid"}, "mic0");
+  f.preconditioner = pc == "none"     ? S::Preconditioner::None
+                     : pc == "jacobi" ? S::Preconditioner::Jacobi
+                     : pc == "ic0"    ? S::Preconditioner::IC0
+                     : pc == "mic0"   ? S::Preconditioner::MIC0
+                                      : S::Preconditioner::Multigrid;
+  f.tolerance = c.number("tolerance", f.tolerance, Bound::Positive);
+  if (f.tolerance >= 1) c.failAt("tolerance", "a relative tolerance below 1", formatNumber(f.tolerance));
+  f.maxIterations = static_cast<int>(c.integer("max_iterations", f.maxIterations, 1, 1000000));
+  c.finish();
+}
+}  // namespace
+
 template <int d>
 void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& world) {
   if (scene.dimension != d) throw std::logic_error("populateWorld: dimension mismatch");
@@ -333,6 +358,7 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
       settings.rigidRotation.energyFix = rr.boolean("energy_fix", true);
       rr.finish();
     }
+    if (solvers.has("fluid")) parseFluidSolverSettings(solvers.child("fluid"), world.settings().fluid);
     solvers.finish();
   }
 

@@ -30,6 +30,8 @@ struct SceneSpec {
   std::vector<std::string> plugins;  // resolved paths
   long checkpointEvery = 0;          // 0 = off
   double guardMaxAbs = 1e12;         // blow-up guard: any state value beyond this is absurd
+  std::string stopDiagnostic;        // "stop": end the run early once this diagnostic ...
+  double stopBelow = 0;              // ... falls below this value (steady state reached)
 };
 
 // One "--set key=value": key is a dotted path (entity names may stand for their index in

@@ -26,16 +26,16 @@ RigidTotals measureRigidTotals(const World<d>& world) {
 template <int d>
 void RigidDiagnostics<d>::run(World<d>& world, StepContext& ctx) {
   const RigidTotals t = measureRigidTotals(world);
-  auto& out = ctx.diagnostics;
-  out.set("kinetic_energy", t.kinetic);
-  out.set("potential_energy", t.potential);
-  out.set("total_energy", t.kinetic + t.potential);
-  out.set("linear_momentum_x", t.linearMomentum.x());
-  out.set("linear_momentum_y", t.linearMomentum.y());
-  out.set("linear_momentum_z", t.linearMomentum.z());
-  out.set("angular_momentum_x", t.angularMomentum.x());
-  out.set("angular_momentum_y", t.angularMomentum.y());
-  out.set("angular_momentum_z", t.angularMomentum.z());
+  auto& out = ctx.diagnostics;  // add, not set: other systems (the fluid) contribute to the same totals
+  out.add("kinetic_energy", t.kinetic);
+  out.add("potential_energy", t.potential);
+  out.add("total_energy", t.kinetic + t.potential);
+  out.add("linear_momentum_x", t.linearMomentum.x());
+  out.add("linear_momentum_y", t.linearMomentum.y());
+  out.add("linear_momentum_z", t.linearMomentum.z());
+  out.add("angular_momentum_x", t.angularMomentum.x());
+  out.add("angular_momentum_y", t.angularMomentum.y());
+  out.add("angular_momentum_z", t.angularMomentum.z());
 }
 
 template RigidTotals measureRigidTotals<2>(const World<2>&);

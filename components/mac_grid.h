@@ -1,0 +1,86 @@
+#pragma once
+// MacGrid<d>: an incompressible fluid on a uniform MAC grid (thesis Sec. 5.2, 6.3.3). One
+// component holds the whole grid: pressures at cell centres, velocity components at the faces
+// normal to their axis (layout of solvers/mac_layout.h: axis 0 faces first, x fastest), the
+// solid flags of cells covered by obstacles and the domain's boundary conditions.
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace monolith {
+
+// What bounds the domain on one side (x_min, x_max, y_min, ...).
+enum class DomainSide : int {
+  Wall = 0,     // no flow through; tangential: no-slip at `velocity` or slip
+  Inflow = 1,   // prescribed inflow (uniform or parabolic profile)
+  Outflow = 2,  // p = 0 outside, free normal velocity (do-nothing)
+  Periodic = 3  // both sides of the axis
+};
+
+template <int d>
+struct SideCondition {
+  DomainSide type = DomainSide::Wall;
+  bool slip = false;                                                 // walls
+  Eigen::Matrix<double, d, 1> velocity = Eigen::Matrix<double, d, 1>::Zero();  // wall velocity / uniform inflow
+  bool parabolic = false;                                            // inflow profile
+  double peakVelocity = 0;                                           // parabolic inflow: centre speed
+};
+
+template <int d>
+struct MacGrid {
+  static constexpr const char* kName = "mac_grid";
+  using Index = Eigen::Matrix<int, d, 1>;
+  using VecD = Eigen::Matrix<double, d, 1>;
+
+  // --- geometry and conditions (set by the scene) ---
+  Index cells = Index::Ones();
+  double dx = 1;
+  VecD origin = VecD::Zero();
+  std::array<SideCondition<d>, 2 * d> sides{};  // order: x_min, x_max, y_min, y_max, (z_min, z_max)
+
+  // --- state (checkpointed) ---
+  std::vector<double> u;          // face velocities
+  std::vector<double> p;          // cell pressures (from the last projection)
+  std::vector<std::uint8_t> solid;  // per cell: 1 = covered by an obstacle
+
+  template <class V>
+  void visitFields(V& visit) {
+    visit("cells", cells);
+    visit("dx", dx);
+    visit("origin", origin);
+    for (auto& s : sides) {
+      int type = static_cast<int>(s.type);
+      visit("side_type", type);
+      s.type = static_cast<DomainSide>(type);
+      visit("side_slip", s.slip);
+      visit("side_velocity", s.velocity);
+      visit("side_parabolic", s.parabolic);
+      visit("side_peak_velocity", s.peakVelocity);
+    }
+    visit("velocity", u);
+    visit("pressure", p);
+    visit("solid", solid);
+  }
+
+  bool periodic(int axis) const { return sides[2 * axis].type == DomainSide::Periodic; }
+  double cellVolume() const {
+    double v = 1;
+    for (int a = 0; a < d; ++a) v *= dx;
+    return v;
+  }
+};
+
+// Fluid properties (constant density and dynamic viscosity), on the grid's entity.
+struct FluidMaterial {
+  static constexpr const char* kName = "fluid_material";
+  double density = 1;
+  double viscosity = 0;
+  template <class V>
+  void visitFields(V& visit) {
+    visit("density", density);
+    visit("viscosity", viscosity);
+  }
+};
+
+}  // namespace monolith

@@ -1,0 +1,135 @@
+#include "scenarios/fluid_components.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "components/mac_grid.h"
+#include "solvers/mac_layout.h"
+
+namespace monolith {
+
+namespace {
+
+const char* kAxisNames[] = {"x", "y", "z"};
+
+std::string sideName(int side) { return std::string(kAxisNames[side / 2]) + (side % 2 ? "_max" : "_min"); }
+
+template <int d>
+SideCondition<d> parseSide(const Config& c) {
+  SideCondition<d> s;
+  const std::string type = c.oneOf("type", {"wall", "inflow", "outflow", "periodic"}, "");
+  if (type == "wall") {
+    s.type = DomainSide::Wall;
+    s.slip = c.boolean("slip", false);
+    s.velocity = c.vector("velocity", Eigen::VectorXd::Zero(d));  // a moving wall (cavity lid)
+  } else if (type == "inflow") {
+    s.type = DomainSide::Inflow;
+    s.parabolic = c.oneOf("profile", {"uniform", "parabolic"}, "uniform") == "parabolic";
+    if (s.parabolic) s.peakVelocity = c.number("peak_velocity");
+    else s.velocity = c.vector("velocity", d);
+  } else if (type == "outflow") {
+    s.type = DomainSide::Outflow;
+  } else {
+    s.type = DomainSide::Periodic;
+  }
+  return s;
+}
+
+// Initial face velocities: zero, uniform, or the Taylor-Green vortex (REFERENCES.md:
+// u = A sin x cos y, v = -A cos x sin y; in 3-D times cos z, w = 0).
+template <int d>
+void initialVelocity(const Config& c, MacGrid<d>& grid, const solvers::MacLayout<d>& layout) {
+  const std::string type = c.oneOf("type", {"zero", "uniform", "taylor_green"}, "zero");
+  Eigen::Matrix<double, d, 1> uniform = Eigen::Matrix<double, d, 1>::Zero();
+  double amplitude = 1;
+  if (type == "uniform") uniform = c.vector("velocity", d);
+  if (type == "taylor_green") amplitude = c.number("amplitude", 1.0);
+  for (int f = 0; f < layout.totalFaces(); ++f) {
+    const auto [axis, index] = layout.faceCoord(f);
+    const Eigen::Matrix<double, d, 1> x = layout.faceCenter(axis, index);
+    double value = 0;
+    if (type == "uniform") value = uniform[axis];
+    if (type == "taylor_green") {
+      const double z = d == 3 ? std::cos(x[d - 1]) : 1.0;
+      if (axis == 0) value = amplitude * std::sin(x[0]) * std::cos(x[1]) * z;
+      if (axis == 1) value = -amplitude * std::cos(x[0]) * std::sin(x[1]) * z;
+    }
+    grid.u[f] = value;
+  }
+}
+
+template <int d>
+void parseMacGrid(World<d>& world, Entity e, const Config& c) {
+  MacGrid<d> grid;
+  const Eigen::VectorXd n = c.vector("cells", d, Bound::Positive);
+  for (int a = 0; a < d; ++a) {
+    if (n[a] != std::floor(n[a]) || n[a] < 2 || n[a] > 65536)
+      c.failAt("cells[" + std::to_string(a) + "]", "an integer number of cells in [2, 65536]", std::to_string(n[a]));
+    grid.cells[a] = static_cast<int>(n[a]);
+  }
+  const Eigen::VectorXd lo = c.vector("domain_min", Eigen::VectorXd::Zero(d));
+  const Eigen::VectorXd hi = c.vector("domain_max", d);
+  grid.origin = lo;
+  grid.dx = (hi[0] - lo[0]) / grid.cells[0];
+  for (int a = 0; a < d; ++a) {
+    const double h = (hi[a] - lo[a]) / grid.cells[a];
+    if (!(h > 0)) c.failAt("domain_max", "a domain_max above domain_min on every axis", "");
+    if (std::abs(h - grid.dx) > 1e-9 * grid.dx) {
+      std::ostringstream got;
+      got << "dx = " << grid.dx << " along x but " << h << " along " << kAxisNames[a];
+      c.failAt("cells", "square cells: (domain_max - domain_min) / cells equal on every axis", got.str());
+    }
+  }
+  if (c.has("boundaries")) {
+    const Config b = c.child("boundaries");
+    for (int side = 0; side < 2 * d; ++side)
+      if (b.has(sideName(side))) grid.sides[side] = parseSide<d>(b.child(sideName(side)));
+    for (int a = 0; a < d; ++a) {
+      const bool lower = grid.sides[2 * a].type == DomainSide::Periodic;
+      const bool upper = grid.sides[2 * a + 1].type == DomainSide::Periodic;
+      if (lower != upper)
+        b.failAt(sideName(lower ? 2 * a + 1 : 2 * a), "\"periodic\" like the opposite side (periodicity pairs sides)",
+                 "another type");
+    }
+    b.finish();
+  }
+  std::array<bool, d> periodic{};
+  for (int a = 0; a < d; ++a) periodic[a] = grid.periodic(a);
+  const solvers::MacLayout<d> layout(grid.cells, grid.dx, grid.origin, periodic);
+  if (static_cast<double>(layout.totalFaces()) > 2e8)
+    c.failAt("cells", "a grid of at most 2e8 faces", std::to_string(layout.totalFaces()) + " faces");
+  grid.u.assign(layout.totalFaces(), 0.0);
+  grid.p.assign(layout.cellCount(), 0.0);
+  grid.solid.assign(layout.cellCount(), 0);
+  if (c.has("initial_velocity")) {
+    const Config init = c.child("initial_velocity");
+    initialVelocity(init, grid, layout);
+    init.finish();
+  }
+  world.add(e, std::move(grid));
+}
+
+template <int d>
+void parseFluidMaterial(World<d>& world, Entity e, const Config& c) {
+  if (!world.template has<MacGrid<d>>(e)) c.fail("fluid_material on the entity that has the mac_grid", "no mac_grid");
+  FluidMaterial m;
+  m.density = c.number("density", Bound::Positive);
+  m.viscosity = c.number("viscosity", 0.0, Bound::NonNegative);
+  world.add(e, m);
+}
+
+}  // namespace
+
+template <int d>
+void registerFluidComponents(Registry& r) {
+  r.addComponentOf<d, MacGrid<d>>(
+      "fluid MAC grid: cells, domain_min/max, boundaries {x_min: wall|inflow|outflow|periodic, ...}, initial_velocity",
+      parseMacGrid<d>);
+  r.addComponentOf<d, FluidMaterial>("fluid density and dynamic viscosity (on the mac_grid entity)",
+                                     parseFluidMaterial<d>);
+}
+
+template void registerFluidComponents<2>(Registry&);
+template void registerFluidComponents<3>(Registry&);
+
+}  // namespace monolith
