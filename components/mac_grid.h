@@ -41,6 +41,7 @@ struct MacGrid {
 
   // --- state (checkpointed) ---
   std::vector<double> u;          // face velocities
+  std::vector<double> uPrevious;  // face velocities at the end of the previous step (steady-state test)
   std::vector<double> p;          // cell pressures (from the last projection)
   std::vector<std::uint8_t> solid;  // per cell: 1 = covered by an obstacle
 
@@ -59,6 +60,7 @@ struct MacGrid {
       visit("side_peak_velocity", s.peakVelocity);
     }
     visit("velocity", u);
+    visit("velocity_previous", uPrevious);
     visit("pressure", p);
     visit("solid", solid);
   }

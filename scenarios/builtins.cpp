@@ -11,6 +11,8 @@
 #include "systems/advance_positions.h"
 #include "systems/advance_velocity.h"
 #include "systems/rigid_diagnostics.h"
+#include "systems/fluid_advection.h"
+#include "systems/fluid_projection.h"
 #include "systems/rigid_forces.h"
 
 namespace monolith {
@@ -160,6 +162,11 @@ void registerDimension(Registry& r) {
                   [] { return single<AdvanceRigidPositions<d>>(); }, ""});
   r.addSystem<d>({"advance_rigid_velocity", "Step V (Sec. 4.7): v^{n+1} = v^{n+1/2} + dt/2 a(x^{n+1})",
                   [] { return single<RigidHalfKick<d>>(Stage::AdvanceVelocity); }, ""});
+  r.addSystem<d>({"advect_fluid", "fluid advection u* = u - dt (u.grad)u (semi-Lagrangian or ENO3/RK3)",
+                  [] { return single<FluidAdvection<d>>(); }, ""});
+  r.addSystem<d>({"fluid_gravity", "gravity on the fluid's free faces", [] { return single<FluidGravity<d>>(); }, ""});
+  r.addSystem<d>({"project_fluid", "coupled SPD pressure-viscosity solve (5.31) or Chorin splitting",
+                  [] { return single<FluidProjection<d>>(); }, ""});
   r.addSystem<d>({"rigid_diagnostics", "energies and momenta of the rigid bodies",
                   [] { return single<RigidDiagnostics<d>>(); }, ""});
 }

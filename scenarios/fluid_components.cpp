@@ -106,6 +106,7 @@ void parseMacGrid(World<d>& world, Entity e, const Config& c) {
     initialVelocity(init, grid, layout);
     init.finish();
   }
+  grid.uPrevious = grid.u;
   world.add(e, std::move(grid));
 }
 

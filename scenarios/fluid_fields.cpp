@@ -17,15 +17,17 @@ solvers::MacLayout<d> layoutOf(const MacGrid<d>& grid) {
 }
 
 // Multilinear interpolation of values stored on a regular lattice of `dims` points whose point
-// k sits at `lower + dx * k`; periodic axes wrap, others clamp.
+// k sits at `lower + dx * k`; periodic axes wrap, others clamp the lattice coordinate to
+// [minK[a], maxK[a]] (which may reach half a cell into ghost points the value functor supplies).
 template <int d, class Value>
 double interpolate(const Eigen::Matrix<int, d, 1>& dims, const Eigen::Matrix<double, d, 1>& lower, double dx,
-                   const std::array<bool, d>& periodic, const Eigen::Matrix<double, d, 1>& x, Value&& value) {
+                   const std::array<bool, d>& periodic, const Eigen::Matrix<double, d, 1>& x, Value&& value,
+                   const Eigen::Matrix<double, d, 1>& minK, const Eigen::Matrix<double, d, 1>& maxK) {
   Eigen::Matrix<int, d, 1> base;
   Eigen::Matrix<double, d, 1> w;
   for (int a = 0; a < d; ++a) {
     double s = (x[a] - lower[a]) / dx;
-    if (!periodic[a]) s = std::clamp(s, 0.0, double(dims[a] - 1));
+    if (!periodic[a]) s = std::clamp(s, minK[a], maxK[a]);
     const double fl = std::floor(s);
     base[a] = static_cast<int>(fl);
     w[a] = s - fl;
@@ -39,7 +41,7 @@ double interpolate(const Eigen::Matrix<int, d, 1>& dims, const Eigen::Matrix<dou
       k[a] = base[a] + bit;
       weight *= bit ? w[a] : 1 - w[a];
       if (periodic[a]) k[a] = ((k[a] % dims[a]) + dims[a]) % dims[a];
-      else k[a] = std::min(k[a], dims[a] - 1);
+      else if (weight == 0) k[a] = std::clamp(k[a], 0, dims[a] - 1);  // unused corner: stay in range
     }
     if (weight != 0) result += weight * value(k);
   }
@@ -97,15 +99,40 @@ CellFields cellFields(const MacGrid<d>& grid) {
   return out;
 }
 
+// Velocity component `axis` sampled up to the domain walls: across a non-periodic axis b != axis
+// the lattice of faces stops half a cell from the wall, so a ghost layer supplies the wall
+// condition there: mirrored about the wall velocity for a no-slip wall or an inflow (the wall
+// value is met at the wall), copied (zero shear) for slip walls and outflow.
 template <int d>
 Eigen::Matrix<double, d, 1> sampleVelocity(const MacGrid<d>& grid, const Eigen::Matrix<double, d, 1>& x) {
+  using Index = Eigen::Matrix<int, d, 1>;
+  using VecD = Eigen::Matrix<double, d, 1>;
   const auto layout = layoutOf(grid);
-  Eigen::Matrix<double, d, 1> v;
+  VecD v;
   for (int axis = 0; axis < d; ++axis) {
-    Eigen::Matrix<double, d, 1> lower = grid.origin + Eigen::Matrix<double, d, 1>::Constant(0.5 * grid.dx);
+    VecD lower = grid.origin + VecD::Constant(0.5 * grid.dx);
     lower[axis] = grid.origin[axis];
-    v[axis] = interpolate<d>(layout.faceDims(axis), lower, grid.dx, layout.periodic, x,
-                             [&](const Eigen::Matrix<int, d, 1>& f) { return grid.u[layout.faceIndex(axis, f)]; });
+    const Index dims = layout.faceDims(axis);
+    VecD minK = VecD::Zero(), maxK = (dims.array() - 1).template cast<double>().matrix();
+    for (int b = 0; b < d; ++b)
+      if (b != axis && !layout.periodic[b]) {
+        minK[b] = -0.5;
+        maxK[b] = dims[b] - 0.5;
+      }
+    auto value = [&](Index f) {
+      for (int b = 0; b < d; ++b) {
+        if (b == axis || layout.periodic[b] || (f[b] >= 0 && f[b] < dims[b])) continue;
+        const int side = 2 * b + (f[b] < 0 ? 0 : 1);
+        f[b] = f[b] < 0 ? 0 : dims[b] - 1;
+        const double inside = grid.u[layout.faceIndex(axis, f)];
+        const SideCondition<d>& c = grid.sides[side];
+        const bool dirichlet = (c.type == DomainSide::Wall && !c.slip) || c.type == DomainSide::Inflow;
+        const double wall = c.type == DomainSide::Inflow && c.parabolic ? 0.0 : c.velocity[axis];
+        return dirichlet ? 2 * wall - inside : inside;
+      }
+      return grid.u[layout.faceIndex(axis, f)];
+    };
+    v[axis] = interpolate<d>(dims, lower, grid.dx, layout.periodic, x, value, minK, maxK);
   }
   return v;
 }
@@ -115,7 +142,8 @@ double samplePressure(const MacGrid<d>& grid, const Eigen::Matrix<double, d, 1>&
   const auto layout = layoutOf(grid);
   const Eigen::Matrix<double, d, 1> lower = grid.origin + Eigen::Matrix<double, d, 1>::Constant(0.5 * grid.dx);
   return interpolate<d>(layout.cells, lower, grid.dx, layout.periodic, x,
-                        [&](const Eigen::Matrix<int, d, 1>& c) { return grid.p[layout.cellIndex(c)]; });
+                        [&](const Eigen::Matrix<int, d, 1>& c) { return grid.p[layout.cellIndex(c)]; },
+                        Eigen::Matrix<double, d, 1>::Zero(), (layout.cells.array() - 1).template cast<double>().matrix());
 }
 
 template CellFields cellFields<2>(const MacGrid<2>&);

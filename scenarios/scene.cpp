@@ -358,7 +358,7 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
       settings.rigidRotation.energyFix = rr.boolean("energy_fix", true);
       rr.finish();
     }
-    if (solvers.has("fluid")) parseFluidSolverSettings(solvers.child("fluid"), world.settings().fluid);
+    if (solvers.has("fluid")) parseFluidSolverSettings(solvers.child("fluid"), settings.fluid);
     solvers.finish();
   }
 

@@ -1,0 +1,242 @@
+#include "solvers/advection/eno.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace monolith::solvers {
+
+double eno3Derivative(const std::array<double, 7>& v, double dx, bool backward) {
+  // Newton divided differences (Osher & Fedkiw Sec. 3.3): d1[j] at j+1/2, d2[j] at node j,
+  // d3[j] at j+1/2; the point is node i = 3.
+  double d1[6], d2[6], d3[5];
+  for (int j = 0; j < 6; ++j) d1[j] = (v[j + 1] - v[j]) / dx;
+  for (int j = 1; j < 6; ++j) d2[j] = (d1[j] - d1[j - 1]) / (2 * dx);
+  for (int j = 1; j < 5; ++j) d3[j] = (d2[j + 1] - d2[j]) / (3 * dx);
+  const int i = 3;
+  const int k = backward ? i - 1 : i;  // leftmost node of the first-order (upwind) stencil
+  double derivative = d1[k];
+  // Extend the stencil to the side with the smaller divided difference (the smoother one).
+  const bool left2 = std::abs(d2[k]) <= std::abs(d2[k + 1]);
+  const int kstar = left2 ? k - 1 : k;
+  derivative += (left2 ? d2[k] : d2[k + 1]) * (2 * (i - k) - 1) * dx;
+  const double c3 = std::abs(d3[kstar]) <= std::abs(d3[kstar + 1]) ? d3[kstar] : d3[kstar + 1];
+  const int m = i - kstar;
+  derivative += c3 * (3 * m * m - 6 * m + 2) * dx * dx;
+  return derivative;
+}
+
+namespace {
+
+template <int d>
+using IndexT = typename MacLayout<d>::Index;
+template <int d>
+using VecT = typename MacLayout<d>::Vec;
+
+int wrap(int i, int n) { return ((i % n) + n) % n; }
+
+// Seven values along `axis` centred on `node` of a grid with `dims` nodes: periodic axes wrap,
+// others repeat the last stored node (zero-gradient ghosts, see eno.h).
+template <int d, class IndexFn, class ValueFn>
+std::array<double, 7> gather7(const IndexT<d>& node, int axis, const IndexT<d>& dims,
+                              const std::array<bool, d>& periodic, IndexFn index, ValueFn value) {
+  std::array<double, 7> v;
+  IndexT<d> n = node;
+  for (int k = 0; k < 7; ++k) {
+    const int j = node[axis] + k - 3;
+    n[axis] = periodic[axis] ? wrap(j, dims[axis]) : std::min(std::max(j, 0), dims[axis] - 1);
+    v[k] = value(index(n));
+  }
+  return v;
+}
+
+// Component `comp` at a point whose coordinate in comp's face grid is base_e + 1/2 on the axes
+// with half[e] and base_e on the others, by the tensor-product 4th-order midpoint rule
+// (-1, 9, 9, -1)/16. Returns false (caller falls back to the sampler) if the stencil leaves a
+// non-periodic domain or touches a prescribed face (walls, structures: data not smooth there).
+template <int d>
+bool cubicMidpoint(const FaceVelocitySampler<d>& sampler, int comp, const IndexT<d>& base,
+                   const std::array<bool, d>& half, double& out) {
+  static constexpr double kWeights[4] = {-1.0 / 16, 9.0 / 16, 9.0 / 16, -1.0 / 16};
+  const MacLayout<d>& layout = sampler.layout();
+  const IndexT<d> dims = layout.faceDims(comp);
+  int nodes[d][4];
+  int count[d];
+  int total = 1;
+  for (int e = 0; e < d; ++e) {
+    count[e] = half[e] ? 4 : 1;
+    total *= count[e];
+    for (int k = 0; k < count[e]; ++k) {
+      int j = half[e] ? base[e] - 1 + k : base[e];
+      if (layout.periodic[e]) j = wrap(j, dims[e]);
+      else if (j < 0 || j >= dims[e]) return false;
+      nodes[e][k] = j;
+    }
+  }
+  double sum = 0;
+  for (int combo = 0; combo < total; ++combo) {
+    IndexT<d> n;
+    double w = 1;
+    for (int e = 0, rest = combo; e < d; ++e) {
+      const int k = rest % count[e];
+      rest /= count[e];
+      n[e] = nodes[e][k];
+      if (half[e]) w *= kWeights[k];
+    }
+    const int face = layout.faceIndex(comp, n);
+    if (sampler.isPrescribed(face)) return false;
+    sum += w * sampler.faceValue(face);
+  }
+  out = sum;
+  return true;
+}
+
+// Upwinding velocity at face f of `axis` (global index g).
+template <int d>
+VecT<d> faceUpwindVelocity(const FaceVelocitySampler<d>& sampler, int axis, const IndexT<d>& f, int g) {
+  VecT<d> w;
+  for (int b = 0; b < d; ++b) {
+    if (b == axis) {
+      w[b] = sampler.faceValue(g);
+      continue;
+    }
+    IndexT<d> base = f;
+    base[axis] -= 1;  // the face lies midway between cell centres f-1 and f along `axis`
+    std::array<bool, d> half{};
+    half[axis] = half[b] = true;
+    if (!cubicMidpoint<d>(sampler, b, base, half, w[b])) w[b] = sampler.component(b, sampler.layout().faceCenter(axis, f));
+  }
+  return w;
+}
+
+template <int d>
+VecT<d> cellUpwindVelocity(const FaceVelocitySampler<d>& sampler, const IndexT<d>& c) {
+  VecT<d> w;
+  for (int b = 0; b < d; ++b) {
+    std::array<bool, d> half{};
+    half[b] = true;
+    if (!cubicMidpoint<d>(sampler, b, c, half, w[b])) w[b] = sampler.component(b, sampler.layout().cellCenter(c));
+  }
+  return w;
+}
+
+void checkDt(double dt) {
+  if (!(dt >= 0) || !std::isfinite(dt)) throw std::invalid_argument("ENO advection: dt must be finite and >= 0");
+}
+
+template <class Fn>
+void forEach(int n, Fn fn) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, n), [&](const tbb::blocked_range<int>& r) {
+    for (int i = r.begin(); i != r.end(); ++i) fn(i);
+  });
+}
+
+// Shu-Osher TVD RK3 for y_t = -C(y); `fix` re-imposes boundary values after every stage.
+template <class Conv, class Fix>
+Eigen::VectorXd tvdRk3(Eigen::VectorXd y0, double dt, Conv conv, Fix fix) {
+  fix(y0);
+  Eigen::VectorXd y1 = y0 - dt * conv(y0);
+  fix(y1);
+  Eigen::VectorXd y2 = 0.75 * y0 + 0.25 * (y1 - dt * conv(y1));
+  fix(y2);
+  Eigen::VectorXd y3 = (1.0 / 3.0) * y0 + (2.0 / 3.0) * (y2 - dt * conv(y2));
+  fix(y3);
+  return y3;
+}
+
+}  // namespace
+
+template <int d>
+Eigen::VectorXd enoConvectiveTerm(const MacLayout<d>& layout, const Eigen::VectorXd& u, const FaceBoundary& boundary) {
+  const FaceVelocitySampler<d> sampler(layout, u, boundary);
+  Eigen::VectorXd out(u.size());
+  forEach(static_cast<int>(u.size()), [&](int g) {
+    if (sampler.isPrescribed(g)) {
+      out[g] = 0;
+      return;
+    }
+    const auto [axis, f] = layout.faceCoord(g);
+    const VecT<d> w = faceUpwindVelocity(sampler, axis, f, g);
+    const IndexT<d> dims = layout.faceDims(axis);
+    double term = 0;
+    for (int b = 0; b < d; ++b) {
+      if (w[b] == 0) continue;
+      const auto v = gather7<d>(f, b, dims, layout.periodic, [&](const IndexT<d>& n) { return layout.faceIndex(axis, n); },
+                                [&](int face) { return sampler.faceValue(face); });
+      term += w[b] * eno3Derivative(v, layout.dx, w[b] > 0);
+    }
+    out[g] = term;
+  });
+  return out;
+}
+
+template <int d>
+Eigen::VectorXd advectFacesEnoRk3(const MacLayout<d>& layout, const Eigen::VectorXd& u, double dt,
+                                  const FaceBoundary& boundary) {
+  checkDt(dt);
+  validateBoundary(layout, boundary);
+  if (u.size() != layout.totalFaces()) throw std::invalid_argument("advectFacesEnoRk3: field needs one value per face");
+  const bool anyPrescribed = !boundary.prescribedFace.empty();
+  auto fix = [&](Eigen::VectorXd& y) {
+    if (!anyPrescribed) return;
+    for (Eigen::Index g = 0; g < y.size(); ++g)
+      if (boundary.prescribedFace[g]) y[g] = boundary.prescribedVelocity[g];
+  };
+  return tvdRk3(u, dt, [&](const Eigen::VectorXd& y) { return enoConvectiveTerm(layout, y, boundary); }, fix);
+}
+
+template <int d>
+Eigen::VectorXd enoScalarConvectiveTerm(const MacLayout<d>& layout, const Eigen::VectorXd& phi, const Eigen::VectorXd& u,
+                                        const FaceBoundary& boundary) {
+  if (phi.size() != layout.cellCount()) throw std::invalid_argument("enoScalarConvectiveTerm: phi needs one value per cell");
+  const FaceVelocitySampler<d> sampler(layout, u, boundary);
+  Eigen::VectorXd out(phi.size());
+  forEach(static_cast<int>(phi.size()), [&](int cell) {
+    if (sampler.hasSolids() && boundary.solidCell[cell]) {
+      out[cell] = 0;
+      return;
+    }
+    const IndexT<d> c = layout.cellCoord(cell);
+    const VecT<d> w = cellUpwindVelocity(sampler, c);
+    double term = 0;
+    for (int b = 0; b < d; ++b) {
+      if (w[b] == 0) continue;
+      const auto v = gather7<d>(c, b, layout.cells, layout.periodic, [&](const IndexT<d>& n) { return layout.cellIndex(n); },
+                                [&](int i) { return phi[i]; });
+      term += w[b] * eno3Derivative(v, layout.dx, w[b] > 0);
+    }
+    out[cell] = term;
+  });
+  return out;
+}
+
+template <int d>
+Eigen::VectorXd advectScalarEnoRk3(const MacLayout<d>& layout, const Eigen::VectorXd& phi, const Eigen::VectorXd& u,
+                                   double dt, const FaceBoundary& boundary) {
+  checkDt(dt);
+  if (phi.size() != layout.cellCount()) throw std::invalid_argument("advectScalarEnoRk3: phi needs one value per cell");
+  validateBoundary(layout, boundary);
+  // Solid cells are not evolved (their convective term is 0); restore them bitwise after each
+  // stage so the RK averaging cannot perturb them by rounding.
+  auto fix = [&](Eigen::VectorXd& y) {
+    for (std::size_t c = 0; c < boundary.solidCell.size(); ++c)
+      if (boundary.solidCell[c]) y[static_cast<Eigen::Index>(c)] = phi[static_cast<Eigen::Index>(c)];
+  };
+  return tvdRk3(phi, dt, [&](const Eigen::VectorXd& y) { return enoScalarConvectiveTerm(layout, y, u, boundary); }, fix);
+}
+
+#define MONOLITH_ENO_INSTANTIATE(D)                                                                                   \
+  template Eigen::VectorXd enoConvectiveTerm<D>(const MacLayout<D>&, const Eigen::VectorXd&, const FaceBoundary&);    \
+  template Eigen::VectorXd advectFacesEnoRk3<D>(const MacLayout<D>&, const Eigen::VectorXd&, double,                  \
+                                                const FaceBoundary&);                                                 \
+  template Eigen::VectorXd enoScalarConvectiveTerm<D>(const MacLayout<D>&, const Eigen::VectorXd&,                    \
+                                                      const Eigen::VectorXd&, const FaceBoundary&);                   \
+  template Eigen::VectorXd advectScalarEnoRk3<D>(const MacLayout<D>&, const Eigen::VectorXd&, const Eigen::VectorXd&, \
+                                                 double, const FaceBoundary&);
+MONOLITH_ENO_INSTANTIATE(2)
+MONOLITH_ENO_INSTANTIATE(3)
+#undef MONOLITH_ENO_INSTANTIATE
+
+}  // namespace monolith::solvers

@@ -1,0 +1,225 @@
+#include "solvers/advection/velocity_sampling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace monolith::solvers {
+namespace {
+
+int wrapIndex(long long i, int n) { return static_cast<int>(((i % n) + n) % n); }
+
+// The (up to two) cells sharing face f of `axis`: f - e_axis and f. On a periodic axis they wrap;
+// on a non-periodic axis a boundary face has only one. Returns the count written to `out`.
+template <int d>
+int faceNeighbourCells(const MacLayout<d>& layout, int axis, typename MacLayout<d>::Index f, int out[2]) {
+  const int n = layout.cells[axis];
+  int count = 0;
+  for (int side = 0; side < 2; ++side) {
+    typename MacLayout<d>::Index c = f;
+    c[axis] = f[axis] - 1 + side;
+    if (layout.periodic[axis]) {
+      c[axis] = wrapIndex(c[axis], n);
+    } else if (c[axis] < 0 || c[axis] >= n) {
+      continue;
+    }
+    out[count++] = layout.cellIndex(c);
+  }
+  return count;
+}
+
+template <int d>
+bool anyNeighbourSolid(const MacLayout<d>& layout, const std::vector<std::uint8_t>& solid, int axis,
+                       const typename MacLayout<d>::Index& f) {
+  int cells[2];
+  const int count = faceNeighbourCells(layout, axis, f, cells);
+  for (int k = 0; k < count; ++k)
+    if (solid[cells[k]]) return true;
+  return false;
+}
+
+}  // namespace
+
+template <int d>
+void validateBoundary(const MacLayout<d>& layout, const FaceBoundary& boundary) {
+  const int faces = layout.totalFaces();
+  if (!boundary.solidCell.empty() && static_cast<int>(boundary.solidCell.size()) != layout.cellCount())
+    throw std::invalid_argument("FaceBoundary: solidCell needs one flag per cell");
+  const bool anyPrescribed = !boundary.prescribedFace.empty();
+  if (anyPrescribed) {
+    if (static_cast<int>(boundary.prescribedFace.size()) != faces ||
+        boundary.prescribedVelocity.size() != faces)
+      throw std::invalid_argument("FaceBoundary: prescribedFace/prescribedVelocity need one entry per face");
+    for (int g = 0; g < faces; ++g)
+      if (boundary.prescribedFace[g] && !std::isfinite(boundary.prescribedVelocity[g]))
+        throw std::invalid_argument("FaceBoundary: non-finite prescribed velocity at face " + std::to_string(g));
+  }
+  if (boundary.solidCell.empty()) return;
+  // The sampler and ENO never read the field on faces touching a structure, so those faces need
+  // a prescribed (structure) velocity: thesis Sec. 5.4.1 places the constraints exactly there.
+  for (int g = 0; g < faces; ++g) {
+    const auto [axis, f] = layout.faceCoord(g);
+    if (anyNeighbourSolid(layout, boundary.solidCell, axis, f) && !(anyPrescribed && boundary.prescribedFace[g]))
+      throw std::invalid_argument("FaceBoundary: face " + std::to_string(g) +
+                                  " touches a solid cell but has no prescribed velocity");
+  }
+}
+
+template <int d>
+FaceBoundary staticObstacleBoundary(const MacLayout<d>& layout, std::vector<std::uint8_t> solidCell) {
+  if (!solidCell.empty() && static_cast<int>(solidCell.size()) != layout.cellCount())
+    throw std::invalid_argument("staticObstacleBoundary: solidCell needs one flag per cell");
+  FaceBoundary boundary;
+  const int faces = layout.totalFaces();
+  boundary.prescribedFace.assign(faces, 0);
+  boundary.prescribedVelocity = Eigen::VectorXd::Zero(faces);
+  for (int g = 0; g < faces; ++g) {
+    const auto [axis, f] = layout.faceCoord(g);
+    const bool wall = !layout.periodic[axis] && (f[axis] == 0 || f[axis] == layout.cells[axis]);
+    const bool touchesSolid = !solidCell.empty() && anyNeighbourSolid(layout, solidCell, axis, f);
+    boundary.prescribedFace[g] = (wall || touchesSolid) ? 1 : 0;
+  }
+  boundary.solidCell = std::move(solidCell);
+  return boundary;
+}
+
+template <int d>
+FaceVelocitySampler<d>::FaceVelocitySampler(const MacLayout<d>& layout, const Eigen::VectorXd& u,
+                                            const FaceBoundary& boundary)
+    : layout_(layout), u_(&u), boundary_(&boundary) {
+  if (u.size() != layout.totalFaces())
+    throw std::invalid_argument("FaceVelocitySampler: field needs one value per face");
+  validateBoundary(layout, boundary);
+}
+
+template <int d>
+FaceVelocitySampler<d>::FaceVelocitySampler(const MacLayout<d>& layout, const Eigen::VectorXd& u)
+    : FaceVelocitySampler(layout, u, [] () -> const FaceBoundary& {
+        static const FaceBoundary none;
+        return none;
+      }()) {}
+
+template <int d>
+bool FaceVelocitySampler<d>::faceInsideSolid(int axis, const Index& f) const {
+  if (!hasSolids()) return false;
+  int cells[2];
+  const int count = faceNeighbourCells(layout_, axis, f, cells);
+  for (int k = 0; k < count; ++k)
+    if (!boundary_->solidCell[cells[k]]) return false;
+  return count > 0;
+}
+
+template <int d>
+typename FaceVelocitySampler<d>::Index FaceVelocitySampler<d>::cellOf(const Vec& x) const {
+  Index c;
+  for (int a = 0; a < d; ++a) {
+    const double s = std::floor((x[a] - layout_.origin[a]) / layout_.dx);
+    if (!std::isfinite(s)) throw std::domain_error("FaceVelocitySampler: non-finite sample position");
+    const int n = layout_.cells[a];
+    if (layout_.periodic[a]) {
+      c[a] = wrapIndex(static_cast<long long>(s), n);
+    } else {
+      c[a] = static_cast<int>(std::clamp(s, 0.0, static_cast<double>(n - 1)));
+    }
+  }
+  return c;
+}
+
+template <int d>
+bool FaceVelocitySampler<d>::pointInSolid(const Vec& x) const {
+  return hasSolids() && boundary_->solidCell[layout_.cellIndex(cellOf(x))] != 0;
+}
+
+template <int d>
+double FaceVelocitySampler<d>::component(int axis, const Vec& x) const {
+  Index lo, hi;
+  double t[d];
+  for (int b = 0; b < d; ++b) {
+    // Face-grid coordinate: faces of `axis` sit at integer positions along `axis` and at cell
+    // centres (half-integers) along the other axes.
+    const double s = (x[b] - layout_.origin[b]) / layout_.dx - (b == axis ? 0.0 : 0.5);
+    if (!std::isfinite(s)) throw std::domain_error("FaceVelocitySampler: non-finite sample position");
+    if (layout_.periodic[b]) {
+      const double fl = std::floor(s);
+      const int n = layout_.cells[b];
+      t[b] = s - fl;
+      lo[b] = wrapIndex(static_cast<long long>(fl), n);
+      hi[b] = lo[b] + 1 == n ? 0 : lo[b] + 1;
+    } else {
+      const int nodes = layout_.cells[b] + (b == axis ? 1 : 0);
+      if (nodes == 1) {
+        lo[b] = hi[b] = 0;
+        t[b] = 0;
+        continue;
+      }
+      const double clamped = std::clamp(s, 0.0, static_cast<double>(nodes - 1));  // rule 2
+      lo[b] = std::min(static_cast<int>(clamped), nodes - 2);
+      hi[b] = lo[b] + 1;
+      t[b] = clamped - lo[b];
+    }
+  }
+  double sum = 0, weightSum = 0, solidSum = 0;
+  bool dropped = false;
+  for (int corner = 0; corner < (1 << d); ++corner) {
+    Index f;
+    double w = 1;
+    for (int b = 0; b < d; ++b) {
+      const bool upper = (corner >> b) & 1;
+      f[b] = upper ? hi[b] : lo[b];
+      w *= upper ? t[b] : 1 - t[b];
+    }
+    if (w == 0) continue;  // also keeps exact face-centre samples free of neighbour values
+    const double value = faceValue(layout_.faceIndex(axis, f));
+    if (faceInsideSolid(axis, f)) {  // rule 4
+      dropped = true;
+      solidSum += w * value;
+      continue;
+    }
+    sum += w * value;
+    weightSum += w;
+  }
+  if (!dropped) return sum;
+  return weightSum > 0 ? sum / weightSum : solidSum;
+}
+
+template <int d>
+typename FaceVelocitySampler<d>::Vec FaceVelocitySampler<d>::velocity(const Vec& x) const {
+  Vec v;
+  for (int a = 0; a < d; ++a) v[a] = component(a, x);
+  return v;
+}
+
+template <int d>
+typename FaceVelocitySampler<d>::Vec FaceVelocitySampler<d>::clipToFluid(const Vec& from, const Vec& to) const {
+  if (!hasSolids()) return to;
+  if (pointInSolid(from)) return from;
+  const double length = (to - from).norm();
+  if (!std::isfinite(length)) throw std::domain_error("FaceVelocitySampler: non-finite trace");
+  // Quarter-cell steps: a cell can then only be missed by cutting one of its corners.
+  const double steps = std::min(std::ceil(length / (0.25 * layout_.dx)), 1048576.0);
+  const int n = std::max(1, static_cast<int>(steps));
+  Vec previous = from;
+  for (int k = 1; k <= n; ++k) {
+    const Vec p = k == n ? to : Vec(from + (static_cast<double>(k) / n) * (to - from));
+    if (pointInSolid(p)) {
+      Vec fluid = previous, solid = p;
+      for (int it = 0; it < 40; ++it) {  // interval shrinks to 2^-40 of a quarter cell
+        const Vec mid = 0.5 * (fluid + solid);
+        (pointInSolid(mid) ? solid : fluid) = mid;
+      }
+      return fluid;
+    }
+    previous = p;
+  }
+  return to;
+}
+
+template void validateBoundary<2>(const MacLayout<2>&, const FaceBoundary&);
+template void validateBoundary<3>(const MacLayout<3>&, const FaceBoundary&);
+template FaceBoundary staticObstacleBoundary<2>(const MacLayout<2>&, std::vector<std::uint8_t>);
+template FaceBoundary staticObstacleBoundary<3>(const MacLayout<3>&, std::vector<std::uint8_t>);
+template class FaceVelocitySampler<2>;
+template class FaceVelocitySampler<3>;
+
+}  // namespace monolith::solvers

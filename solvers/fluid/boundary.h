@@ -1,0 +1,102 @@
+#pragma once
+// Which fluid degrees of freedom exist on a MAC grid and what is known at the others (thesis
+// Sec. 5.2, 5.4.2, 5.7): per cell fluid / solid / Dirichlet, per face a free velocity unknown, a
+// prescribed normal velocity, or inactive, and per domain side the condition used by the pressure
+// (normal) and viscous (tangential) operators. Knows nothing of entities.
+//
+// Sides are numbered side = 2 * axis + (0 lower, 1 upper).
+#include "solvers/mac_layout.h"
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace monolith::solvers {
+
+enum class CellKind : uint8_t {
+  Fluid,      // a pressure unknown
+  Solid,      // inside an obstacle: its faces carry the obstacle velocity
+  Dirichlet,  // p = 0 (e.g. air); faces between it and fluid are free
+};
+
+enum class FaceKind : uint8_t {
+  Free,        // velocity unknown
+  Prescribed,  // normal velocity known (domain wall, inflow, obstacle): moved to the RHS
+  Inactive,    // touches no fluid cell and no solid: not used by any operator
+};
+
+template <int d>
+using VelocityField = std::function<Eigen::Matrix<double, d, 1>(const Eigen::Matrix<double, d, 1>&)>;
+
+// Condition at one side of the box.
+//  * Wall: normal velocity = velocity(x)·n on the boundary faces (0 for a wall at rest; a lid moves
+//    tangentially so its normal velocity is 0). Tangentially, noSlip: the viscous operator sees the
+//    wall velocity at the wall (mirrored ghost, see operators.h); slip: zero shear (row dropped).
+//  * Inflow: boundary faces prescribed with velocity(x)·n; tangential: Dirichlet velocity(x).
+//  * Outflow: ghost cells outside have p = 0, so the boundary faces are free; zero shear.
+//  * Periodic: both sides of the axis, and the layout's axis must be periodic.
+template <int d>
+struct SideSpec {
+  using Vec = Eigen::Matrix<double, d, 1>;
+  enum class Kind : uint8_t { Wall, Inflow, Outflow, Periodic };
+
+  Kind kind = Kind::Wall;
+  bool noSlip = true;
+  VelocityField<d> velocity;  // empty means zero
+
+  static SideSpec wall(bool noSlip = true, const Vec& wallVelocity = Vec::Zero());
+  static SideSpec movingWall(bool noSlip, VelocityField<d> wallVelocity);
+  static SideSpec inflow(VelocityField<d> inflowVelocity);
+  static SideSpec inflow(const Vec& inflowVelocity);
+  static SideSpec outflow();
+  static SideSpec periodic();
+
+  Vec velocityAt(const Vec& x) const { return velocity ? velocity(x) : Vec::Zero(); }
+  // Tangential velocity is Dirichlet for the viscous operator (else the row is dropped).
+  bool tangentialDirichlet() const { return kind == Kind::Inflow || (kind == Kind::Wall && noSlip); }
+  // Boundary faces of this side are prescribed (else free, or periodic interior faces).
+  bool normalPrescribed() const { return kind == Kind::Wall || kind == Kind::Inflow; }
+};
+
+template <int d>
+using BoxSpec = std::array<SideSpec<d>, 2 * d>;
+
+template <int d>
+struct FluidDomain {
+  using Vec = Eigen::Matrix<double, d, 1>;
+  using Index = typename MacLayout<d>::Index;
+
+  MacLayout<d> layout;
+  std::vector<CellKind> cells;        // layout.cellCount()
+  std::vector<FaceKind> faces;        // layout.totalFaces()
+  std::vector<double> faceVelocity;   // prescribed normal velocity of Prescribed faces, else 0
+  BoxSpec<d> sides;
+
+  // Classification of a face from its two cells and the sides (outside a Wall/Inflow side counts
+  // as solid, outside an Outflow side as Dirichlet): solid on either side -> Prescribed, else a
+  // fluid cell on either side -> Free, else Inactive.
+  FaceKind classifyFace(int face) const;
+  // Cell on the lower (side 0) or upper (side 1) side of a face; returns false if it lies outside
+  // the box on a non-periodic axis (then `cell` is unchanged).
+  bool faceCell(int face, int which, int& cell) const;
+};
+
+// A box with the given side conditions: all cells fluid, faces classified, boundary faces of
+// Wall/Inflow sides prescribed with the side velocity's normal component at the face centre.
+// Throws std::invalid_argument if a side is Periodic but the layout axis is not (or vice versa).
+template <int d>
+FluidDomain<d> boxDomain(const MacLayout<d>& layout, const BoxSpec<d>& sides);
+
+// Marks cells with solidMask[c] != 0 as Solid (an obstacle) and prescribes every face touching
+// them with the obstacle velocity's normal component at the face centre (thesis Sec. 5.4.2: the
+// faces covered by a structure are not fluid unknowns; here the structure is kinematic).
+template <int d>
+void markSolid(FluidDomain<d>& domain, const std::vector<uint8_t>& solidMask,
+               const VelocityField<d>& obstacleVelocity = {});
+
+// Marks cells with mask[c] != 0 as Dirichlet (p = 0) and reclassifies the faces around them.
+template <int d>
+void markDirichlet(FluidDomain<d>& domain, const std::vector<uint8_t>& mask);
+
+}  // namespace monolith::solvers

@@ -1,0 +1,77 @@
+#include "systems/fluid_advection.h"
+
+#include <limits>
+
+#include "solvers/advection/cfl.h"
+#include "solvers/advection/eno.h"
+#include "solvers/advection/semi_lagrangian.h"
+#include "systems/fluid_domain.h"
+
+namespace monolith {
+
+namespace {
+// Prescribed faces (walls, inflow, obstacles) and solid cells as the advection schemes see them.
+template <int d>
+solvers::FaceBoundary faceBoundaryOf(const solvers::FluidDomain<d>& domain) {
+  solvers::FaceBoundary b;
+  const int faces = domain.layout.totalFaces();
+  b.prescribedFace.assign(faces, 0);
+  b.prescribedVelocity = Eigen::VectorXd::Zero(faces);
+  bool anySolid = false;
+  for (int f = 0; f < faces; ++f)
+    if (domain.faces[f] == solvers::FaceKind::Prescribed) {
+      b.prescribedFace[f] = 1;
+      b.prescribedVelocity[f] = domain.faceVelocity[f];
+    }
+  std::vector<std::uint8_t> solid(domain.cells.size(), 0);
+  for (std::size_t c = 0; c < solid.size(); ++c) {
+    solid[c] = domain.cells[c] == solvers::CellKind::Solid;
+    anySolid = anySolid || solid[c];
+  }
+  if (anySolid) b.solidCell = std::move(solid);
+  return b;
+}
+}  // namespace
+
+template <int d>
+void FluidAdvection<d>::run(World<d>& world, StepContext& ctx) {
+  auto& pool = world.template pool<MacGrid<d>>();
+  for (auto& grid : pool.components()) {
+    const auto domain = fluidDomainOf(grid);
+    const solvers::FaceBoundary boundary = faceBoundaryOf(domain);
+    const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(grid.u.data(), grid.u.size());
+    const Eigen::VectorXd advected =
+        world.settings().fluid.advection == FluidSolverSettings::Advection::Eno3
+            ? solvers::advectFacesEnoRk3(domain.layout, u, ctx.dt, boundary)
+            : solvers::advectFacesSemiLagrangian(domain.layout, u, ctx.dt, boundary);
+    Eigen::Map<Eigen::VectorXd>(grid.u.data(), grid.u.size()) = advected;
+  }
+}
+
+template <int d>
+double FluidAdvection<d>::unitCflDt(const World<d>& world) const {
+  double dt = std::numeric_limits<double>::infinity();
+  if (const auto* pool = world.template findPool<MacGrid<d>>())
+    for (const auto& grid : pool->components()) {
+      const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(grid.u.data(), grid.u.size());
+      dt = std::min(dt, solvers::cflTimeStep(macLayoutOf(grid), u, 1.0, std::numeric_limits<double>::infinity()));
+    }
+  return dt;
+}
+
+template <int d>
+void FluidGravity<d>::run(World<d>& world, StepContext& ctx) {
+  const Vec<d> g = world.settings().gravity;
+  for (auto& grid : world.template pool<MacGrid<d>>().components()) {
+    const auto domain = fluidDomainOf(grid);
+    for (int f = 0; f < domain.layout.totalFaces(); ++f)
+      if (domain.faces[f] == solvers::FaceKind::Free) grid.u[f] += ctx.dt * g[domain.layout.faceCoord(f).first];
+  }
+}
+
+template class FluidAdvection<2>;
+template class FluidAdvection<3>;
+template class FluidGravity<2>;
+template class FluidGravity<3>;
+
+}  // namespace monolith

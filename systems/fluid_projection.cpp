@@ -1,0 +1,112 @@
+#include "systems/fluid_projection.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "solvers/fluid/projection.h"
+#include "systems/fluid_domain.h"
+
+namespace monolith {
+
+template <int d>
+struct FluidProjection<d>::Cache {
+  std::vector<std::uint8_t> solid;  // geometry the operators were built for
+  double dt = -1, density = 0, viscosity = -1;
+  solvers::PoissonPreconditionerKind kind = solvers::PoissonPreconditionerKind::None;
+  std::unique_ptr<solvers::FluidOperators<d>> ops;
+  std::unique_ptr<solvers::PoissonPreconditioner<d>> preconditioner;
+};
+
+template <int d>
+FluidProjection<d>::FluidProjection() : cache_(std::make_unique<Cache>()) {}
+template <int d>
+FluidProjection<d>::~FluidProjection() = default;
+
+namespace {
+solvers::PoissonPreconditionerKind preconditionerKind(FluidSolverSettings::Preconditioner p) {
+  using P = FluidSolverSettings::Preconditioner;
+  using K = solvers::PoissonPreconditionerKind;
+  switch (p) {
+    case P::None: return K::None;
+    case P::Jacobi: return K::Jacobi;
+    case P::IC0: return K::IC0;
+    case P::MIC0: return K::MIC0;
+    case P::Multigrid: return K::Multigrid;
+  }
+  return K::MIC0;
+}
+}  // namespace
+
+template <int d>
+void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
+  auto& pool = world.template pool<MacGrid<d>>();
+  const FluidSolverSettings& settings = world.settings().fluid;
+  for (std::size_t g = 0; g < pool.size(); ++g) {
+    MacGrid<d>& grid = pool.components()[g];
+    const FluidMaterial* material = world.template get<FluidMaterial>(pool.entities()[g]);
+    const double rho = material ? material->density : 1.0, mu = material ? material->viscosity : 0.0;
+
+    // Rebuild the operators only when what they depend on changed (CFL steps change dt).
+    Cache& c = *cache_;
+    const auto kind = preconditionerKind(settings.preconditioner);
+    if (!c.ops || c.dt != ctx.dt || c.density != rho || c.viscosity != mu || c.solid != grid.solid || c.kind != kind) {
+      c.ops = std::make_unique<solvers::FluidOperators<d>>(
+          solvers::buildFluidOperators(fluidDomainOf(grid), solvers::FluidParameters{rho, mu, ctx.dt}));
+      c.preconditioner = std::make_unique<solvers::PoissonPreconditioner<d>>(*c.ops, kind);
+      c.dt = ctx.dt;
+      c.density = rho;
+      c.viscosity = mu;
+      c.solid = grid.solid;
+      c.kind = kind;
+    }
+    solvers::ProjectionSettings ps;
+    ps.preconditioner = kind;
+    ps.solve.maxIterations = settings.maxIterations;
+    ps.solve.relativeTolerance = settings.tolerance;
+    ps.viscosity.maxIterations = settings.maxIterations;
+    ps.viscosity.relativeTolerance = settings.tolerance;
+
+    Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(grid.u.data(), grid.u.size());
+    const solvers::ProjectionReport report =
+        settings.projection == FluidSolverSettings::Projection::Chorin
+            ? solvers::chorinProjection(*c.ops, u, ps, c.preconditioner.get())
+            : solvers::coupledProjection(*c.ops, u, ps, c.preconditioner.get());
+    Eigen::Map<Eigen::VectorXd>(grid.u.data(), grid.u.size()) = u;
+    for (std::size_t i = 0; i < grid.p.size(); ++i) grid.p[i] = report.pressure[static_cast<Eigen::Index>(i)];
+
+    // Diagnostics of t^{n+1}.
+    const auto& layout = c.ops->domain.layout;
+    const Eigen::VectorXd divergence = solvers::volumeDivergence(layout, u);
+    double maxDivergence = 0;
+    for (int p = 0; p < c.ops->pressureCount(); ++p)
+      maxDivergence = std::max(maxDivergence, std::abs(divergence[c.ops->dofs.pressureToCell[p]]));
+    double kinetic = 0, change = 0;
+    Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
+    const double faceMass = rho * layout.cellVolume();  // a face carries the mass of one cell
+    for (int f = 0; f < layout.totalFaces(); ++f) {
+      if (c.ops->domain.faces[f] == solvers::FaceKind::Inactive) continue;
+      kinetic += 0.5 * faceMass * u[f] * u[f];
+      momentum[layout.faceCoord(f).first] += faceMass * u[f];
+      change = std::max(change, std::abs(u[f] - grid.uPrevious[f]));
+    }
+    grid.uPrevious = grid.u;
+    auto& out = ctx.diagnostics;
+    out.add("kinetic_energy", kinetic);
+    out.add("total_energy", kinetic);
+    out.add("linear_momentum_x", momentum.x());
+    out.add("linear_momentum_y", momentum.y());
+    out.add("linear_momentum_z", momentum.z());
+    out.set("fluid_kinetic_energy", kinetic);
+    out.set("fluid_solver_iterations", report.solve.iterations);
+    out.set("fluid_solver_relative_residual", report.solve.relativeResidual());
+    out.set("fluid_viscosity_iterations", report.viscosity.iterations);
+    out.set("fluid_divergence_max", maxDivergence / layout.cellVolume());  // per unit volume: 1/s
+    out.set("fluid_velocity_change", change / ctx.dt);                     // max |du|/dt
+    out.set("fluid_cfl", (u.cwiseAbs().maxCoeff()) * ctx.dt / layout.dx);
+  }
+}
+
+template class FluidProjection<2>;
+template class FluidProjection<3>;
+
+}  // namespace monolith

@@ -1,0 +1,63 @@
+// Lid-driven cavity to steady state (Ghia, Ghia & Shin 1982): wall time against the error of
+// the centre-line profiles. Runs scenarios/scenes/cavity_re100.json (and cavity_re1000.json with
+// the argument "1000") through the real pipeline; steady state = max|du|/dt < 1e-6 (the scene's
+// stop criterion).
+//
+// usage: bench_cavity [100|1000] [cells] [threads]
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "components/mac_grid.h"
+#include "scenarios/fluid_fields.h"
+#include "scenarios/simulation.h"
+#include "support/ghia.h"
+
+using namespace monolith;
+
+int main(int argc, char** argv) {
+  const int re = argc > 1 ? std::atoi(argv[1]) : 100;
+  const std::string file = std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/cavity_re" + std::to_string(re) + ".json";
+  std::vector<Override> overrides;
+  if (argc > 2) {
+    const int n = std::atoi(argv[2]);
+    char dt[32];
+    std::snprintf(dt, sizeof dt, "%.17g", 1.0 / n);  // CFL about 1, as in the scenes
+    overrides = {{"entities.fluid.mac_grid.cells", "[" + std::to_string(n) + "," + std::to_string(n) + "]"}, {"time.dt", dt}};
+  }
+  const int threads = argc > 3 ? std::atoi(argv[3]) : 2;
+  Registry registry;
+  registerBuiltins(registry);
+  const SceneSpec scene = loadScene(file, overrides);
+  Simulation<2> sim(scene, registry, threads);
+  const auto t0 = std::chrono::steady_clock::now();
+  double iterations = 0;
+  bool steady = false;
+  while (!sim.finished()) {
+    const auto& diag = sim.step();
+    iterations += diag.at("fluid_solver_iterations");
+    if (diag.at(scene.stopDiagnostic) < scene.stopBelow) {
+      steady = true;
+      break;
+    }
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const MacGrid<2>& grid = sim.world().pool<MacGrid<2>>().components()[0];
+  double worstU = 0, worstV = 0;
+  for (const auto& p : test::kGhiaU) {
+    const double ref = re == 100 ? p.re100 : p.re1000;
+    worstU = std::max(worstU, std::abs(sampleVelocity(grid, Eigen::Vector2d(0.5, p.coordinate)).x() - ref));
+  }
+  for (const auto& p : test::kGhiaV) {
+    const double ref = re == 100 ? p.re100 : p.re1000;
+    worstV = std::max(worstV, std::abs(sampleVelocity(grid, Eigen::Vector2d(p.coordinate, 0.5)).y() - ref));
+  }
+  std::printf("| Re | cells | threads | steady | t | steps | CG iterations/step | wall s | ms/step | max abs(u - Ghia) | max abs(v - Ghia) |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("| %d | %d^2 | %d | %s | %.2f | %ld | %.1f | %.1f | %.2f | %.4f | %.4f |\n", re, grid.cells[0], threads,
+              steady ? "yes" : "NO", sim.time(), sim.stepsDone(), iterations / sim.stepsDone(), seconds,
+              1e3 * seconds / sim.stepsDone(), worstU, worstV);
+  return 0;
+}
