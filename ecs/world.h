@@ -33,7 +33,7 @@ struct FluidSolverSettings {
   enum class Preconditioner { None, Jacobi, IC0, MIC0, Multigrid };
   Advection advection = Advection::SemiLagrangian;
   Projection projection = Projection::Coupled;
-  Preconditioner preconditioner = Preconditioner::MIC0;
+  Preconditioner preconditioner = Preconditioner::Multigrid;  // flat iteration counts (benchmarks)
   double tolerance = 1e-8;   // relative residual of the Krylov solve
   int maxIterations = 5000;
 };

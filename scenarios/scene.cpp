@@ -328,7 +328,7 @@ void parseFluidSolverSettings(const Config& c, FluidSolverSettings& f) {
   const std::string advection = c.oneOf("advection", {"semi_lagrangian", "eno3", "none"}, "semi_lagrangian");
   f.advection = advection == "eno3" ? S::Advection::Eno3 : advection == "none" ? S::Advection::None : S::Advection::SemiLagrangian;
   f.projection = c.oneOf("projection", {"coupled", "chorin"}, "coupled") == "chorin" ? S::Projection::Chorin : S::Projection::Coupled;
-  const std::string pc = c.oneOf("preconditioner", {"none", "jacobi", "ic0", "mic0", "multigrid"}, "mic0");
+  const std::string pc = c.oneOf("preconditioner", {"none", "jacobi", "ic0", "mic0", "multigrid"}, "multigrid");
   f.preconditioner = pc == "none"     ? S::Preconditioner::None
                      : pc == "jacobi" ? S::Preconditioner::Jacobi
                      : pc == "ic0"    ? S::Preconditioner::IC0
