@@ -4,6 +4,7 @@
 // where the coupled solve and Chorin's splitting are compared.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 
 #include "components/mac_grid.h"
@@ -11,6 +12,7 @@
 #include "scenarios/simulation.h"
 #include "solvers/mac_layout.h"
 #include "support/ghia.h"
+#include "support/taylor_green.h"
 
 using namespace monolith;
 
@@ -57,36 +59,11 @@ TEST(Poiseuille, SteadyProfileIsParabolicWithinOnePercent) {
   EXPECT_LE(worst, 1e-3);
 }
 
-// L-infinity error of the Taylor-Green vortex at t = 1 on an n x n grid with dt = dx / 2.
-double taylorGreenError(int n, const std::string& advection, const Registry& registry) {
-  char dt[32];
-  std::snprintf(dt, sizeof dt, "%.17g", 0.5 * 2 * M_PI / n);
-  const double steps = std::round(1.0 / std::atof(dt));
-  char dtExact[32];
-  std::snprintf(dtExact, sizeof dtExact, "%.17g", 1.0 / steps);  // land exactly on t = 1
-  const SceneSpec scene = loadScene(kScenes + "taylor_green.json",
-                                    {{"entities.fluid.mac_grid.cells", "[" + std::to_string(n) + "," + std::to_string(n) + "]"},
-                                     {"time.dt", dtExact},
-                                     {"solvers.fluid.advection", advection}});
-  Simulation<2> sim(scene, registry);
-  while (!sim.finished()) sim.step();
-  const MacGrid<2>& grid = gridOf(sim);
-  const solvers::MacLayout<2> layout(grid.cells, grid.dx, grid.origin, {true, true});
-  const double nu = 0.01, decay = std::exp(-2 * nu * sim.time());
-  double error = 0;
-  for (int f = 0; f < layout.totalFaces(); ++f) {
-    const auto [axis, index] = layout.faceCoord(f);
-    const auto x = layout.faceCenter(axis, index);
-    const double exact = axis == 0 ? std::sin(x.x()) * std::cos(x.y()) * decay : -std::cos(x.x()) * std::sin(x.y()) * decay;
-    error = std::max(error, std::abs(grid.u[f] - exact));
-  }
-  return error;
-}
-
 TEST(TaylorGreen, ErrorConvergesForBothAdvectionSchemes) {
   const Registry registry = builtins();
   for (const std::string scheme : {"semi_lagrangian", "eno3"}) {
-    const double e32 = taylorGreenError(32, scheme, registry), e64 = taylorGreenError(64, scheme, registry);
+    const double e32 = test::taylorGreen(32, scheme, "coupled", registry).error;
+    const double e64 = test::taylorGreen(64, scheme, "coupled", registry).error;
     const double order = std::log2(e32 / e64);
     std::printf("taylor_green %s: error(32) = %.3e, error(64) = %.3e, order %.2f\n", scheme.c_str(), e32, e64, order);
     // Both schemes are first order in time (the projection splitting) and semi-Lagrangian is
