@@ -15,6 +15,7 @@
 
 #include "scenarios/simulation.h"
 #include "scenarios/checkpoint.h"
+#include "scenarios/fluid_probes.h"
 #include "scenarios/metrics_writer.h"
 #include "scenarios/progress.h"
 #include "components/mac_grid.h"
@@ -93,6 +94,7 @@ class Run {
     std::unique_ptr<PvdCollection> pvd;
   };
   std::vector<FrameSeries> series_;
+  std::unique_ptr<FluidProbeWriter<d>> probes_;
   void setUpFrameSeries();
   std::vector<std::string> checkpoints_;
   double wallTotal_ = 0;
@@ -102,7 +104,9 @@ class Run {
 
 template <int d>
 void Run<d>::writeFrame(long step) {
-  if (!options_.writeFrames || (scene_.frameEvery == 0 && scene_.frameInterval == 0)) return;
+  if (scene_.frameEvery == 0 && scene_.frameInterval == 0) return;
+  if (probes_) probes_->frame(world(), step);  // profiles are data, written even with --no-frames
+  if (!options_.writeFrames) return;
   const double t = sim_->time();
   for (auto& s : series_) {
     const std::string file = frameName(s.kind, step, s.extension);
@@ -226,6 +230,7 @@ RunResult Run<d>::execute() {
   }
 
   setUpFrameSeries();
+  probes_ = std::make_unique<FluidProbeWriter<d>>(scene_, world(), outDir_, resume_ ? firstStep : -1);
   MetricsWriter metrics(outDir_ + "/metrics.csv", resume_ ? firstStep : -1);
   if (!resume_) writeFrame(0);
 
@@ -281,6 +286,7 @@ RunResult Run<d>::execute() {
       return result;  // the bad state is neither framed nor checkpointed
     }
     if (diagnostics != &lastDiagnostics) lastDiagnostics = *diagnostics;
+    probes_->afterStep(world(), done, sim_->time());
     if (sim_->frameDue()) writeFrame(done);
     if (checkpointEvery > 0 && done % checkpointEvery == 0) {
       const std::string path = checkpointPath(done);
@@ -299,6 +305,7 @@ RunResult Run<d>::execute() {
   }
   progress.finish((converged ? "converged: " : "done: ") + std::to_string(sim_->stepsDone() - firstStep) + " steps");
   if (converged && sim_->frameDue() == false) writeFrame(sim_->stepsDone());  // the steady state itself
+  probes_->frame(world(), sim_->stepsDone());  // profiles of the final state in any case
   writeSummary(converged ? "converged" : "completed", "", sim_->stepsDone(), lastDiagnostics);
   result.stepsCompleted = sim_->stepsDone();
   result.stateHash = stateHash(world());

@@ -223,6 +223,46 @@ void parseCflTime(const Config& time, SceneSpec& s) {
   s.frameEvery = s.frameInterval > 0 ? 1 : 0;
 }
 
+// "output": {"probes": [{"name", "position"}], "profiles": [{"name", "from", "to", "points"}]}
+void parseProbesAndProfiles(const Config& out, SceneSpec& s) {
+  std::set<std::string> names;
+  auto uniqueName = [&](const Config& c) {
+    const std::string name = c.string("name");
+    if (name.empty() || name.find_first_of("/\\ ,") != std::string::npos)
+      c.failAt("name", "a non-empty name without '/', spaces or commas (it names files and columns)", "\"" + name + "\"");
+    if (!names.insert(name).second) c.failAt("name", "a name no other probe or profile uses", "\"" + name + "\" again");
+    return name;
+  };
+  const auto toVector = [](const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); };
+  if (out.has("probes")) {
+    out.markUsed("probes");
+    const Config list(out.raw()["probes"], out.file(), out.pathOf("probes"));
+    for (std::size_t i = 0; i < list.arraySize(); ++i) {
+      const Config c = list.element(i);
+      if (!c.raw().is_object()) c.fail("a probe {\"name\", \"position\"}", describeJson(c.raw()));
+      ProbeSpec p{uniqueName(c), toVector(c.vector("position", s.dimension)), c.pathOf("position")};
+      c.finish();
+      s.probes.push_back(std::move(p));
+    }
+  }
+  if (out.has("profiles")) {
+    out.markUsed("profiles");
+    const Config list(out.raw()["profiles"], out.file(), out.pathOf("profiles"));
+    for (std::size_t i = 0; i < list.arraySize(); ++i) {
+      const Config c = list.element(i);
+      if (!c.raw().is_object()) c.fail("a profile {\"name\", \"from\", \"to\", \"points\"}", describeJson(c.raw()));
+      ProfileSpec p;
+      p.name = uniqueName(c);
+      p.from = toVector(c.vector("from", s.dimension));
+      p.to = toVector(c.vector("to", s.dimension));
+      p.points = static_cast<int>(c.integer("points", 2, 100000));
+      p.path = c.path();
+      c.finish();
+      s.profiles.push_back(std::move(p));
+    }
+  }
+}
+
 }  // namespace
 
 SceneSpec parseScene(const std::string& text, const std::string& file, const std::vector<Override>& overrides) {
@@ -256,6 +296,7 @@ SceneSpec parseScene(const std::string& text, const std::string& file, const std
   if (top.has("output")) {
     const Config out = top.child("output");
     s.outputDirectory = out.string("directory", "");
+    parseProbesAndProfiles(out, s);
     if (!out.boolean("frames", true)) {
       s.frameEvery = 0;
       s.frameInterval = 0;

@@ -13,6 +13,20 @@
 
 namespace monolith {
 
+// A point where the fluid velocity and pressure are recorded every step (probes.csv).
+struct ProbeSpec {
+  std::string name;
+  std::vector<double> position;
+  std::string path;  // JSON path, for the error when the point lies outside the grid
+};
+// A line sampled at every frame (profiles/<name>_<step>.csv), e.g. a cavity centre line.
+struct ProfileSpec {
+  std::string name;
+  std::vector<double> from, to;
+  int points = 2;
+  std::string path;
+};
+
 struct SceneSpec {
   std::string file;       // the path as given (used in messages)
   std::string directory;  // relative paths in the scene are resolved against this
@@ -27,6 +41,8 @@ struct SceneSpec {
   double frameInterval = 0;  // CFL scenes: write a frame every this much simulated time
   int threads = 2;
   std::string outputDirectory;  // "" = derived from the scene name
+  std::vector<ProbeSpec> probes;
+  std::vector<ProfileSpec> profiles;
   std::vector<std::string> plugins;  // resolved paths
   long checkpointEvery = 0;          // 0 = off
   double guardMaxAbs = 1e12;         // blow-up guard: any state value beyond this is absurd
