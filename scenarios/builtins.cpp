@@ -12,6 +12,7 @@
 #include "systems/advance_velocity.h"
 #include "systems/rigid_diagnostics.h"
 #include "systems/fluid_advection.h"
+#include "systems/fluid_obstacles.h"
 #include "systems/fluid_projection.h"
 #include "systems/rigid_forces.h"
 
@@ -167,6 +168,10 @@ void registerDimension(Registry& r) {
   r.addSystem<d>({"fluid_gravity", "gravity on the fluid's free faces", [] { return single<FluidGravity<d>>(); }, ""});
   r.addSystem<d>({"project_fluid", "coupled SPD pressure-viscosity solve (5.31) or Chorin splitting",
                   [] { return single<FluidProjection<d>>(); }, ""});
+  r.addSystem<d>({"rasterize_obstacles", "solid cells of the MAC grid covered by fluid_obstacle shapes (staircase)",
+                  [] { return single<RasterizeObstacles<d>>(); }, ""});
+  r.addSystem<d>({"obstacle_forces", "first-order force of the fluid on each fluid_obstacle (pressure + wall shear)",
+                  [] { return single<ObstacleForces<d>>(); }, ""});
   r.addSystem<d>({"rigid_diagnostics", "energies and momenta of the rigid bodies",
                   [] { return single<RigidDiagnostics<d>>(); }, ""});
 }

@@ -3,7 +3,10 @@
 #include <cmath>
 #include <sstream>
 
+#include "components/fluid_obstacle.h"
 #include "components/mac_grid.h"
+#include "components/rigid_body.h"
+#include "components/shape.h"
 #include "solvers/mac_layout.h"
 
 namespace monolith {
@@ -119,6 +122,19 @@ void parseFluidMaterial(World<d>& world, Entity e, const Config& c) {
   world.add(e, m);
 }
 
+// A static obstacle in the fluid: needs the entity's shape and static rigid_body (parsed
+// before this component; registerFluidComponents runs after their registration).
+template <int d>
+void parseFluidObstacle(World<d>& world, Entity e, const Config& c) {
+  if (!world.template has<Shape<d>>(e)) c.fail("fluid_obstacle on an entity with a \"shape\"", "no shape");
+  const RigidBody<d>* body = world.template get<RigidBody<d>>(e);
+  if (!body) c.fail("fluid_obstacle on an entity with a \"rigid_body\" (its position/orientation)", "no rigid_body");
+  if (!body->isStatic)
+    c.fail("fluid_obstacle on a static rigid_body (\"static\": true; moving obstacles are not supported)",
+           "a dynamic rigid_body");
+  world.add(e, FluidObstacle{});
+}
+
 }  // namespace
 
 template <int d>
@@ -128,6 +144,9 @@ void registerFluidComponents(Registry& r) {
       parseMacGrid<d>);
   r.addComponentOf<d, FluidMaterial>("fluid density and dynamic viscosity (on the mac_grid entity)",
                                      parseFluidMaterial<d>);
+  r.addComponentOf<d, FluidObstacle>(
+      "static obstacle in the fluid: the entity's shape at its static rigid_body pose becomes solid cells",
+      parseFluidObstacle<d>);
 }
 
 template void registerFluidComponents<2>(Registry&);

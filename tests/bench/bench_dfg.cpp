@@ -1,0 +1,106 @@
+// Schaefer-Turek DFG 2D-1 (steady Re 20 flow past a cylinder, REFERENCES.md): drag and lift
+// coefficients and the pressure difference across the cylinder against the reference values,
+// for the first-order staircase obstacle (fluid_obstacle) at several resolutions. Runs
+// scenarios/scenes/dfg_2d1.json through the real pipeline to steady state
+// (max|du|/dt < 1e-6, the scene's stop criterion).
+//
+// usage: bench_dfg [max cells across the channel: 41|82|164] [threads] [end time, default the scene's 30] [first cells across, default 41]
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "components/mac_grid.h"
+#include "scenarios/fluid_fields.h"
+#include "scenarios/simulation.h"
+
+using namespace monolith;
+
+namespace {
+constexpr double kCD = 5.57953523384, kCL = 0.010618948146, kDP = 0.11752016697;  // reference
+constexpr double kUbar = 0.2, kD = 0.1, kRho = 1;
+
+// Pressure at x, bilinear from the cell centres around it but over fluid cells only (weights
+// renormalized): solid cells carry p = 0, and both probe points (0.15, 0.2) and (0.25, 0.2) lie
+// on the disk's boundary, so samplePressure would mix those zeros in (it halves dP at dx = 0.01).
+double fluidPressure(const MacGrid<2>& grid, const Eigen::Vector2d& x) {
+  const Eigen::Vector2d s = (x - grid.origin) / grid.dx - Eigen::Vector2d::Constant(0.5);
+  const int i0 = int(std::floor(s.x())), j0 = int(std::floor(s.y()));
+  double sum = 0, weights = 0;
+  for (int di = 0; di <= 1; ++di)
+    for (int dj = 0; dj <= 1; ++dj) {
+      const int i = i0 + di, j = j0 + dj;
+      if (i < 0 || j < 0 || i >= grid.cells[0] || j >= grid.cells[1]) continue;
+      const int c = i + grid.cells[0] * j;
+      if (grid.solid[c]) continue;
+      const double w = (di ? s.x() - i0 : 1 - (s.x() - i0)) * (dj ? s.y() - j0 : 1 - (s.y() - j0));
+      sum += w * grid.p[c];
+      weights += w;
+    }
+  return weights > 0 ? sum / weights : 0.0;
+}
+
+struct Row {
+  int ny = 0;
+  long steps = 0;
+  double seconds = 0, t = 0, cD = 0, cL = 0, dP = 0, dPraw = 0, change = 0;
+  bool steady = false;
+};
+
+Row run(const Registry& registry, int ny, int threads, const std::string& end) {
+  const std::string file = std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/dfg_2d1.json";
+  const int nx = ny * 220 / 41;  // square cells: 2.2 / nx = 0.41 / ny
+  std::vector<Override> overrides = {
+      {"entities.fluid.mac_grid.cells", "[" + std::to_string(nx) + "," + std::to_string(ny) + "]"}};
+  char dt[32];
+  std::snprintf(dt, sizeof dt, "%.17g", 0.025 * 41 / ny);  // the scene's CFL about 0.95 at every resolution
+  overrides.push_back({"time.dt", dt});
+  if (!end.empty()) overrides.push_back({"time.end", end});
+  const SceneSpec scene = loadScene(file, overrides);
+  Simulation<2> sim(scene, registry, threads);
+  Row r;
+  r.ny = ny;
+  const auto t0 = std::chrono::steady_clock::now();
+  double fx = 0, fy = 0;
+  while (!sim.finished()) {
+    const auto& diag = sim.step();
+    fx = diag.at("obstacle_cylinder_force_x");
+    fy = diag.at("obstacle_cylinder_force_y");
+    r.change = diag.at(scene.stopDiagnostic);
+    if (diag.at(scene.stopDiagnostic) < scene.stopBelow) {
+      r.steady = true;
+      break;
+    }
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const MacGrid<2>& grid = sim.world().pool<MacGrid<2>>().components()[0];
+  r.steps = sim.stepsDone();
+  r.t = sim.time();
+  r.cD = 2 * fx / (kRho * kUbar * kUbar * kD);
+  r.cL = 2 * fy / (kRho * kUbar * kUbar * kD);
+  r.dP = fluidPressure(grid, Eigen::Vector2d(0.15, 0.2)) - fluidPressure(grid, Eigen::Vector2d(0.25, 0.2));
+  r.dPraw = samplePressure(grid, Eigen::Vector2d(0.15, 0.2)) - samplePressure(grid, Eigen::Vector2d(0.25, 0.2));
+  return r;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int maxNy = argc > 1 ? std::atoi(argv[1]) : 164;
+  const int threads = argc > 2 ? std::atoi(argv[2]) : 2;
+  const std::string end = argc > 3 ? argv[3] : "";
+  const int firstNy = argc > 4 ? std::atoi(argv[4]) : 41;
+  Registry registry;
+  registerBuiltins(registry);
+  std::printf("| cells | steady | t | final max du/dt | steps | wall s | c_D | err c_D | c_L | err c_L | dP | err dP | dP (samplePressure) |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (int ny = firstNy; ny <= maxNy; ny *= 2) {
+    const Row r = run(registry, ny, threads, end);
+    std::printf("| %dx%d | %s | %.2f | %.1e | %ld | %.1f | %.4f | %+.1f%% | %.5f | %+.0f%% | %.5f | %+.1f%% | %.5f |\n",
+                ny * 220 / 41, ny, r.steady ? "yes" : "NO", r.t, r.change, r.steps, r.seconds, r.cD,
+                100 * (r.cD - kCD) / kCD, r.cL, 100 * (r.cL - kCL) / kCL, r.dP, 100 * (r.dP - kDP) / kDP, r.dPraw);
+    std::fflush(stdout);
+    if (r.seconds > 240) break;  // the next resolution would take > 4x as long
+  }
+  return 0;
+}
