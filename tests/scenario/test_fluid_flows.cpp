@@ -4,6 +4,8 @@
 // where the coupled solve and Chorin's splitting are compared.
 #include <gtest/gtest.h>
 
+#include "support/scenes.h"
+
 #include <chrono>
 #include <cmath>
 
@@ -17,13 +19,8 @@
 using namespace monolith;
 
 namespace {
-const std::string kScenes = std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/";
-
-Registry builtins() {
-  Registry r;
-  registerBuiltins(r);
-  return r;
-}
+using test::builtins;
+using test::kScenes;
 
 // Steps until the scene's "stop" diagnostic falls below its threshold (or the end).
 template <int d>

@@ -3,6 +3,8 @@
 // short run, and the force columns in the CLI's metrics.csv.
 #include <gtest/gtest.h>
 
+#include "support/scenes.h"
+
 #include <cmath>
 
 #include "components/mac_grid.h"
@@ -15,13 +17,8 @@ using namespace monolith;
 using namespace monolith::test;
 
 namespace {
-const std::string kScenes = std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/";
-
-Registry builtins() {
-  Registry r;
-  registerBuiltins(r);
-  return r;
-}
+using test::builtins;
+using test::kScenes;
 
 const MacGrid<2>& gridOf(Simulation<2>& sim) { return sim.world().pool<MacGrid<2>>().components()[0]; }
 }  // namespace

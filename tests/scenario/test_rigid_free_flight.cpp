@@ -3,6 +3,8 @@
 // constant torques change L exactly; results are bitwise identical on 1 and 2 threads.
 #include <gtest/gtest.h>
 
+#include "support/scenes.h"
+
 #include <cmath>
 #include <fstream>
 
@@ -13,13 +15,8 @@
 using namespace monolith;
 
 namespace {
-const std::string kScenes = std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/";
-
-Registry builtins() {
-  Registry r;
-  registerBuiltins(r);
-  return r;
-}
+using test::builtins;
+using test::kScenes;
 }  // namespace
 
 TEST(SpinSliver, EnergyAndAngularMomentumExactAtFrameRate) {
