@@ -11,6 +11,8 @@
 #include "solvers/fluid/spd_systems.h"
 
 #include <gtest/gtest.h>
+
+#include "support/random_vector.h"
 #include <oneapi/tbb/task_arena.h>
 
 #include <chrono>
@@ -26,13 +28,7 @@ using namespace monolith::solvers;
 using Eigen::VectorXd;
 using Kind = PoissonPreconditionerKind;
 
-VectorXd randomVector(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> dist(-1, 1);
-  VectorXd v(n);
-  for (int i = 0; i < n; ++i) v[i] = dist(rng);
-  return v;
-}
+using monolith::test::randomVector;
 
 FluidDomain<2> closedBox2(int n) {
   using S = SideSpec<2>;

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/random_vector.h"
+
 #include <cmath>
 #include <random>
 #include <vector>
@@ -17,13 +19,7 @@ using namespace monolith::solvers;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-VectorXd randomVector(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> dist(-1, 1);
-  VectorXd v(n);
-  for (int i = 0; i < n; ++i) v[i] = dist(rng);
-  return v;
-}
+using monolith::test::randomVector;
 
 // 2-D: x has a moving no-slip lid below and an outflow above, y is periodic; a moving obstacle and
 // one Dirichlet (air) cell make every face kind and every boundary rule appear.

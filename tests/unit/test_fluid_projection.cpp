@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/random_vector.h"
+
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -19,13 +21,7 @@ using namespace monolith::solvers;
 using Eigen::VectorXd;
 constexpr double kPi = 3.14159265358979323846;
 
-VectorXd randomVector(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> dist(-1, 1);
-  VectorXd v(n);
-  for (int i = 0; i < n; ++i) v[i] = dist(rng);
-  return v;
-}
+using monolith::test::randomVector;
 
 // Tight solves so that solver error does not hide a scheme difference: 1e-12 relative residual.
 ProjectionSettings tight(PoissonPreconditionerKind kind = PoissonPreconditionerKind::MIC0) {
