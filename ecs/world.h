@@ -38,11 +38,33 @@ struct FluidSolverSettings {
   int maxIterations = 5000;
 };
 
+// Collisions, contact and interpenetration resolution (issue 3; scene "solvers": {"contact":
+// {...}}). Iteration counts are the defaults of the thesis's code (notes 1.4, 1.6, 1.7).
+struct ContactSettings {
+  int collisionIterations = 5;       // Gauss-Seidel sweeps over the pairs (Step II)
+  int collisionPairIterations = 20;  // impulses per pair per sweep
+  int contactIterations = 10;        // outer contact sweeps (Step III), epsilon-scaled
+  int contactLevelIterations = 2;    // per level and sweep
+  int contactPairIterations = 20;
+  bool shockPropagation = true;      // GBF 2003 shock propagation after contact
+  int shockLevelIterations = 2;
+  int shockPairIterations = 10;
+  bool pushOut = true;               // interpenetration resolution, Sec. 4.6.1 / App. B
+  int pushOutLevelIterations = 2;
+  int pushOutBodyIterations = 5;
+  bool velocityContact = true;       // second contact step in Step V (Sec. 2.3.2 "Contact Clamping")
+  bool energyClamp = true;           // Sec. 2.3.2 for collisions and the second contact step
+  double thickness = 1e-4;           // contact is processed within this separation (m)
+  double pushOutTolerance = 1e-5;    // penetration left alone by push-out (m)
+  double approachTolerance = 1e-9;   // |v_rel.n| below this is "not approaching" (m/s)
+};
+
 // Scene-wide physical settings shared by systems (read-only during a step).
 template <int d>
 struct WorldSettings {
   Vec<d> gravity = Vec<d>::Zero();
   RigidRotationSettings rigidRotation;
+  ContactSettings contact;
   FluidSolverSettings fluid;
 };
 

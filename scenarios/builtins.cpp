@@ -7,6 +7,7 @@
 #include "components/rigid_body.h"
 #include "components/shape.h"
 #include "ecs/registry.h"
+#include "scenarios/contact_components.h"
 #include "scenarios/fluid_components.h"
 #include "systems/advance_positions.h"
 #include "systems/advance_velocity.h"
@@ -14,6 +15,8 @@
 #include "systems/fluid_advection.h"
 #include "systems/fluid_obstacles.h"
 #include "systems/fluid_projection.h"
+#include "systems/kinematic_motion.h"
+#include "systems/rigid_contact.h"
 #include "systems/rigid_forces.h"
 
 namespace monolith {
@@ -29,28 +32,6 @@ AngularVec<d> angularConfig(const Config& c, const std::string& key) {
   return a;
 }
 
-template <int d>
-void parseShape(World<d>& world, Entity e, const Config& c) {
-  Shape<d> shape;
-  const std::string sphereName = d == 3 ? "sphere" : "disk";
-  // The round shape of the other dimension is too far from this one's name for "did you
-  // mean": point at it explicitly.
-  const std::string otherName = d == 3 ? "disk" : "sphere";
-  if (c.has("type") && c.raw()["type"] == otherName)
-    c.failAt("type", "one of \"box\", \"" + sphereName + "\"",
-             describeJson(c.raw()["type"]) + " (a " + std::to_string(5 - d) + "-D shape; did you mean \"" + sphereName +
-                 "\"?)");
-  const std::string type = c.oneOf("type", {"box", sphereName}, "");
-  if (type == "box") {
-    shape.type = ShapeType::Box;
-    shape.halfExtents = c.vector("half_extents", d, Bound::Positive);
-  } else {
-    shape.type = ShapeType::Sphere;
-    shape.radius = c.number("radius", Bound::Positive);
-  }
-  world.add(e, shape);
-}
-
 // Body-frame inertia from the config ("inertia": principal moments, a full matrix, or in 2-D a
 // number), else from the shape. Checked: symmetric positive definite, and physically
 // realizable (each principal moment at most the sum of the other two).
@@ -61,6 +42,10 @@ InertiaMat<d> parseInertia(World<d>& world, Entity e, const Config& c, double ma
     const Shape<d>* shape = world.template get<Shape<d>>(e);
     if (!shape)
       c.failAt("inertia", "an inertia, or a \"shape\" component on the entity to derive it from", "neither");
+    const bool noClosedForm =
+        shape->type == ShapeType::Mesh || shape->type == ShapeType::Plane || (d == 3 && shape->type == ShapeType::Convex);
+    if (noClosedForm && !c.boolean("static", false))
+      c.failAt("inertia", "an explicit inertia (a convex hull, mesh or plane shape has none built in)", "none");
     return shape->inertia(mass);
   }
   if constexpr (d == 2) {
@@ -93,6 +78,8 @@ template <int d>
 void parseRigidBody(World<d>& world, Entity e, const Config& c) {
   RigidBody<d> b;
   b.isStatic = c.boolean("static", false);
+  if (const Shape<d>* shape = world.template get<Shape<d>>(e); shape && shape->type == ShapeType::Plane && !b.isStatic)
+    c.failAt("static", "true: a plane (half-space) has infinite extent and can only be static", "a dynamic body");
   b.mass = b.isStatic ? c.number("mass", 1.0, Bound::Positive) : c.number("mass", Bound::Positive);
   b.inertiaBody = parseInertia(world, e, c, b.mass);
   b.refresh();
@@ -141,14 +128,17 @@ auto single(Args... args) {
 template <int d>
 void registerDimension(Registry& r) {
   // Order matters: components parse in this order (shape before rigid_body).
-  r.addComponentOf<d, Shape<d>>(d == 3 ? "geometry: box {half_extents} or sphere {radius}"
-                                       : "geometry: box {half_extents} or disk {radius}",
-                                parseShape<d>);
+  r.addComponentOf<d, Shape<d>>(d == 3 ? "geometry: box {half_extents}, sphere {radius}, capsule/cylinder {radius, "
+                                                "half_height} (axis z), plane {normal}, convex {vertices}, mesh "
+                                                "{vertices, triangles} or {file (OBJ), scale}"
+                                       : "geometry: box {half_extents}, disk {radius}, polygon {vertices}, plane {normal}",
+                                parseShapeComponent<d>);
   r.addComponentOf<d, RigidBody<d>>(
       "rigid body: mass, inertia (or from shape), position, orientation/angle, velocity, angular_velocity, static",
       parseRigidBody<d>);
   r.addComponentOf<d, ExternalForce<d>>("constant world-frame force and torque on a rigid body", parseExternalForce<d>);
   r.addComponentOf<d, RigidForces<d>>("(internal) force/torque accumulator of a dynamic rigid body", nullptr);
+  registerContactComponents<d>(r);
   registerFluidComponents<d>(r);
 
   r.addSystem<d>({"clear_rigid_forces", "zero the force accumulators before each force evaluation",
@@ -158,11 +148,19 @@ void registerDimension(Registry& r) {
                   [] { return atBothForceStages<ExternalForces<d>, d>(); }, ""});
   r.addSystem<d>({"advance_rigid_velocity_half", "Step I (Sec. 4.3): v^{n+1/2} = v^n + dt/2 a(x^n)",
                   [] { return single<RigidHalfKick<d>>(Stage::AdvanceVelocityHalf); }, ""});
+  r.addSystem<d>({"script_kinematic_velocity", "kinematic bodies take their scripted velocity at t^{n+1/2}",
+                  [] { return single<ScriptKinematicVelocity<d>>(); }, ""});
   r.addSystem<d>({"advance_rigid_positions",
                   "Step IV (Sec. 4.6): positions, orientation rule (4.4.1/App. A) and energy fix (2.2)",
                   [] { return single<AdvanceRigidPositions<d>>(); }, ""});
   r.addSystem<d>({"advance_rigid_velocity", "Step V (Sec. 4.7): v^{n+1} = v^{n+1/2} + dt/2 a(x^{n+1})",
                   [] { return single<RigidHalfKick<d>>(Stage::AdvanceVelocity); }, ""});
+  r.addSystem<d>({"advance_kinematic_positions", "Step IV for kinematic bodies: x += dt v, R = exp(dt w) R",
+                  [] { return single<AdvanceKinematicPositions<d>>(); }, ""});
+  r.addSystem<d>({"rigid_contact",
+                  "Steps II-V contact (Sec. 4.4-4.7, App. B): collisions, contact, shock_propagation, "
+                  "resolve_interpenetration, velocity_contact",
+                  [] { return makeRigidContactSystems<d>(); }, ""});
   r.addSystem<d>({"advect_fluid", "fluid advection u* = u - dt (u.grad)u (semi-Lagrangian or ENO3/RK3)",
                   [] { return single<FluidAdvection<d>>(); }, ""});
   r.addSystem<d>({"fluid_gravity", "gravity on the fluid's free faces", [] { return single<FluidGravity<d>>(); }, ""});

@@ -380,6 +380,30 @@ void parseFluidSolverSettings(const Config& c, FluidSolverSettings& f) {
   f.maxIterations = static_cast<int>(c.integer("max_iterations", f.maxIterations, 1, 1000000));
   c.finish();
 }
+
+// "solvers": {"contact": {...}}: iteration counts and switches of issue 3 (world.h).
+void parseContactSettings(const Config& c, ContactSettings& s) {
+  auto count = [&](const char* key, int& value, int min) {
+    value = static_cast<int>(c.integer(key, value, min, 100000));
+  };
+  count("collision_iterations", s.collisionIterations, 0);
+  count("collision_pair_iterations", s.collisionPairIterations, 1);
+  count("contact_iterations", s.contactIterations, 0);
+  count("contact_level_iterations", s.contactLevelIterations, 1);
+  count("contact_pair_iterations", s.contactPairIterations, 1);
+  s.shockPropagation = c.boolean("shock_propagation", s.shockPropagation);
+  count("shock_level_iterations", s.shockLevelIterations, 1);
+  count("shock_pair_iterations", s.shockPairIterations, 1);
+  s.pushOut = c.boolean("push_out", s.pushOut);
+  count("push_out_level_iterations", s.pushOutLevelIterations, 1);
+  count("push_out_body_iterations", s.pushOutBodyIterations, 1);
+  s.velocityContact = c.boolean("velocity_contact", s.velocityContact);
+  s.energyClamp = c.boolean("energy_clamp", s.energyClamp);
+  s.thickness = c.number("thickness", s.thickness, Bound::NonNegative);
+  s.pushOutTolerance = c.number("push_out_tolerance", s.pushOutTolerance, Bound::NonNegative);
+  s.approachTolerance = c.number("approach_tolerance", s.approachTolerance, Bound::NonNegative);
+  c.finish();
+}
 }  // namespace
 
 template <int d>
@@ -400,6 +424,7 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
       rr.finish();
     }
     if (solvers.has("fluid")) parseFluidSolverSettings(solvers.child("fluid"), settings.fluid);
+    if (solvers.has("contact")) parseContactSettings(solvers.child("contact"), settings.contact);
     solvers.finish();
   }
 

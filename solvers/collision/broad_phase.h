@@ -1,0 +1,38 @@
+#pragma once
+// Broad phase (issue 3): candidate pairs of overlapping world bounding boxes.
+#include <utility>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace monolith::solvers::collision {
+
+enum class BroadPhaseMethod { SweepAndPrune, FclDynamicTree };
+
+// Returns every pair (i, j), i < j, whose boxes overlap (closed boxes: touching counts), sorted
+// lexicographically, so the result is independent of the method and of thread count.
+// `isInfinite` (empty, or one flag per box) filters pairs: two flagged boxes (half-spaces, or
+// static bodies that never collide with each other) are never paired. Boxes reaching beyond
+// 1e20 (a half-space's box) are checked against every box directly, whatever their flag.
+// Throws std::invalid_argument for a flag count that does not match or a NaN bound.
+template <int d>
+class BroadPhase {
+ public:
+  explicit BroadPhase(BroadPhaseMethod method = BroadPhaseMethod::SweepAndPrune);
+  ~BroadPhase();
+  BroadPhase(const BroadPhase&) = delete;
+  BroadPhase& operator=(const BroadPhase&) = delete;
+
+  // Reuses internal storage across calls (no allocation per step once warmed up).
+  const std::vector<std::pair<int, int>>& findPairs(const std::vector<Eigen::AlignedBox<double, d>>& boxes,
+                                                    const std::vector<char>& isInfinite);
+  BroadPhaseMethod method() const { return method_; }
+
+ private:
+  BroadPhaseMethod method_;
+  struct Impl;
+  Impl* impl_;
+  std::vector<std::pair<int, int>> pairs_;
+};
+
+}  // namespace monolith::solvers::collision

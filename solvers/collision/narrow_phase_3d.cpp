@@ -1,0 +1,219 @@
+// 3-D narrow phase (issue 3): which pairs are exact and which go through FCL, and how FCL's
+// single contact point becomes a manifold.
+//
+// Exact (no FCL): every pair with a half-space (the feature points of the other shape: box and
+// hull vertices, capsule ends, cylinder rim points, sphere centre, mesh vertices), every sphere
+// pair but sphere-mesh (the centre against the other shape's exact signed distance) and
+// capsule-capsule (closest points of the two segments plus the end caps). These support the
+// margin exactly.
+// FCL: the rest. Box-box gives FCL's clipped face manifold; the other pairs give FCL's one point,
+// completed as in the thesis by the vertex-in-shape test both ways (the vertices of A inside B
+// with B's face normal and vice versa). Beyond FCL's contact, the margin is served by
+// fcl::distance (one point) and by the feature tests (exact). Shapes against a mesh go through
+// narrow_phase_mesh.cpp (FCL per nearby triangle plus the feature points above each).
+#include <cmath>
+
+#include "solvers/collision/collision_impl.h"
+#include "solvers/collision/narrow_phase_fcl.h"
+
+namespace monolith::solvers::collision {
+
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using CP = ContactPoint<3>;
+using PG = PreparedGeometry<3>;
+
+// FCL's point is redundant when a feature point is as deep along (nearly) the same normal: MPR's
+// axis matches a face normal to ~1e-7 rad and the depths along it then agree to ~1e-7 of the size.
+constexpr double kRedundantDepth = 1e-6;  // times the pair's length scale
+// Contacts closer than this (times the length scale) are duplicates, e.g. a corner found both by
+// FCL's box-box clipping and by the vertex test.
+constexpr double kMergeDistance = 1e-6;
+// A mesh triangle's own normal must be within 60 degrees of FCL's contact normal for the shape to
+// rest on the triangle's face (rather than touch its edge), where feature points make sense.
+constexpr double kTriangleFaceCosine = 0.5;
+
+struct Scratch {
+  std::vector<CP> main, extra, result;
+  std::vector<int> triangles;
+  std::vector<FeaturePoint<3>> features;
+};
+// Per thread: queries are const and run concurrently, and reuse their buffers once warm.
+Scratch& scratch() {
+  thread_local Scratch s;
+  return s;
+}
+
+GeometryType typeOf(const PG& g) { return g.geometry().type; }
+
+CP midwayContact(const Vec3& onA, const Vec3& onB, const Vec3& normal, double depth) {
+  CP c;
+  c.point = 0.5 * (onA + onB);
+  c.normal = normal;
+  c.depth = depth;
+  return c;
+}
+
+// Closest points of the segments p1-q1 and p2-q2 (Ericson, Real-Time Collision Detection, 5.1.9).
+void closestSegmentPoints(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2, Vec3& c1, Vec3& c2) {
+  const Vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  const double c = d1.dot(r), b = d1.dot(d2);
+  const double denom = a * e - b * b;
+  // Parallel segments (denom ~ 0): any s works; 0 is as good as another, the end caps supply
+  // the rest of the line contact.
+  double s = denom > 1e-12 * a * e ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+  double t = (b * s + f) / e;
+  if (t < 0) {
+    t = 0;
+    s = std::clamp(-c / a, 0.0, 1.0);
+  } else if (t > 1) {
+    t = 1;
+    s = std::clamp((b - c) / a, 0.0, 1.0);
+  }
+  c1 = p1 + s * d1;
+  c2 = p2 + t * d2;
+}
+
+void capsulePair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb, double margin, double scale,
+                 Scratch& s) {
+  const Vec3 axisA = pa.R.col(2) * a.geometry().halfHeight, axisB = pb.R.col(2) * b.geometry().halfHeight;
+  Vec3 ca, cb;
+  closestSegmentPoints(pa.x - axisA, pa.x + axisA, pb.x - axisB, pb.x + axisB, ca, cb);
+  const Vec3 diff = ca - cb;
+  const double dist = diff.norm();
+  Vec3 n;
+  if (dist > 1e-12 * scale) {
+    n = diff / dist;
+  } else {  // the axes cross: the common normal of the two axes, facing A
+    n = axisA.cross(axisB);
+    n = n.norm() > 1e-12 * axisA.norm() * axisB.norm() ? Vec3(n.normalized()) : Vec3(axisA.unitOrthogonal());
+    if (n.dot(pa.x - pb.x) < 0) n = -n;
+  }
+  const double ra = a.geometry().radius, rb = b.geometry().radius;
+  s.main.clear();
+  s.extra.clear();
+  const double depth = ra + rb - dist;
+  if (depth >= -margin) s.main.push_back(midwayContact(ca - ra * n, cb + rb * n, n, depth));
+  // The end caps: two points for capsules lying side by side.
+  s.features.clear();
+  featurePoints<3>(a, pa, -n, s.features);
+  featuresInShape<3>(s.features, b, pb, margin, false, s.extra);
+  s.features.clear();
+  featurePoints<3>(b, pb, n, s.features);
+  featuresInShape<3>(s.features, a, pa, margin, true, s.extra);
+  keepUnrepresented<3>(s.main, s.extra, kRedundantDepth * scale, s.result);
+}
+
+void generalPair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb, double margin, double scale,
+                 Scratch& s) {
+  if (typeOf(b) == GeometryType::Mesh && typeOf(a) != GeometryType::Mesh) {
+    meshContacts(a, pa, b, pb, margin, scale, s.result);
+    return;
+  }
+  const bool boxBox = typeOf(a) == GeometryType::Box && typeOf(b) == GeometryType::Box;
+  const double tolerance = kRedundantDepth * scale;
+  s.main.clear();
+  s.extra.clear();
+  s.triangles.clear();
+  const bool fclWorked = fclContacts(a, pa, b, pb, s.main, s.triangles);
+  const bool clippedManifold = boxBox && !s.main.empty();  // FCL's box-box points: all kept
+  if (fclWorked && s.main.empty()) {
+    if (!(margin > 0)) return;
+    CP c;
+    int triangle = -1;
+    if (!fclMarginContact(a, pa, b, pb, margin, c, triangle)) return;
+    s.main.push_back(c);
+    s.triangles.push_back(triangle);
+  }
+  // Mesh-mesh keeps FCL's triangle contacts as they are (two static bodies, normally never
+  // paired); box-box without margin needs nothing more (FCL clipped the faces already); the
+  // rest gets the feature points both ways.
+  if (typeOf(b) != GeometryType::Mesh && !(boxBox && fclWorked && !(margin > 0))) {
+    const Vec3 towardsB = s.main.empty() ? Vec3(pb.x - pa.x) : Vec3(-s.main[0].normal);
+    s.features.clear();
+    featurePoints<3>(a, pa, towardsB, s.features);
+    featuresInShape<3>(s.features, b, pb, margin, false, s.extra);
+    s.features.clear();
+    featurePoints<3>(b, pb, -towardsB, s.features);
+    featuresInShape<3>(s.features, a, pa, margin, true, s.extra);
+    if (!s.main.empty()) {
+      // A vertex that went more than half way through picks the far face: its normal opposes
+      // FCL's (the minimum-translation direction of the pair) and would push the wrong way.
+      const Vec3 n = s.main[0].normal;
+      std::size_t kept = 0;
+      for (const CP& c : s.extra)
+        if (c.normal.dot(n) > 0) s.extra[kept++] = c;
+      s.extra.resize(kept);
+    }
+  }
+  if (clippedManifold) {
+    s.result.insert(s.result.end(), s.main.begin(), s.main.end());
+    s.result.insert(s.result.end(), s.extra.begin(), s.extra.end());
+  } else {
+    keepUnrepresented<3>(s.main, s.extra, tolerance, s.result);
+  }
+}
+
+// A and B in the order the routines expect: a half-space is B, a sphere is A (unless the other is
+// a mesh), a mesh is B.
+void orderedContacts(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb, double margin, double scale,
+                     Scratch& s) {
+  const GeometryType ta = typeOf(a), tb = typeOf(b);
+  if (tb == GeometryType::HalfSpace || (ta == GeometryType::Sphere && tb != GeometryType::Mesh)) {
+    const Vec3 towardsB = tb == GeometryType::HalfSpace ? Vec3(-(pb.R * b.geometry().normal)) : Vec3(pb.x - pa.x);
+    s.features.clear();
+    featurePoints<3>(a, pa, towardsB, s.features);
+    featuresInShape<3>(s.features, b, pb, margin, false, s.result);
+  } else if (ta == GeometryType::Capsule && tb == GeometryType::Capsule) {
+    capsulePair(a, pa, b, pb, margin, scale, s);
+  } else {
+    generalPair(a, pa, b, pb, margin, scale, s);
+  }
+}
+
+bool swapForOrder(GeometryType ta, GeometryType tb) {
+  if (ta == GeometryType::HalfSpace || tb == GeometryType::HalfSpace) return ta == GeometryType::HalfSpace;
+  if (ta == GeometryType::Mesh || tb == GeometryType::Mesh) return ta == GeometryType::Mesh && tb != GeometryType::Mesh;
+  return tb == GeometryType::Sphere && ta != GeometryType::Sphere;
+}
+
+// Pairs whose contacts cost about as much as FCL's boolean test: overlaps() asks for the deepest
+// contact instead (the mesh path included: FCL's own BVH traversal is the slow part).
+bool contactsAreCheap(GeometryType ta, GeometryType tb) {
+  if (ta == GeometryType::HalfSpace || tb == GeometryType::HalfSpace) return true;
+  if (ta == GeometryType::Mesh || tb == GeometryType::Mesh) return ta != tb;
+  return ta == GeometryType::Sphere || tb == GeometryType::Sphere ||
+         (ta == GeometryType::Capsule && tb == GeometryType::Capsule);
+}
+
+}  // namespace
+
+int findContacts3(const PG& a, const Pose<3>& poseA, const PG& b, const Pose<3>& poseB, const ContactQuery& query,
+                  std::vector<CP>& out) {
+  if (a.unbounded() && b.unbounded()) return 0;
+  const bool swap = swapForOrder(typeOf(a), typeOf(b));
+  const double margin = std::max(0.0, query.margin);
+  const double scale = pairLengthScale<3>(a, b);
+  Scratch& s = scratch();
+  s.result.clear();
+  if (swap) orderedContacts(b, poseB, a, poseA, margin, scale, s);
+  else orderedContacts(a, poseA, b, poseB, margin, scale, s);
+  finishManifold<3>(s.result, query.maxPoints, kMergeDistance * scale);
+  for (const CP& c : s.result) out.push_back(swap ? flipped<3>(c) : c);
+  return static_cast<int>(s.result.size());
+}
+
+bool overlaps3(const PG& a, const Pose<3>& poseA, const PG& b, const Pose<3>& poseB) {
+  if (a.unbounded() && b.unbounded()) return false;
+  if (!contactsAreCheap(typeOf(a), typeOf(b))) return fclOverlap(a, poseA, b, poseB);
+  thread_local std::vector<CP> deepest;
+  deepest.clear();
+  ContactQuery query;
+  query.maxPoints = 1;  // the deepest point decides
+  findContacts3(a, poseA, b, poseB, query, deepest);
+  return !deepest.empty() && deepest[0].depth > 0;
+}
+
+}  // namespace monolith::solvers::collision

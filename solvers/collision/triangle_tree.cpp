@@ -1,0 +1,87 @@
+// Bounding-box tree over a mesh's triangles (issue 3), built once per PreparedGeometry: the mesh
+// narrow phase asks it for the triangles near a shape before running FCL on each of them.
+// Median splits along the longest axis of the triangle centroids, ties broken by index, so the
+// tree (and the candidate order) only depends on the mesh.
+#include <algorithm>
+#include <numeric>
+
+#include "solvers/collision/collision_impl.h"
+
+namespace monolith::solvers::collision {
+
+namespace {
+
+constexpr int kLeafSize = 4;
+
+struct Builder {
+  PreparedGeometry<3>::Impl& impl;
+  std::vector<Eigen::AlignedBox3d> boxes;
+  std::vector<Eigen::Vector3d> centroids;
+
+  int build(int first, int count) {
+    using Node = PreparedGeometry<3>::Impl::TreeNode;
+    const int id = static_cast<int>(impl.triangleTree.size());
+    impl.triangleTree.push_back(Node{});
+    Eigen::AlignedBox3d box, centres;
+    for (int k = first; k < first + count; ++k) {
+      box.extend(boxes[impl.triangleOrder[k]]);
+      centres.extend(centroids[impl.triangleOrder[k]]);
+    }
+    impl.triangleTree[id].box = box;
+    if (count <= kLeafSize) {
+      impl.triangleTree[id].first = first;
+      impl.triangleTree[id].count = count;
+      return id;
+    }
+    int axis;
+    centres.sizes().maxCoeff(&axis);
+    const int half = count / 2;
+    auto begin = impl.triangleOrder.begin() + first;
+    std::nth_element(begin, begin + half, begin + count, [&](int i, int j) {
+      const double ci = centroids[i][axis], cj = centroids[j][axis];
+      return ci != cj ? ci < cj : i < j;
+    });
+    const int left = build(first, half);
+    const int right = build(first + half, count - half);
+    impl.triangleTree[id].left = left;
+    impl.triangleTree[id].right = right;
+    return id;
+  }
+};
+
+}  // namespace
+
+void buildTriangleTree(PreparedGeometry<3>::Impl& impl, const Geometry<3>& mesh) {
+  Builder builder{impl, {}, {}};
+  for (const auto& t : mesh.triangles) {
+    Eigen::AlignedBox3d box;
+    for (int v : t) box.extend(mesh.vertices[v]);
+    builder.boxes.push_back(box);
+    builder.centroids.push_back((mesh.vertices[t[0]] + mesh.vertices[t[1]] + mesh.vertices[t[2]]) / 3);
+  }
+  impl.triangleOrder.resize(mesh.triangles.size());
+  std::iota(impl.triangleOrder.begin(), impl.triangleOrder.end(), 0);
+  impl.triangleTree.clear();
+  builder.build(0, static_cast<int>(mesh.triangles.size()));
+}
+
+void trianglesNear(const PreparedGeometry<3>::Impl& impl, const Eigen::AlignedBox3d& box, std::vector<int>& out) {
+  if (impl.triangleTree.empty()) return;
+  // Depth-first, left before right: a fixed order. A median-split tree over n triangles is about
+  // log2(n / 4) deep, so 64 slots cover any mesh that fits in memory.
+  int stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const auto& node = impl.triangleTree[stack[--top]];
+    if (!node.box.intersects(box)) continue;
+    if (node.left < 0) {
+      for (int k = node.first; k < node.first + node.count; ++k) out.push_back(impl.triangleOrder[k]);
+    } else {
+      stack[top++] = node.right;
+      stack[top++] = node.left;
+    }
+  }
+}
+
+}  // namespace monolith::solvers::collision

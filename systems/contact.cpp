@@ -1,0 +1,82 @@
+// Step III of the Newmark step (thesis Sec. 4.5; notes 1.6): contact on the pairs collisions
+// processed, in contact-graph order from the bottom level up, with restitution -1 + eps where
+// eps ramps to 1 over the sweeps (early sweeps remove only part of the approach velocity, the
+// last one is fully inelastic). The candidate positions are x^n + dt v^{n+1/2}. Not clamped
+// (Sec. 2.3.2: clamping this split state against (x^n, v^n) makes resting stacks jitter).
+#include "systems/rigid_contact.h"
+
+namespace monolith {
+
+template <int d>
+void Contact<d>::run(World<d>&, StepContext& ctx) {
+  ContactWorkspace<d>& ws = *this->ws_;
+  if (ws.bodies.empty()) return;
+  ws.updateAllCandidates();
+  const ContactSettings& s = ws.settings;
+  std::vector<int> impulses(ws.islands.members.size(), 0);
+  ws.forEachIsland([&](int island) {
+    std::vector<solvers::collision::ContactPoint<d>> scratch;
+    const auto& list = ws.islandPairsByLevel[island];
+    for (int it = 0; it < s.contactIterations; ++it) {
+      for (std::size_t begin = 0; begin < list.size();) {
+        std::size_t end = begin;
+        while (end < list.size() && ws.pairs[list[end]].level == ws.pairs[list[begin]].level) ++end;
+        for (int li = 0; li < s.contactLevelIterations; ++li) {
+          const double eps = double((it + 1) * (li + 1)) / double(s.contactIterations * s.contactLevelIterations);
+          for (std::size_t k = begin; k < end; ++k)
+            impulses[island] += ws.updatePair(ws.pairs[list[k]], ImpulseMode::Contact, eps, s.contactPairIterations,
+                                              s.thickness, scratch, nullptr, nullptr);
+        }
+        begin = end;
+      }
+    }
+  });
+  ws.unpack(false);
+  int total = 0;
+  for (int n : impulses) total += n;
+  ctx.diagnostics.set("contact_impulses", total);
+}
+
+// Shock propagation (Guendelman, Bridson & Fedkiw 2003; notes 1.6): one more bottom-up pass;
+// after a level is processed its bodies are frozen (infinite mass), so the bodies above cannot
+// push them back down. Everything is unfrozen at the end.
+template <int d>
+void ShockPropagation<d>::run(World<d>&, StepContext& ctx) {
+  ContactWorkspace<d>& ws = *this->ws_;
+  if (ws.bodies.empty()) return;
+  const ContactSettings& s = ws.settings;
+  std::vector<int> impulses(ws.islands.members.size(), 0);
+  ws.forEachIsland([&](int island) {
+    std::vector<solvers::collision::ContactPoint<d>> scratch;
+    const auto& list = ws.islandPairsByLevel[island];
+    for (std::size_t begin = 0; begin < list.size();) {
+      const int level = ws.pairs[list[begin]].level;
+      std::size_t end = begin;
+      while (end < list.size() && ws.pairs[list[end]].level == level) ++end;
+      for (int li = 0; li < s.shockLevelIterations; ++li) {
+        const double eps = double(li + 1) / double(s.shockLevelIterations);
+        for (std::size_t k = begin; k < end; ++k)
+          impulses[island] += ws.updatePair(ws.pairs[list[k]], ImpulseMode::Contact, eps, s.shockPairIterations,
+                                            s.thickness, scratch, nullptr, nullptr);
+      }
+      for (std::size_t k = begin; k < end; ++k) {
+        const ContactPairState& p = ws.pairs[list[k]];
+        if (ws.levels.levelOf[p.a] == level) ws.bodies[p.a].frozen = true;
+        if (ws.levels.levelOf[p.b] == level) ws.bodies[p.b].frozen = true;
+      }
+      begin = end;
+    }
+    for (int m : ws.islands.members[island]) ws.bodies[m].frozen = false;
+  });
+  ws.unpack(false);
+  int total = 0;
+  for (int n : impulses) total += n;
+  ctx.diagnostics.set("shock_propagation_impulses", total);
+}
+
+template class Contact<2>;
+template class Contact<3>;
+template class ShockPropagation<2>;
+template class ShockPropagation<3>;
+
+}  // namespace monolith

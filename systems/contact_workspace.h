@@ -1,0 +1,137 @@
+#pragma once
+// The state the rigid collision/contact systems share within one time step (issue 3): the
+// colliding bodies packed in pool order, the candidate poses the pair tests use, the pairs found
+// by the broad phase, which of them collisions processed (Step II) and contact touched
+// (Step III), the contact-graph levels and the islands. Nothing in it survives a step except
+// caches (prepared geometry, broad-phase storage), so checkpoints need nothing from here.
+//
+// Conventions (notes 7.2): in a pair (a, b) the normal points out of b towards a, a receives
+// +j and b receives -j, the relative velocity is v_a - v_b at the point.
+#include <memory>
+#include <vector>
+
+#include "components/collider.h"
+#include "components/forces.h"
+#include "components/kinematic.h"
+#include "components/rigid_body.h"
+#include "components/shape.h"
+#include "ecs/step_context.h"
+#include "ecs/world.h"
+#include "solvers/collision/broad_phase.h"
+#include "solvers/collision/narrow_phase.h"
+#include "solvers/contact/contact_graph.h"
+#include "solvers/contact/rigid_math.h"
+
+namespace monolith {
+
+// Shape component -> entity-free collision geometry (throws std::invalid_argument if degenerate).
+template <int d>
+solvers::collision::Geometry<d> collisionGeometryOf(const Shape<d>& shape);
+
+template <int d>
+struct ContactBody {
+  using VecD = Eigen::Matrix<double, d, 1>;
+  using AngV = solvers::contact::AngVec<d>;
+  using AngM = solvers::contact::AngMat<d>;
+
+  RigidBody<d>* body = nullptr;
+  const solvers::collision::PreparedGeometry<d>* geometry = nullptr;
+  bool isStatic = false, kinematic = false;
+  bool frozen = false;  // shock propagation / push-out: treated as infinitely massive for now
+  double mass = 1, restitution = 0, friction = 0;
+  // The base configuration (time n in Steps II-IV, time n+1 in Step V).
+  VecD x0 = VecD::Zero();
+  Orientation<d> q0 = RigidBody<d>::identityOrientation();
+  Eigen::Matrix<double, d, d> R0 = Eigen::Matrix<double, d, d>::Identity();
+  AngM inverseInertia0 = AngM::Zero(), inertia0 = AngM::Zero();  // world, at q0
+  // Working velocity (what impulses change) and the Step I increment added for candidates.
+  VecD v = VecD::Zero();
+  AngV L = AngV::Zero();
+  VecD dv = VecD::Zero();
+  AngV dL = AngV::Zero();
+  VecD vCollided = VecD::Zero();  // \hat v^n after Step II, restored after Step IV
+  AngV LCollided = AngV::Zero();
+  solvers::collision::Pose<d> candidate;
+  long movedStamp = 0;
+
+  bool infinite() const { return isStatic || kinematic || frozen; }
+  double inverseMass() const { return infinite() ? 0.0 : 1.0 / mass; }
+  AngM inverseInertia() const { return infinite() ? AngM::Zero() : inverseInertia0; }
+  AngV omega() const { return inverseInertia0 * L; }
+  // Velocity at a point with lever arm r (from the centre of mass).
+  VecD pointVelocity(const VecD& r) const { return v + solvers::contact::angularCross<d>(omega(), r); }
+  double kineticEnergy() const { return infinite() ? 0.0 : 0.5 * mass * v.squaredNorm() + 0.5 * L.dot(omega()); }
+};
+
+struct ContactPairState {
+  int a = 0, b = 0;
+  bool processed = false;  // interpenetrated at candidate positions during Step II
+  bool contacted = false;  // received a contact impulse in Step III (used by Step V)
+  long checkedStamp = -1;
+  int level = 0;
+};
+
+// How one pair update treats the impulse (notes 1.4-1.6, Sec. 2.3.2).
+enum class ImpulseMode {
+  Collision,        // restitution e, friction clamp, energy clamp against the base state, split lever arms
+  Contact,          // restitution -1 + eps, no energy clamp (first contact step)
+  ClampedContact,   // restitution -1 + eps, energy clamp against the base state (second contact step)
+};
+
+template <int d>
+class ContactWorkspace {
+ public:
+  using VecD = Eigen::Matrix<double, d, 1>;
+
+  // Packs the colliding bodies. `subtractKick`: the bodies carry v^{n+1/2} and the Step I
+  // increment dt/2 F/m is taken off to recover v^n (Step II). Returns false if nothing collides.
+  bool pack(World<d>& world, double dt, bool subtractKick);
+  // Writes the working velocities (and positions, if `positions`) back to the components.
+  void unpack(bool positions);
+
+  // Candidate pose x0 + dt (v + kick*dv), rotated by dt * I^{-1}(L + kick*dL) (first order:
+  // candidates only decide which pairs touch).
+  void updateCandidate(ContactBody<d>& b) const;
+  void updateAllCandidates();
+  // Candidate pose from the current components (Step IV: the actual x^{n+1}).
+  void setCandidateToBase(ContactBody<d>& b) const;
+
+  // Broad phase at the candidate poses, then islands; resets pair flags.
+  void findPairs();
+  // Contact-graph levels from the processed pairs (Step III item 1, notes 1.6).
+  void computeLevels();
+
+  // One pair update: up to `iterations` impulses at the deepest approaching point.
+  // Returns the number of impulses applied.
+  int updatePair(ContactPairState& pair, ImpulseMode mode, double epsilon, int iterations, double margin,
+                 std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
+                 int* clampsApplied);
+
+  // Runs f(islandIndex) for every island in parallel (bodies of different islands are disjoint,
+  // so results do not depend on the thread count).
+  template <class F>
+  void forEachIsland(F&& f);
+
+  std::vector<ContactBody<d>> bodies;
+  std::vector<ContactPairState> pairs;
+  solvers::contact::Islands islands;
+  solvers::contact::ContactLevels levels;
+  // Per island: pair indices sorted by (level, index).
+  std::vector<std::vector<int>> islandPairsByLevel;
+  double dt = 0;
+  bool kick = false;
+  ContactSettings settings;
+  Vec<d> gravity = Vec<d>::Zero();
+
+ private:
+  void ensureGeometry(World<d>& world);
+  std::vector<Entity> entities_;
+  std::vector<std::unique_ptr<solvers::collision::PreparedGeometry<d>>> geometries_;
+  std::unique_ptr<solvers::collision::BroadPhase<d>> broadPhase_;
+  std::vector<Eigen::AlignedBox<double, d>> boxes_;
+  std::vector<char> infinite_;
+};
+
+}  // namespace monolith
+
+#include "systems/contact_workspace_impl.h"

@@ -1,0 +1,91 @@
+#pragma once
+// The rigid collision and contact stages of the Newmark step (thesis Sec. 4.2, issue 3), one
+// system per stage, sharing one ContactWorkspace per step:
+//   collisions               Step II  (Sec. 4.4): v^n -> \hat v^n, pairwise Gauss-Seidel, restitution
+//                                     and friction, energy clamp against (x^n, v^n); then
+//                                     \hat v^{n+1/2} = \hat v^n + (\tilde v^{n+1/2} - v^n)
+//   contact                  Step III (Sec. 4.5): contact graph, epsilon-scaled inelastic contact on
+//                                     the pairs collisions processed, level by level; no clamp
+//   shock_propagation        Step III (GBF 2003 [64]): bottom-up, each level frozen after it is done
+//   resolve_interpenetration Step IV  (Sec. 4.6.1, App. B): central-body push-out, then the
+//                                     velocity is reset to \hat v^n (+ the Step I kick)
+//   velocity_contact         Step V   (Sec. 2.3.2 "Contact Clamping"): contact again on the pairs
+//                                     contact touched, clamped against (x^{n+1}, v^{n+1})
+#include <memory>
+#include <vector>
+
+#include "ecs/system.h"
+#include "systems/contact_workspace.h"
+
+namespace monolith {
+
+template <int d>
+class RigidContactSystem : public System<d> {
+ public:
+  explicit RigidContactSystem(std::shared_ptr<ContactWorkspace<d>> ws) : ws_(std::move(ws)) {}
+  std::vector<std::string> reads() const override {
+    return {Collider<d>::kName, Shape<d>::kName, RigidForces<d>::kName, KinematicMotion<d>::kName};
+  }
+  std::vector<std::string> writes() const override { return {RigidBody<d>::kName, "contact_workspace"}; }
+  bool needed(const World<d>& w) const override { return w.template count<Collider<d>>() > 0; }
+
+ protected:
+  std::shared_ptr<ContactWorkspace<d>> ws_;
+};
+
+template <int d>
+class Collisions final : public RigidContactSystem<d> {
+ public:
+  using RigidContactSystem<d>::RigidContactSystem;
+  std::string name() const override { return "collisions"; }
+  Stage stage() const override { return Stage::Collisions; }
+  void run(World<d>& world, StepContext& ctx) override;
+};
+
+template <int d>
+class Contact final : public RigidContactSystem<d> {
+ public:
+  using RigidContactSystem<d>::RigidContactSystem;
+  std::string name() const override { return "contact"; }
+  Stage stage() const override { return Stage::Contact; }
+  void run(World<d>& world, StepContext& ctx) override;
+};
+
+template <int d>
+class ShockPropagation final : public RigidContactSystem<d> {
+ public:
+  using RigidContactSystem<d>::RigidContactSystem;
+  std::string name() const override { return "shock_propagation"; }
+  Stage stage() const override { return Stage::Contact; }
+  bool needed(const World<d>& w) const override {
+    return RigidContactSystem<d>::needed(w) && w.settings().contact.shockPropagation;
+  }
+  void run(World<d>& world, StepContext& ctx) override;
+};
+
+template <int d>
+class ResolveInterpenetration final : public RigidContactSystem<d> {
+ public:
+  using RigidContactSystem<d>::RigidContactSystem;
+  std::string name() const override { return "resolve_interpenetration"; }
+  Stage stage() const override { return Stage::AdvancePositions; }
+  void run(World<d>& world, StepContext& ctx) override;
+};
+
+template <int d>
+class VelocityContact final : public RigidContactSystem<d> {
+ public:
+  using RigidContactSystem<d>::RigidContactSystem;
+  std::string name() const override { return "velocity_contact"; }
+  Stage stage() const override { return Stage::AdvanceVelocity; }
+  bool needed(const World<d>& w) const override {
+    return RigidContactSystem<d>::needed(w) && w.settings().contact.velocityContact;
+  }
+  void run(World<d>& world, StepContext& ctx) override;
+};
+
+// The five systems above sharing one workspace, in pipeline order.
+template <int d>
+std::vector<std::unique_ptr<System<d>>> makeRigidContactSystems();
+
+}  // namespace monolith

@@ -1,0 +1,73 @@
+// Step V item 4 (thesis Sec. 4.7; notes 1.3 "post-CG constraints"): contact again, after the
+// velocity update, on the pairs that received contact impulses in Step III. The split state is
+// (x^{n+2} = x^{n+1} + dt v^{n+1}, v^{n+1}); impulses are clamped against the non-split state
+// (x^{n+1}, v^{n+1}) (Sec. 2.3.2 "Contact Clamping"), so this step never adds kinetic energy.
+#include <algorithm>
+
+#include "systems/rigid_contact.h"
+
+namespace monolith {
+
+template <int d>
+void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
+  ContactWorkspace<d>& ws = *this->ws_;
+  if (ws.bodies.empty()) return;
+  // Keep pairs, levels and islands of this step; re-base the bodies at time n+1.
+  std::vector<ContactPairState> pairs = ws.pairs;
+  if (!ws.pack(world, ctx.dt, /*subtractKick=*/false)) return;
+  ws.pairs = std::move(pairs);
+  const ContactSettings& s = ws.settings;
+  double energyBefore = 0;
+  for (const auto& b : ws.bodies) energyBefore += b.kineticEnergy();
+  std::vector<int> impulses(ws.islands.members.size(), 0), clamps(ws.islands.members.size(), 0);
+  std::vector<double> change(ws.islands.members.size(), 0.0);
+  ws.forEachIsland([&](int island) {
+    std::vector<solvers::collision::ContactPoint<d>> scratch;
+    const auto& list = ws.islandPairsByLevel[island];
+    for (int it = 0; it < s.contactIterations; ++it) {
+      for (std::size_t begin = 0; begin < list.size();) {
+        std::size_t end = begin;
+        while (end < list.size() && ws.pairs[list[end]].level == ws.pairs[list[begin]].level) ++end;
+        for (int li = 0; li < s.contactLevelIterations; ++li) {
+          const double eps = double((it + 1) * (li + 1)) / double(s.contactIterations * s.contactLevelIterations);
+          for (std::size_t k = begin; k < end; ++k) {
+            ContactPairState& pair = ws.pairs[list[k]];
+            if (!pair.contacted) continue;
+            impulses[island] += ws.updatePair(pair, ImpulseMode::ClampedContact, eps, s.contactPairIterations,
+                                              s.thickness, scratch, &change[island], &clamps[island]);
+          }
+        }
+        begin = end;
+      }
+    }
+  });
+  double energyAfter = 0;
+  for (const auto& b : ws.bodies) energyAfter += b.kineticEnergy();
+  ws.unpack(false);
+  int total = 0, clampCount = 0;
+  for (int n : impulses) total += n;
+  for (int n : clamps) clampCount += n;
+  ctx.diagnostics.set("velocity_contact_impulses", total);
+  ctx.diagnostics.set("velocity_contact_energy_clamps", clampCount);
+  ctx.diagnostics.set("velocity_contact_energy_change", (energyAfter - energyBefore) / std::max(energyBefore, 1e-12));
+  ctx.diagnostics.set("velocity_contact_energy_change_absolute", energyAfter - energyBefore);
+}
+
+template <int d>
+std::vector<std::unique_ptr<System<d>>> makeRigidContactSystems() {
+  auto ws = std::make_shared<ContactWorkspace<d>>();
+  std::vector<std::unique_ptr<System<d>>> v;
+  v.push_back(std::make_unique<Collisions<d>>(ws));
+  v.push_back(std::make_unique<Contact<d>>(ws));
+  v.push_back(std::make_unique<ShockPropagation<d>>(ws));
+  v.push_back(std::make_unique<ResolveInterpenetration<d>>(ws));
+  v.push_back(std::make_unique<VelocityContact<d>>(ws));
+  return v;
+}
+
+template class VelocityContact<2>;
+template class VelocityContact<3>;
+template std::vector<std::unique_ptr<System<2>>> makeRigidContactSystems<2>();
+template std::vector<std::unique_ptr<System<3>>> makeRigidContactSystems<3>();
+
+}  // namespace monolith

@@ -1,0 +1,675 @@
+// Narrow phase and collision geometry (issue 3): contact points, normals and depths checked
+// against closed-form values for every shape pair, the normal convention (out of B towards A,
+// flipped with the argument order), manifolds for face contacts, the margin, validation,
+// determinism and thread safety.
+#include "solvers/collision/geometry.h"
+#include "solvers/collision/narrow_phase.h"
+
+#include <fcl/geometry/shape/box.h>
+#include <fcl/geometry/shape/capsule.h>
+#include <fcl/narrowphase/collision.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+namespace {
+
+using namespace monolith::solvers::collision;
+using Vec3 = Eigen::Vector3d;
+using Vec2 = Eigen::Vector2d;
+using Mat3 = Eigen::Matrix3d;
+
+constexpr double kTight = 1e-9;
+const double kSqrt2 = std::sqrt(2.0);
+constexpr double kPi = 3.14159265358979323846;
+
+// --- shapes and poses ----------------------------------------------------------------------
+Geometry<3> box3(double hx, double hy, double hz) {
+  Geometry<3> g;
+  g.type = GeometryType::Box;
+  g.halfExtents = Vec3(hx, hy, hz);
+  return g;
+}
+Geometry<3> sphere3(double r) {
+  Geometry<3> g;
+  g.type = GeometryType::Sphere;
+  g.radius = r;
+  return g;
+}
+Geometry<3> capsule3(double r, double h) {
+  Geometry<3> g;
+  g.type = GeometryType::Capsule;
+  g.radius = r;
+  g.halfHeight = h;
+  return g;
+}
+Geometry<3> cylinder3(double r, double h) {
+  Geometry<3> g = capsule3(r, h);
+  g.type = GeometryType::Cylinder;
+  return g;
+}
+template <int d>
+Geometry<d> halfSpace(const Eigen::Matrix<double, d, 1>& n, double offset) {
+  Geometry<d> g;
+  g.type = GeometryType::HalfSpace;
+  g.normal = n;
+  g.offset = offset;
+  return g;
+}
+// Cube corners in a scrambled order plus interior points: the hull must drop the latter.
+Geometry<3> convexCube(double h) {
+  Geometry<3> g;
+  g.type = GeometryType::Convex;
+  for (int c : {5, 0, 3, 6, 1, 7, 2, 4}) g.vertices.push_back(Vec3(c & 1 ? h : -h, c & 2 ? h : -h, c & 4 ? h : -h));
+  g.vertices.push_back(Vec3::Zero());
+  g.vertices.push_back(Vec3(0.5 * h, 0, h));  // on a face
+  return g;
+}
+// Square ground [-5, 5]^2 at y = 0, two triangles facing +y.
+Geometry<3> groundMesh() {
+  Geometry<3> g;
+  g.type = GeometryType::Mesh;
+  g.vertices = {Vec3(-5, 0, -5), Vec3(5, 0, -5), Vec3(5, 0, 5), Vec3(-5, 0, 5)};
+  g.triangles = {{0, 2, 1}, {0, 3, 2}};
+  return g;
+}
+Geometry<2> box2(double hx, double hy) {
+  Geometry<2> g;
+  g.type = GeometryType::Box;
+  g.halfExtents = Vec2(hx, hy);
+  return g;
+}
+Geometry<2> disk(double r) {
+  Geometry<2> g;
+  g.type = GeometryType::Sphere;
+  g.radius = r;
+  return g;
+}
+
+Pose<3> at(const Vec3& x, const Mat3& R = Mat3::Identity()) {
+  Pose<3> p;
+  p.x = x;
+  p.R = R;
+  return p;
+}
+Pose<2> at2(const Vec2& x, double angle = 0) {
+  Pose<2> p;
+  p.x = x;
+  p.R = Eigen::Rotation2Dd(angle).toRotationMatrix();
+  return p;
+}
+Mat3 rot(double angle, const Vec3& axis) { return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix(); }
+
+template <int d>
+std::vector<ContactPoint<d>> contacts(const Geometry<d>& a, const Pose<d>& pa, const Geometry<d>& b, const Pose<d>& pb,
+                                      double margin = 0, int maxPoints = 8) {
+  const PreparedGeometry<d> ga(a), gb(b);
+  ContactQuery q;
+  q.margin = margin;
+  q.maxPoints = maxPoints;
+  std::vector<ContactPoint<d>> out;
+  const int n = findContacts<d>(ga, pa, gb, pb, q, out);
+  EXPECT_EQ(n, static_cast<int>(out.size()));
+  return out;
+}
+
+// Every contact has this normal and depth, and the points are exactly `expected` (any order).
+template <int d>
+void expectManifold(const std::vector<ContactPoint<d>>& got, const std::vector<Eigen::Matrix<double, d, 1>>& expected,
+                    const Eigen::Matrix<double, d, 1>& normal, double depth, double tol = kTight) {
+  ASSERT_EQ(got.size(), expected.size());
+  std::vector<char> used(got.size(), 0);
+  for (const auto& e : expected) {
+    bool found = false;
+    for (std::size_t i = 0; i < got.size() && !found; ++i)
+      if (!used[i] && (got[i].point - e).norm() < tol) used[i] = 1, found = true;
+    EXPECT_TRUE(found) << "missing contact point " << e.transpose();
+  }
+  for (const auto& c : got) {
+    EXPECT_NEAR((c.normal - normal).norm(), 0, tol) << c.normal.transpose();
+    EXPECT_NEAR(c.depth, depth, tol);
+    EXPECT_NEAR(c.normal.norm(), 1, 1e-12);
+  }
+}
+
+std::vector<Vec3> boxCornersXZ(double hx, double hz, double y, const Mat3& R = Mat3::Identity(), const Vec3& c = Vec3::Zero()) {
+  std::vector<Vec3> out;
+  for (double sx : {-1, 1})
+    for (double sz : {-1, 1}) {
+      Vec3 p = R * Vec3(sx * hx, 0, sz * hz) + c;
+      p.y() = y;
+      out.push_back(p);
+    }
+  return out;
+}
+
+// --- FCL's conventions our glue relies on (narrow_phase_fcl.cpp) ----------------------------
+TEST(FclConvention, ContactNormalPointsFromFirstToSecondObject) {
+  // Box o1 above box o2, overlapping by 0.01: FCL 0.7's normal is (0,-1,0), from o1 to o2, and
+  // box-box puts the point midway between the faces.
+  fcl::Boxd box(1, 1, 1);
+  fcl::Transform3d upper = fcl::Transform3d::Identity(), lower = fcl::Transform3d::Identity();
+  upper.translation() = Vec3(0, 0.99, 0);
+  fcl::CollisionRequestd request(4, true);
+  fcl::CollisionResultd result;
+  fcl::collide(&box, upper, &box, lower, request, result);
+  ASSERT_EQ(result.numContacts(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_NEAR((result.getContact(i).normal - Vec3(0, -1, 0)).norm(), 0, kTight);
+    EXPECT_NEAR(result.getContact(i).penetration_depth, 0.01, kTight);
+    EXPECT_NEAR(result.getContact(i).pos.y(), 0.495, kTight);
+  }
+  // The same through libccd's MPR (capsule over box).
+  fcl::Capsuled capsule(0.2, 1.0);
+  fcl::Transform3d above = fcl::Transform3d::Identity();
+  above.translation() = Vec3(0, 0.69, 0);
+  fcl::CollisionResultd mpr;
+  fcl::collide(&capsule, above, &box, lower, request, mpr);
+  ASSERT_EQ(mpr.numContacts(), 1u);
+  EXPECT_LT(mpr.getContact(0).normal.y(), -0.999);
+}
+
+// --- half-space pairs ------------------------------------------------------------------------
+TEST(NarrowPhase3, BoxRestingOnHalfSpaceGivesItsFourBottomCorners) {
+  const auto got = contacts<3>(box3(0.5, 0.5, 0.5), at(Vec3(0, 0.49, 0)), halfSpace<3>(Vec3::UnitY(), 0), at(Vec3::Zero()));
+  expectManifold<3>(got, boxCornersXZ(0.5, 0.5, -0.005), Vec3::UnitY(), 0.01);
+  for (const auto& c : got) {
+    EXPECT_NEAR(c.pointOnA().y(), -0.01, kTight);  // the box corner
+    EXPECT_NEAR(c.pointOnB().y(), 0.0, kTight);    // on the plane
+  }
+  // Swapped arguments: same points, normal out of the box (now B) towards the ground (A).
+  const auto swapped = contacts<3>(halfSpace<3>(Vec3::UnitY(), 0), at(Vec3::Zero()), box3(0.5, 0.5, 0.5), at(Vec3(0, 0.49, 0)));
+  expectManifold<3>(swapped, boxCornersXZ(0.5, 0.5, -0.005), -Vec3::UnitY(), 0.01);
+}
+
+TEST(NarrowPhase3, HalfSpaceNormalIsNormalisedAndPosed) {
+  // Body normal (0,0,2) with offset 1 (= z <= 0.5), rotated so that body z is world y, moved
+  // down by 0.5: the world plane is y <= 0 again.
+  const Mat3 R = rot(-kPi / 2, Vec3::UnitX());
+  ASSERT_NEAR((R * Vec3::UnitZ() - Vec3::UnitY()).norm(), 0, 1e-15);
+  const auto got = contacts<3>(box3(0.5, 0.5, 0.5), at(Vec3(0, 0.49, 0)), halfSpace<3>(Vec3(0, 0, 2), 1), at(Vec3(0, -0.5, 0), R));
+  expectManifold<3>(got, boxCornersXZ(0.5, 0.5, -0.005), Vec3::UnitY(), 0.01, 1e-12);
+}
+
+TEST(NarrowPhase3, TiltedBoxOnHalfSpaceTouchesWithOneEdge) {
+  // Rotated 45 degrees about z: the lowest edge runs along z at y = yc - sqrt(2)/2.
+  const double yc = kSqrt2 / 2 - 0.02;
+  const auto got = contacts<3>(box3(0.5, 0.5, 0.5), at(Vec3(0, yc, 0), rot(kPi / 4, Vec3::UnitZ())), halfSpace<3>(Vec3::UnitY(), 0), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(0, -0.01, -0.5), Vec3(0, -0.01, 0.5)}, Vec3::UnitY(), 0.02, 1e-12);
+}
+
+TEST(NarrowPhase3, ConvexCubeOnHalfSpaceMatchesTheBox) {
+  const auto got = contacts<3>(convexCube(0.5), at(Vec3(0, 0.49, 0)), halfSpace<3>(Vec3::UnitY(), 0), at(Vec3::Zero()));
+  expectManifold<3>(got, boxCornersXZ(0.5, 0.5, -0.005), Vec3::UnitY(), 0.01);
+}
+
+TEST(NarrowPhase3, CapsuleLyingOnHalfSpaceGivesBothEnds) {
+  const auto got = contacts<3>(capsule3(0.2, 0.5), at(Vec3(0, 0.19, 0)), halfSpace<3>(Vec3::UnitY(), 0), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(0, -0.005, -0.5), Vec3(0, -0.005, 0.5)}, Vec3::UnitY(), 0.01);
+}
+
+TEST(NarrowPhase3, CylinderStandingOnHalfSpaceGivesFourRimPoints) {
+  // Axis (body z) turned to world y; without a preferred rim direction the points are at body
+  // +-x and +-y, i.e. world +-x and +-z.
+  const Mat3 R = rot(-kPi / 2, Vec3::UnitX());
+  const auto got = contacts<3>(cylinder3(0.2, 0.5), at(Vec3(0, 0.49, 0), R), halfSpace<3>(Vec3::UnitY(), 0), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(0.2, -0.005, 0), Vec3(-0.2, -0.005, 0), Vec3(0, -0.005, 0.2), Vec3(0, -0.005, -0.2)},
+                    Vec3::UnitY(), 0.01, 1e-12);
+}
+
+TEST(NarrowPhase3, CylinderLyingOnHalfSpaceGivesOnePointPerCap) {
+  const auto got = contacts<3>(cylinder3(0.2, 0.5), at(Vec3(1, 0.19, 2)), halfSpace<3>(Vec3::UnitY(), 0), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(1, -0.005, 1.5), Vec3(1, -0.005, 2.5)}, Vec3::UnitY(), 0.01, 1e-12);
+}
+
+TEST(NarrowPhase3, SphereOnHalfSpace) {
+  const auto got = contacts<3>(sphere3(0.5), at(Vec3(3, 0.45, -1)), halfSpace<3>(Vec3::UnitY(), 0), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(3, -0.025, -1)}, Vec3::UnitY(), 0.05);
+}
+
+TEST(NarrowPhase3, TwoHalfSpacesNeverCollide) {
+  EXPECT_TRUE(contacts<3>(halfSpace<3>(Vec3::UnitY(), 0), at(Vec3::Zero()), halfSpace<3>(-Vec3::UnitY(), 0), at(Vec3::Zero())).empty());
+}
+
+// --- sphere pairs (exact) --------------------------------------------------------------------
+TEST(NarrowPhase3, SphereSphereDepthAndNormalAreAnalytic) {
+  const Vec3 xa(1, 2, 3), dir = Vec3(1, -2, 2) / 3;
+  const Vec3 xb = xa - 0.9 * dir;  // radii 0.6 + 0.4 = 1: overlap 0.1
+  const auto got = contacts<3>(sphere3(0.6), at(xa), sphere3(0.4), at(xb));
+  // Surfaces: A's at xa - 0.6 dir, B's at xb + 0.4 dir; the point is their midpoint.
+  expectManifold<3>(got, {Vec3(0.5 * ((xa - 0.6 * dir) + (xb + 0.4 * dir)))}, dir, 0.1, 1e-12);
+  const auto swapped = contacts<3>(sphere3(0.4), at(xb), sphere3(0.6), at(xa));
+  expectManifold<3>(swapped, {got[0].point}, -dir, 0.1, 1e-12);
+}
+
+TEST(NarrowPhase3, SphereAgainstBoxFaceEdgeAndInside) {
+  // Above the top face.
+  auto got = contacts<3>(sphere3(0.5), at(Vec3(0.2, 0.99, 0.1)), box3(0.5, 0.5, 0.5), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(0.2, 0.495, 0.1)}, Vec3::UnitY(), 0.01);
+  // Beyond the edge x = y = 0.5: the normal points from the edge to the centre.
+  const Vec3 dir = Vec3(1, 1, 0).normalized();
+  const Vec3 edge(0.5, 0.5, 0.2);
+  got = contacts<3>(sphere3(0.3), at(edge + 0.25 * dir), box3(0.5, 0.5, 0.5), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(edge + 0.5 * (0.25 - 0.3) * dir)}, dir, 0.05, 1e-12);
+  // Centre inside the box, nearest face x = 0.5 at distance 0.1: depth = r + 0.1.
+  got = contacts<3>(sphere3(0.2), at(Vec3(0.4, 0, 0)), box3(0.5, 0.5, 0.5), at(Vec3::Zero()));
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_NEAR((got[0].normal - Vec3::UnitX()).norm(), 0, kTight);
+  EXPECT_NEAR(got[0].depth, 0.3, kTight);
+}
+
+TEST(NarrowPhase3, SphereAgainstCapsuleCylinderAndConvex) {
+  // Capsule along z: a sphere beside its middle.
+  auto got = contacts<3>(sphere3(0.3), at(Vec3(0.45, 0, 0.1)), capsule3(0.2, 0.5), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(0.175, 0, 0.1)}, Vec3::UnitX(), 0.05);
+  // Cylinder along z: a sphere on its cap.
+  got = contacts<3>(sphere3(0.3), at(Vec3(0.05, 0, 0.78)), cylinder3(0.2, 0.5), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(0.05, 0, 0.49)}, Vec3::UnitZ(), 0.02);
+  // Convex cube, sphere beyond a vertex: the normal points from the vertex to the centre.
+  const Vec3 dir = Vec3(1, 1, 1).normalized();
+  const Vec3 corner = Vec3::Constant(0.5);
+  got = contacts<3>(sphere3(0.3), at(corner + 0.2 * dir), convexCube(0.5), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(corner - 0.05 * dir)}, dir, 0.1, 1e-12);
+}
+
+TEST(NarrowPhase3, SphereOnTriangleMeshGround) {
+  // Inside one triangle, and on the diagonal shared by both (one point, not two).
+  for (const Vec3& x : {Vec3(0.3, 0.49, 0.1), Vec3(1, 0.47, 1)}) {
+    const double depth = 0.5 - x.y();
+    const auto got = contacts<3>(sphere3(0.5), at(x), groundMesh(), at(Vec3::Zero()));
+    expectManifold<3>(got, {Vec3(x.x(), -0.5 * depth, x.z())}, Vec3::UnitY(), depth, 1e-9);
+  }
+  // Posed mesh (moved and turned about y), swapped arguments.
+  const Pose<3> ground = at(Vec3(10, -2, 3), rot(0.7, Vec3::UnitY()));
+  const auto got = contacts<3>(groundMesh(), ground, sphere3(0.5), at(Vec3(10.3, -1.52, 3.2)));
+  expectManifold<3>(got, {Vec3(10.3, -2.01, 3.2)}, -Vec3::UnitY(), 0.02, 1e-9);
+}
+
+// --- box pairs (FCL) ---------------------------------------------------------------------------
+TEST(NarrowPhase3, SmallBoxRestingOnBoxGivesFourCorners) {
+  const auto got = contacts<3>(box3(0.3, 0.3, 0.3), at(Vec3(0.1, 0.79, -0.05)), box3(0.5, 0.5, 0.5), at(Vec3::Zero()));
+  std::vector<Vec3> corners = boxCornersXZ(0.3, 0.3, 0.495, Mat3::Identity(), Vec3(0.1, 0, -0.05));
+  expectManifold<3>(got, corners, Vec3::UnitY(), 0.01);
+  const auto swapped = contacts<3>(box3(0.5, 0.5, 0.5), at(Vec3::Zero()), box3(0.3, 0.3, 0.3), at(Vec3(0.1, 0.79, -0.05)));
+  expectManifold<3>(swapped, corners, -Vec3::UnitY(), 0.01);
+}
+
+TEST(NarrowPhase3, RotatedBoxOnBoxGivesItsRotatedCorners) {
+  const Mat3 R = rot(kPi / 6, Vec3::UnitY());
+  const auto got = contacts<3>(box3(0.3, 0.2, 0.3), at(Vec3(0, 1.19, 0), R), box3(1, 1, 1), at(Vec3::Zero()));
+  expectManifold<3>(got, boxCornersXZ(0.3, 0.3, 0.995, R), Vec3::UnitY(), 0.01);
+}
+
+TEST(NarrowPhase3, BoxEdgeCrossingBoxEdge) {
+  // A turned 45 degrees about z (lowest edge along z), B turned 45 degrees about x (highest edge
+  // along x): the edges cross at the origin's vertical with depth sqrt(2) - yA. No vertex of
+  // either box is inside the other. The whole scene is then moved rigidly, which must move the
+  // contact with it.
+  const double depth = 0.01, yA = kSqrt2 - depth;
+  const Mat3 Q = rot(0.8, Vec3(1, 2, -0.5));
+  const Vec3 t(3, -1, 2);
+  const auto got = contacts<3>(box3(0.5, 0.5, 0.5), at(Q * Vec3(0, yA, 0) + t, Q * rot(kPi / 4, Vec3::UnitZ())),
+                               box3(0.5, 0.5, 0.5), at(t, Q * rot(kPi / 4, Vec3::UnitX())));
+  ASSERT_GE(got.size(), 1u);
+  for (const auto& c : got) {
+    EXPECT_NEAR(c.depth, depth, 1e-9);
+    EXPECT_NEAR((c.normal - Q * Vec3::UnitY()).norm(), 0, 1e-9);
+    EXPECT_NEAR((c.point - (Q * Vec3(0, kSqrt2 / 2 - depth / 2, 0) + t)).norm(), 0, 1e-9);
+  }
+}
+
+TEST(NarrowPhase3, SeparatedBoxesWithinMarginReportNegativeDepth) {
+  // Gap 0.005 between a small box and a big one: four corners at depth -0.005 with margin 0.01,
+  // nothing with margin 0.001 or without margin.
+  const Pose<3> pa = at(Vec3(0, 0.805, 0)), pb = at(Vec3::Zero());
+  const auto got = contacts<3>(box3(0.3, 0.3, 0.3), pa, box3(0.5, 0.5, 0.5), pb, 0.01);
+  expectManifold<3>(got, boxCornersXZ(0.3, 0.3, 0.5025), Vec3::UnitY(), -0.005);
+  EXPECT_TRUE(contacts<3>(box3(0.3, 0.3, 0.3), pa, box3(0.5, 0.5, 0.5), pb, 0.001).empty());
+  EXPECT_TRUE(contacts<3>(box3(0.3, 0.3, 0.3), pa, box3(0.5, 0.5, 0.5), pb).empty());
+}
+
+TEST(NarrowPhase3, SeparatedEdgesWithinMarginUseTheDistance) {
+  // The crossing edges of BoxEdgeCrossingBoxEdge, 0.004 apart: one point from fcl::distance.
+  const auto got = contacts<3>(box3(0.5, 0.5, 0.5), at(Vec3(0, kSqrt2 + 0.004, 0), rot(kPi / 4, Vec3::UnitZ())),
+                               box3(0.5, 0.5, 0.5), at(Vec3::Zero(), rot(kPi / 4, Vec3::UnitX())), 0.01);
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_NEAR(got[0].depth, -0.004, 1e-6);
+  EXPECT_NEAR((got[0].normal - Vec3::UnitY()).norm(), 0, 1e-5);
+  EXPECT_NEAR((got[0].point - Vec3(0, kSqrt2 / 2 + 0.002, 0)).norm(), 0, 1e-5);
+}
+
+TEST(NarrowPhase3, MarginAroundHalfSpacesAndSpheres) {
+  const Geometry<3> ground = halfSpace<3>(Vec3::UnitY(), 0);
+  auto got = contacts<3>(box3(0.5, 0.5, 0.5), at(Vec3(0, 0.503, 0)), ground, at(Vec3::Zero()), 0.005);
+  expectManifold<3>(got, boxCornersXZ(0.5, 0.5, 0.0015), Vec3::UnitY(), -0.003);
+  EXPECT_TRUE(contacts<3>(box3(0.5, 0.5, 0.5), at(Vec3(0, 0.503, 0)), ground, at(Vec3::Zero()), 0.002).empty());
+  got = contacts<3>(sphere3(0.5), at(Vec3(0, 1.004, 0)), sphere3(0.5), at(Vec3::Zero()), 0.01);
+  expectManifold<3>(got, {Vec3(0, 0.502, 0)}, Vec3::UnitY(), -0.004);
+  EXPECT_TRUE(contacts<3>(sphere3(0.5), at(Vec3(0, 1.004, 0)), sphere3(0.5), at(Vec3::Zero()), 0.003).empty());
+}
+
+// --- convex hulls -----------------------------------------------------------------------------
+TEST(NarrowPhase3, ConvexCubeRestingOnConvexCube) {
+  const Geometry<3> small = convexCube(0.3), big = convexCube(0.5);
+  const auto got = contacts<3>(small, at(Vec3(0.1, 0.79, 0)), big, at(Vec3::Zero()));
+  expectManifold<3>(got, boxCornersXZ(0.3, 0.3, 0.495, Mat3::Identity(), Vec3(0.1, 0, 0)), Vec3::UnitY(), 0.01);
+  // Mixed with a box, both orders.
+  expectManifold<3>(contacts<3>(small, at(Vec3(0.1, 0.79, 0)), box3(0.5, 0.5, 0.5), at(Vec3::Zero())),
+                    boxCornersXZ(0.3, 0.3, 0.495, Mat3::Identity(), Vec3(0.1, 0, 0)), Vec3::UnitY(), 0.01);
+  expectManifold<3>(contacts<3>(box3(0.5, 0.5, 0.5), at(Vec3::Zero()), small, at(Vec3(0.1, 0.79, 0))),
+                    boxCornersXZ(0.3, 0.3, 0.495, Mat3::Identity(), Vec3(0.1, 0, 0)), -Vec3::UnitY(), 0.01);
+}
+
+TEST(NarrowPhase3, ConvexWithinMarginOfConvex) {
+  const auto got = contacts<3>(convexCube(0.3), at(Vec3(0, 0.806, 0)), convexCube(0.5), at(Vec3::Zero()), 0.01);
+  expectManifold<3>(got, boxCornersXZ(0.3, 0.3, 0.503), Vec3::UnitY(), -0.006, 1e-9);
+}
+
+TEST(NarrowPhase3, TetrahedronCornerIntoBox) {
+  // A tetrahedron pointing down with its tip 0.03 into the top face of a box: one point.
+  Geometry<3> tet;
+  tet.type = GeometryType::Convex;
+  tet.vertices = {Vec3(0, -0.3, 0), Vec3(0.3, 0.2, 0), Vec3(-0.2, 0.2, 0.25), Vec3(-0.2, 0.2, -0.25)};
+  const auto got = contacts<3>(tet, at(Vec3(0.1, 0.77, 0.05)), box3(0.5, 0.5, 0.5), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(0.1, 0.485, 0.05)}, Vec3::UnitY(), 0.03, 1e-9);
+}
+
+// --- capsules and cylinders against other shapes ----------------------------------------------
+TEST(NarrowPhase3, CapsulesSideBySideAndCrossed) {
+  // Parallel along z, one above the other: the two end caps.
+  auto got = contacts<3>(capsule3(0.2, 0.5), at(Vec3(0, 0.39, 0)), capsule3(0.2, 0.5), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(0, 0.195, -0.5), Vec3(0, 0.195, 0.5)}, Vec3::UnitY(), 0.01);
+  // Crossed (A along x): one point between the axes.
+  got = contacts<3>(capsule3(0.2, 0.5), at(Vec3(0.1, 0.38, 0.2), rot(kPi / 2, Vec3::UnitY())), capsule3(0.2, 0.5), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(0, 0.19, 0.2)}, Vec3::UnitY(), 0.02);
+}
+
+TEST(NarrowPhase3, CapsuleLyingOnBoxGivesBothEnds) {
+  const auto got = contacts<3>(capsule3(0.2, 0.4), at(Vec3(0.1, 0.69, 0)), box3(0.5, 0.5, 0.5), at(Vec3::Zero()));
+  expectManifold<3>(got, {Vec3(0.1, 0.495, -0.4), Vec3(0.1, 0.495, 0.4)}, Vec3::UnitY(), 0.01, 1e-9);
+}
+
+TEST(NarrowPhase3, CylinderStandingOnBoxGivesRimPoints) {
+  const Mat3 R = rot(-kPi / 2, Vec3::UnitX());
+  const auto got = contacts<3>(cylinder3(0.2, 0.3), at(Vec3(0.1, 0.79, 0), R), box3(0.5, 0.5, 0.5), at(Vec3::Zero()));
+  ASSERT_GE(got.size(), 3u);
+  for (const auto& c : got) {
+    EXPECT_NEAR(c.depth, 0.01, 1e-9);
+    EXPECT_NEAR((c.normal - Vec3::UnitY()).norm(), 0, 1e-9);
+    EXPECT_NEAR(c.point.y(), 0.495, 1e-9);
+    EXPECT_LE(std::hypot(c.point.x() - 0.1, c.point.z()), 0.2 + 1e-9);
+  }
+}
+
+TEST(NarrowPhase3, BoxOnTriangleMeshGroundGivesFourCorners) {
+  const Mat3 R = rot(0.3, Vec3::UnitY());
+  const auto got = contacts<3>(box3(0.4, 0.5, 0.3), at(Vec3(0.2, 0.49, -0.1), R), groundMesh(), at(Vec3::Zero()));
+  expectManifold<3>(got, boxCornersXZ(0.4, 0.3, -0.005, R, Vec3(0.2, 0, -0.1)), Vec3::UnitY(), 0.01, 1e-9);
+}
+
+// --- general behaviour ---------------------------------------------------------------------------
+TEST(NarrowPhase3, ManifoldIsCappedKeepingTheDeepestAndTheSpread) {
+  // A slightly tilted box: four corners in, the deepest must survive a cap of 2, with the
+  // farthest one from it (the diagonal corner).
+  const Mat3 R = rot(0.01, Vec3(1, 0, 1));
+  const auto all = contacts<3>(box3(0.5, 0.5, 0.5), at(Vec3(0, 0.49, 0), R), halfSpace<3>(Vec3::UnitY(), 0), at(Vec3::Zero()));
+  ASSERT_EQ(all.size(), 4u);
+  const auto two = contacts<3>(box3(0.5, 0.5, 0.5), at(Vec3(0, 0.49, 0), R), halfSpace<3>(Vec3::UnitY(), 0), at(Vec3::Zero()), 0, 2);
+  ASSERT_EQ(two.size(), 2u);
+  double deepest = 0;
+  for (const auto& c : all) deepest = std::max(deepest, c.depth);
+  EXPECT_EQ(std::max(two[0].depth, two[1].depth), deepest);
+  EXPECT_NEAR((two[0].point - two[1].point).norm(), kSqrt2, 0.02);
+}
+
+TEST(NarrowPhase3, RepeatedQueriesAreBitwiseEqual) {
+  const PreparedGeometry<3> a(convexCube(0.3)), b(box3(0.5, 0.5, 0.5));
+  const Pose<3> pa = at(Vec3(0.1, 0.75, 0.05), rot(0.3, Vec3(1, 1, 0))), pb = at(Vec3::Zero());
+  ContactQuery q;
+  q.margin = 0.01;
+  std::vector<ContactPoint<3>> first, again;
+  findContacts<3>(a, pa, b, pb, q, first);
+  ASSERT_FALSE(first.empty());
+  for (int rep = 0; rep < 5; ++rep) {
+    again.clear();
+    findContacts<3>(a, pa, b, pb, q, again);
+    ASSERT_EQ(again.size(), first.size());
+    for (std::size_t i = 0; i < first.size(); ++i) {
+      EXPECT_EQ(std::memcmp(first[i].point.data(), again[i].point.data(), sizeof(double) * 3), 0);
+      EXPECT_EQ(std::memcmp(first[i].normal.data(), again[i].normal.data(), sizeof(double) * 3), 0);
+      EXPECT_EQ(first[i].depth, again[i].depth);
+    }
+  }
+}
+
+TEST(NarrowPhase3, ConcurrentQueriesMatchSerialOnes) {
+  std::vector<std::unique_ptr<PreparedGeometry<3>>> shapes;
+  for (const auto& g : {box3(0.5, 0.3, 0.4), sphere3(0.4), capsule3(0.2, 0.4), cylinder3(0.3, 0.3), convexCube(0.4), groundMesh()})
+    shapes.push_back(std::make_unique<PreparedGeometry<3>>(g));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  struct Query {
+    int a, b;
+    Pose<3> pa, pb;
+  };
+  std::vector<Query> queries;
+  for (int i = 0; i < 400; ++i) {
+    Query q{static_cast<int>(i % shapes.size()), static_cast<int>((i / shapes.size()) % shapes.size()), {}, {}};
+    q.pa = at(0.5 * Vec3(u(rng), u(rng), u(rng)), rot(3 * u(rng), Vec3(u(rng), u(rng), u(rng) + 2)));
+    q.pb = at(0.5 * Vec3(u(rng), u(rng), u(rng)), rot(3 * u(rng), Vec3(u(rng) + 2, u(rng), u(rng))));
+    if (q.b == 5) q.pb = at(Vec3::Zero());
+    queries.push_back(q);
+  }
+  auto runAll = [&](std::vector<std::vector<ContactPoint<3>>>& results) {
+    results.assign(queries.size(), {});
+    for (std::size_t i = 0; i < queries.size(); ++i)
+      findContacts<3>(*shapes[queries[i].a], queries[i].pa, *shapes[queries[i].b], queries[i].pb, ContactQuery{0.01, 8}, results[i]);
+  };
+  std::vector<std::vector<ContactPoint<3>>> serial;
+  runAll(serial);
+  std::vector<std::vector<std::vector<ContactPoint<3>>>> parallel(4);
+  std::vector<std::thread> threads;
+  for (auto& r : parallel) threads.emplace_back([&] { runAll(r); });
+  for (auto& t : threads) t.join();
+  for (const auto& r : parallel)
+    for (std::size_t i = 0; i < queries.size(); ++i) {
+      ASSERT_EQ(r[i].size(), serial[i].size());
+      for (std::size_t k = 0; k < r[i].size(); ++k) {
+        EXPECT_EQ(r[i][k].point, serial[i][k].point);
+        EXPECT_EQ(r[i][k].depth, serial[i][k].depth);
+      }
+    }
+}
+
+TEST(NarrowPhase3, OverlapsAgreesWithContacts) {
+  const PreparedGeometry<3> b(box3(0.5, 0.5, 0.5)), s(sphere3(0.5)), g(halfSpace<3>(Vec3::UnitY(), 0)), c(capsule3(0.2, 0.5));
+  EXPECT_TRUE(overlaps<3>(b, at(Vec3(0, 0.99, 0)), b, at(Vec3::Zero())));
+  EXPECT_FALSE(overlaps<3>(b, at(Vec3(0, 1.01, 0)), b, at(Vec3::Zero())));
+  EXPECT_TRUE(overlaps<3>(s, at(Vec3(0, 0.49, 0)), g, at(Vec3::Zero())));
+  EXPECT_FALSE(overlaps<3>(s, at(Vec3(0, 0.51, 0)), g, at(Vec3::Zero())));
+  EXPECT_TRUE(overlaps<3>(g, at(Vec3::Zero()), b, at(Vec3(0, 0.49, 0))));
+  EXPECT_TRUE(overlaps<3>(c, at(Vec3(0, 0.69, 0)), b, at(Vec3::Zero())));
+  EXPECT_FALSE(overlaps<3>(c, at(Vec3(0, 0.71, 0)), b, at(Vec3::Zero())));
+  EXPECT_FALSE(overlaps<3>(g, at(Vec3::Zero()), g, at(Vec3::Zero())));
+}
+
+// --- geometry: validation, sizes, bounds --------------------------------------------------------
+TEST(CollisionGeometry, RejectsDegenerateInput) {
+  auto rejects = [](auto make) { EXPECT_THROW(make(), std::invalid_argument); };
+  rejects([] { return PreparedGeometry<3>(box3(0.5, 0, 0.5)); });
+  rejects([] { return PreparedGeometry<3>(box3(0.5, std::nan(""), 0.5)); });
+  rejects([] { return PreparedGeometry<3>(sphere3(-1)); });
+  rejects([] { return PreparedGeometry<3>(sphere3(std::numeric_limits<double>::infinity())); });
+  rejects([] { return PreparedGeometry<3>(capsule3(0.2, 0)); });
+  rejects([] { return PreparedGeometry<3>(halfSpace<3>(Vec3::Zero(), 0)); });
+  rejects([] { return PreparedGeometry<3>(halfSpace<3>(Vec3::UnitY(), std::nan(""))); });
+  rejects([] {
+    Geometry<3> flat;
+    flat.type = GeometryType::Convex;
+    flat.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, 1), Vec3(1, 0, 1)};
+    return PreparedGeometry<3>(flat);
+  });
+  rejects([] {
+    Geometry<3> m = groundMesh();
+    m.triangles.push_back({0, 1, 4});
+    return PreparedGeometry<3>(m);
+  });
+  rejects([] {
+    Geometry<3> m = groundMesh();
+    m.vertices[1].x() = std::numeric_limits<double>::infinity();
+    return PreparedGeometry<3>(m);
+  });
+  rejects([] {
+    Geometry<2> m;
+    m.type = GeometryType::Mesh;
+    return PreparedGeometry<2>(m);
+  });
+  rejects([] {
+    Geometry<2> c;
+    c.type = GeometryType::Capsule;
+    return PreparedGeometry<2>(c);
+  });
+  rejects([] {
+    Geometry<2> c;
+    c.type = GeometryType::Cylinder;
+    return PreparedGeometry<2>(c);
+  });
+  rejects([] {
+    Geometry<2> line;
+    line.type = GeometryType::Convex;
+    line.vertices = {Vec2(0, 0), Vec2(1, 1), Vec2(2, 2)};
+    return PreparedGeometry<2>(line);
+  });
+  try {
+    PreparedGeometry<3> bad(box3(-1, 1, 1));
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("box half extents"), std::string::npos) << e.what();
+  }
+}
+
+TEST(CollisionGeometry, BoundingRadiusAndMinimumSize) {
+  const PreparedGeometry<3> b(box3(1, 2, 2)), s(sphere3(0.5)), c(capsule3(0.2, 0.5)), y(cylinder3(0.3, 0.4)),
+      h(halfSpace<3>(Vec3(0, 3, 4), 10)), v(convexCube(0.5)), m(groundMesh());
+  EXPECT_DOUBLE_EQ(b.boundingRadius(), 3);
+  EXPECT_DOUBLE_EQ(b.minimumSize(), 2);
+  EXPECT_DOUBLE_EQ(s.boundingRadius(), 0.5);
+  EXPECT_DOUBLE_EQ(s.minimumSize(), 1);
+  EXPECT_DOUBLE_EQ(c.boundingRadius(), 0.7);
+  EXPECT_DOUBLE_EQ(c.minimumSize(), 0.4);
+  EXPECT_DOUBLE_EQ(y.boundingRadius(), 0.5);
+  EXPECT_DOUBLE_EQ(y.minimumSize(), 0.6);
+  EXPECT_TRUE(std::isinf(h.boundingRadius()));
+  EXPECT_TRUE(std::isinf(h.minimumSize()));
+  EXPECT_NEAR((h.geometry().normal - Vec3(0, 0.6, 0.8)).norm(), 0, 1e-15);
+  EXPECT_DOUBLE_EQ(h.geometry().offset, 2);
+  EXPECT_DOUBLE_EQ(v.boundingRadius(), std::sqrt(0.75));
+  EXPECT_DOUBLE_EQ(v.minimumSize(), 1);
+  EXPECT_DOUBLE_EQ(m.boundingRadius(), 5 * kSqrt2);
+  EXPECT_DOUBLE_EQ(m.minimumSize(), 10);  // a flat mesh: its smallest nonzero extent
+  const PreparedGeometry<2> p(box2(0.5, 0.25)), dk(disk(0.3));
+  EXPECT_DOUBLE_EQ(p.minimumSize(), 0.5);
+  EXPECT_DOUBLE_EQ(dk.boundingRadius(), 0.3);
+}
+
+TEST(CollisionGeometry, WorldBounds) {
+  const Mat3 R = rot(kPi / 4, Vec3::UnitZ());
+  auto bb = worldBounds<3>(PreparedGeometry<3>(box3(0.5, 0.5, 0.5)), at(Vec3(1, 2, 3), R));
+  EXPECT_NEAR((bb.min() - Vec3(1 - kSqrt2 / 2, 2 - kSqrt2 / 2, 2.5)).norm(), 0, 1e-12);
+  EXPECT_NEAR((bb.max() - Vec3(1 + kSqrt2 / 2, 2 + kSqrt2 / 2, 3.5)).norm(), 0, 1e-12);
+  bb = worldBounds<3>(PreparedGeometry<3>(capsule3(0.2, 0.5)), at(Vec3::Zero()));
+  EXPECT_NEAR((bb.max() - Vec3(0.2, 0.2, 0.7)).norm(), 0, 1e-15);
+  bb = worldBounds<3>(PreparedGeometry<3>(cylinder3(0.2, 0.5)), at(Vec3::Zero(), rot(kPi / 2, Vec3::UnitX())));
+  EXPECT_NEAR((bb.max() - Vec3(0.2, 0.5, 0.2)).norm(), 0, 1e-12);
+  bb = worldBounds<3>(PreparedGeometry<3>(convexCube(0.5)), at(Vec3(1, 0, 0)));
+  EXPECT_NEAR((bb.min() - Vec3(0.5, -0.5, -0.5)).norm(), 0, 1e-15);
+  bb = worldBounds<3>(PreparedGeometry<3>(halfSpace<3>(Vec3::UnitY(), 0)), at(Vec3::Zero()));
+  EXPECT_LE(bb.min().maxCoeff(), -1e29);
+  EXPECT_GE(bb.max().minCoeff(), 1e29);
+  const auto b2 = worldBounds<2>(PreparedGeometry<2>(disk(0.5)), at2(Vec2(1, 1)));
+  EXPECT_NEAR((b2.min() - Vec2(0.5, 0.5)).norm(), 0, 1e-15);
+}
+
+// --- 2-D ----------------------------------------------------------------------------------------
+TEST(NarrowPhase2, DiskDisk) {
+  const Vec2 dir = Vec2(3, 4) / 5;
+  const auto got = contacts<2>(disk(0.5), at2(Vec2(1, 1) + 0.9 * dir), disk(0.5), at2(Vec2(1, 1)));
+  expectManifold<2>(got, {Vec2(Vec2(1, 1) + 0.45 * dir)}, dir, 0.1, 1e-12);
+}
+
+TEST(NarrowPhase2, BoxOnHalfPlaneGivesTwoCorners) {
+  const auto got = contacts<2>(box2(0.5, 0.25), at2(Vec2(2, 0.24)), halfSpace<2>(Vec2::UnitY(), 0), at2(Vec2::Zero()));
+  expectManifold<2>(got, {Vec2(1.5, -0.005), Vec2(2.5, -0.005)}, Vec2::UnitY(), 0.01);
+  const auto swapped = contacts<2>(halfSpace<2>(Vec2::UnitY(), 0), at2(Vec2::Zero()), box2(0.5, 0.25), at2(Vec2(2, 0.24)));
+  expectManifold<2>(swapped, {Vec2(1.5, -0.005), Vec2(2.5, -0.005)}, -Vec2::UnitY(), 0.01);
+}
+
+TEST(NarrowPhase2, BoxOnBoxGivesTwoClippedPoints) {
+  // A (half width 0.5) overhangs B (half width 1) on the right: clipped to x in [0.7, 1].
+  const auto got = contacts<2>(box2(0.5, 0.5), at2(Vec2(1.2, 1.49)), box2(1, 1), at2(Vec2::Zero()));
+  expectManifold<2>(got, {Vec2(0.7, 0.995), Vec2(1.0, 0.995)}, Vec2::UnitY(), 0.01);
+  const auto swapped = contacts<2>(box2(1, 1), at2(Vec2::Zero()), box2(0.5, 0.5), at2(Vec2(1.2, 1.49)));
+  expectManifold<2>(swapped, {Vec2(0.7, 0.995), Vec2(1.0, 0.995)}, -Vec2::UnitY(), 0.01);
+}
+
+TEST(NarrowPhase2, RotatedPolygonCornerIntoBox) {
+  // A square turned 45 degrees, its lowest corner 0.03 below the top of the box: one point.
+  const double depth = 0.03;
+  const auto got = contacts<2>(box2(0.5, 0.5), at2(Vec2(0.2, 1 + kSqrt2 / 2 - depth), kPi / 4), box2(1, 1), at2(Vec2::Zero()));
+  expectManifold<2>(got, {Vec2(0.2, 1 - depth / 2)}, Vec2::UnitY(), depth, 1e-12);
+}
+
+TEST(NarrowPhase2, DiskOnPolygonAndConvexHullInput) {
+  // A triangle given clockwise with a duplicate and an interior point; a disk on its top edge.
+  Geometry<2> tri;
+  tri.type = GeometryType::Convex;
+  tri.vertices = {Vec2(-1, 0), Vec2(0, 1), Vec2(1, 0), Vec2(0, 0.2), Vec2(1, 0)};
+  auto got = contacts<2>(disk(0.2), at2(Vec2(-0.45, 0.55 + 0.19 * kSqrt2)), tri, at2(Vec2::Zero()));
+  const Vec2 n = Vec2(-1, 1) / kSqrt2;
+  // The edge y = x + 1 passes (-0.45, 0.55); the centre is 0.19 from it along n... plus the
+  // vertical offset: distance = (0.19 sqrt2)/sqrt2 = 0.19, depth 0.01.
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_NEAR(got[0].depth, 0.01, 1e-12);
+  EXPECT_NEAR((got[0].normal - n).norm(), 0, 1e-12);
+  // Polygon vs polygon: the triangle's apex into a box from below.
+  got = contacts<2>(tri, at2(Vec2(0.3, -0.98)), box2(1, 0.5), at2(Vec2(0, 0.5)));
+  expectManifold<2>(got, {Vec2(0.3, 0.01)}, -Vec2::UnitY(), 0.02, 1e-12);
+}
+
+TEST(NarrowPhase2, MarginAndSeparatedCorners) {
+  // Box above a half-plane with a gap of 0.004: two points at depth -0.004 with margin 0.01.
+  auto got = contacts<2>(box2(0.5, 0.5), at2(Vec2(0, 0.504)), halfSpace<2>(Vec2::UnitY(), 0), at2(Vec2::Zero()), 0.01);
+  expectManifold<2>(got, {Vec2(-0.5, 0.002), Vec2(0.5, 0.002)}, Vec2::UnitY(), -0.004, 1e-12);
+  // Box above a box, gap 0.004: the two clipped points.
+  got = contacts<2>(box2(0.5, 0.5), at2(Vec2(0.2, 1.504)), box2(1, 1), at2(Vec2::Zero()), 0.01);
+  expectManifold<2>(got, {Vec2(-0.3, 1.002), Vec2(0.7, 1.002)}, Vec2::UnitY(), -0.004, 1e-12);
+  EXPECT_TRUE(contacts<2>(box2(0.5, 0.5), at2(Vec2(0.2, 1.504)), box2(1, 1), at2(Vec2::Zero()), 0.003).empty());
+  // Corner to corner across a diagonal gap of 0.005: no clipped point, the exact distance.
+  const Vec2 gap = Vec2(1, 1).normalized() * 0.005;
+  got = contacts<2>(box2(0.5, 0.5), at2(Vec2(1.5, 1.5) + gap), box2(1, 1), at2(Vec2::Zero()), 0.01);
+  expectManifold<2>(got, {Vec2(Vec2(1, 1) + 0.5 * gap)}, Vec2(1, 1).normalized(), -0.005, 1e-12);
+  EXPECT_TRUE(contacts<2>(box2(0.5, 0.5), at2(Vec2(1.5, 1.5) + gap), box2(1, 1), at2(Vec2::Zero()), 0.004).empty());
+}
+
+TEST(NarrowPhase2, OverlapsAndDeterminism) {
+  const PreparedGeometry<2> a(box2(0.5, 0.5)), b(box2(1, 1));
+  EXPECT_TRUE(overlaps<2>(a, at2(Vec2(0, 1.49), 0.1), b, at2(Vec2::Zero())));
+  EXPECT_FALSE(overlaps<2>(a, at2(Vec2(0, 1.51)), b, at2(Vec2::Zero())));
+  std::vector<ContactPoint<2>> first, again;
+  findContacts<2>(a, at2(Vec2(0.1, 1.45), 0.2), b, at2(Vec2::Zero()), ContactQuery{}, first);
+  findContacts<2>(a, at2(Vec2(0.1, 1.45), 0.2), b, at2(Vec2::Zero()), ContactQuery{}, again);
+  ASSERT_EQ(first.size(), again.size());
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    EXPECT_EQ(first[i].point, again[i].point);
+    EXPECT_EQ(first[i].normal, again[i].normal);
+    EXPECT_EQ(first[i].depth, again[i].depth);
+  }
+}
+
+}  // namespace
