@@ -44,29 +44,10 @@ template <int d>
 void ShockPropagation<d>::run(World<d>&, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (ws.bodies.empty()) return;
-  const ContactSettings& s = ws.settings;
-  std::vector<int> impulses(ws.islands.members.size(), 0);
+    std::vector<int> impulses(ws.islands.members.size(), 0);
   ws.forEachIsland([&](int island) {
     std::vector<solvers::collision::ContactPoint<d>> scratch;
-    const auto& list = ws.islandPairsByLevel[island];
-    for (std::size_t begin = 0; begin < list.size();) {
-      const int level = ws.pairs[list[begin]].level;
-      std::size_t end = begin;
-      while (end < list.size() && ws.pairs[list[end]].level == level) ++end;
-      for (int li = 0; li < s.shockLevelIterations; ++li) {
-        const double eps = double(li + 1) / double(s.shockLevelIterations);
-        for (std::size_t k = begin; k < end; ++k)
-          impulses[island] += ws.updatePair(ws.pairs[list[k]], ImpulseMode::Contact, eps, s.shockPairIterations,
-                                            s.thickness, scratch, nullptr, nullptr);
-      }
-      for (std::size_t k = begin; k < end; ++k) {
-        const ContactPairState& p = ws.pairs[list[k]];
-        if (ws.levels.levelOf[p.a] == level) ws.bodies[p.a].frozen = true;
-        if (ws.levels.levelOf[p.b] == level) ws.bodies[p.b].frozen = true;
-      }
-      begin = end;
-    }
-    for (int m : ws.islands.members[island]) ws.bodies[m].frozen = false;
+    impulses[island] = ws.propagateShock(island, ImpulseMode::Contact, false, scratch, nullptr, nullptr);
   });
   ws.unpack(false);
   int total = 0;

@@ -189,7 +189,6 @@ void ContactWorkspace<d>::computeLevels() {
   // advanced with its old one (notes 1.6). Bodies of infinite mass are never re-advanced, so
   // they end up at the bottom.
   std::vector<std::pair<int, int>> edges;
-  col::Pose<d> oldA, oldB, newA, newB;
   auto poseWith = [&](const ContactBody<d>& b, double k) {
     col::Pose<d> p;
     if (b.isStatic) {
@@ -201,16 +200,30 @@ void ContactWorkspace<d>::computeLevels() {
     p.R = rotationOf<d>(rotated<d>(b.q0, dt * (b.inverseInertia0 * (b.L + k * b.dL))));
     return p;
   };
-  for (const ContactPairState& pair : pairs) {
-    if (!pair.processed) continue;
+  // The same test also completes the processed list (notes 1.4, "contact pairs" gathered on the
+  // last collision sweep): bodies resting on each other fall together in the candidate
+  // positions, so only moving one of them with its new velocity shows that they touch. A
+  // separation within the contact thickness counts as touching.
+  std::vector<col::ContactPoint<d>> scratch;
+  col::ContactQuery query;
+  query.margin = settings.thickness;
+  query.maxPoints = 1;
+  auto touches = [&](const ContactBody<d>& mover, const ContactBody<d>& other) {
+    scratch.clear();
+    return col::findContacts(*mover.geometry, poseWith(mover, 1.0), *other.geometry, poseWith(other, 0.0), query,
+                             scratch) > 0;
+  };
+  for (ContactPairState& pair : pairs) {
     const ContactBody<d>& A = bodies[pair.a];
     const ContactBody<d>& B = bodies[pair.b];
-    if (!(A.isStatic || A.kinematic) &&
-        col::overlaps(*A.geometry, poseWith(A, 1.0), *B.geometry, poseWith(B, 0.0)))
+    if (!(A.isStatic || A.kinematic) && touches(A, B)) {
       edges.emplace_back(pair.b, pair.a);
-    if (!(B.isStatic || B.kinematic) &&
-        col::overlaps(*B.geometry, poseWith(B, 1.0), *A.geometry, poseWith(A, 0.0)))
+      pair.processed = true;
+    }
+    if (!(B.isStatic || B.kinematic) && touches(B, A)) {
       edges.emplace_back(pair.a, pair.b);
+      pair.processed = true;
+    }
   }
   levels = con::computeLevels(static_cast<int>(bodies.size()), edges);
   for (ContactPairState& pair : pairs) pair.level = std::max(levels.levelOf[pair.a], levels.levelOf[pair.b]);
@@ -243,64 +256,165 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
   const bool clamp = settings.energyClamp && mode != ImpulseMode::Contact;
   col::ContactQuery query;
   query.margin = margin;
-  int applied = 0;
-  for (int it = 0; it < iterations; ++it) {
-    scratch.clear();
-    if (col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, query, scratch) == 0) break;
-    if (collision) pair.processed = true;
-    // Lever arms and normals are those of the split state (candidate positions), as GBF 2003
-    // and Sec. 2.3.2 compute them: the contact point relative to each candidate centre of mass.
-    // (Mapping the point back through the body's rotation to time n, as the level-set code
-    // does for surface vertices, is wrong for round shapes: a rolling disk's deepest point is
-    // not a material point, and the mapped lever arm would lag by the step's rotation.)
-    int best = -1;
-    double bestDepth = -margin;
-    VecD bestRa, bestRb, bestN, bestVrel;
-    for (int k = 0; k < static_cast<int>(scratch.size()); ++k) {
-      const auto& c = scratch[k];
-      if (c.depth < bestDepth || (best >= 0 && c.depth == bestDepth)) continue;
-      const VecD ra = c.point - A.candidate.x, rb = c.point - B.candidate.x, n = c.normal;
-      const VecD vrel = A.pointVelocity(ra) - B.pointVelocity(rb);
-      if (vrel.dot(n) >= -settings.approachTolerance) continue;
-      best = k;
-      bestDepth = c.depth;
-      bestRa = ra;
-      bestRb = rb;
-      bestN = n;
-      bestVrel = vrel;
-    }
-    if (best < 0) break;
-    con::ImpulseBody<d> ia{A.inverseMass(), A.inverseInertia(), bestRa};
-    con::ImpulseBody<d> ib{B.inverseMass(), B.inverseInertia(), bestRb};
-    const Eigen::Matrix<double, d, d> K = con::impulseFactor(ia) + con::impulseFactor(ib);
-    VecD j = con::pointImpulse<d>(K, bestVrel, bestN, impulse);
-    if (clamp) {
-      // Energy of the non-split base state; a partner of infinite mass that moves (kinematic)
-      // is handled in its frame: the dynamic body's velocity relative to its point velocity.
-      con::ClampBody<d> ca{A.inverseMass(), A.inverseInertia(), A.v, A.L, bestRa};
-      con::ClampBody<d> cb{B.inverseMass(), B.inverseInertia(), B.v, B.L, bestRb};
-      if (B.infinite()) ca.velocity = A.v - B.pointVelocity(bestRb), cb.velocity.setZero(), cb.angularMomentum.setZero();
-      if (A.infinite()) cb.velocity = B.v - A.pointVelocity(bestRa), ca.velocity.setZero(), ca.angularMomentum.setZero();
-      const con::ClampResult r = con::clampImpulseEnergy<d>(ca, cb, j);
-      if (r.kind != con::ClampResult::Case::NoGain && clampsApplied) ++*clampsApplied;
-      if (clampEnergyChange) *clampEnergyChange += r.energyChange;
-      j *= r.scale;
-    }
-    if (j.squaredNorm() == 0) break;
-    if (!A.infinite()) {
-      A.v += A.inverseMass() * j;
-      A.L += con::cross<d>(bestRa, j);
-      updateCandidate(A);
-    }
-    if (!B.infinite()) {
-      B.v -= B.inverseMass() * j;
-      B.L -= con::cross<d>(bestRb, j);
-      updateCandidate(B);
-    }
-    if (mode != ImpulseMode::Collision) pair.contacted = true;
-    ++applied;
+  scratch.clear();
+  if (col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, query, scratch) == 0) return 0;
+  if (collision) pair.processed = true;
+  // Manifold points within the margin, with split-state lever arms and normals (candidate
+  // positions, as GBF 2003 and Sec. 2.3.2 compute them; mapping points back through the body's
+  // rotation to time n, as the level-set code does for surface vertices, is wrong for round
+  // shapes: a rolling disk's deepest point is not a material point).
+  struct Point {
+    VecD ra, rb, n;
+    Eigen::Matrix<double, d, d> K;
+    double target = 0, normalImpulse = 0;
+    VecD friction = VecD::Zero();
+  };
+  thread_local std::vector<Point> points;
+  points.clear();
+  bool anyApproaching = false;
+  for (const auto& c : scratch) {
+    if (c.depth < -margin) continue;
+    Point p;
+    p.ra = c.point - A.candidate.x;
+    p.rb = c.point - B.candidate.x;
+    p.n = c.normal;
+    const double vn = (A.pointVelocity(p.ra) - B.pointVelocity(p.rb)).dot(p.n);
+    const bool approaching = vn < -settings.approachTolerance;
+    anyApproaching = anyApproaching || approaching;
+    // Target normal velocity -e min(0, v_n); contact's e = -1 + eps removes the fraction eps
+    // of the approach (notes 1.6). Points not approaching must not start to.
+    p.target = approaching ? -impulse.restitution * vn : 0.0;
+    p.K = con::impulseFactor(con::ImpulseBody<d>{A.inverseMass(), A.inverseInertia(), p.ra}) +
+          con::impulseFactor(con::ImpulseBody<d>{B.inverseMass(), B.inverseInertia(), p.rb});
+    points.push_back(p);
   }
-  return applied;
+  if (!anyApproaching) return 0;
+
+  // Working copies: the impulse of the whole pair is found first, then (second contact step,
+  // collisions) clamped as one against the state before it (Sec. 2.3.2) and applied.
+  VecD vA = A.v, vB = B.v;
+  con::AngVec<d> LA = A.L, LB = B.L;
+  const double mA = A.inverseMass(), mB = B.inverseMass();
+  const bool finiteA = !A.infinite(), finiteB = !B.infinite();
+  auto relativeVelocity = [&](const Point& p) {
+    return VecD(vA + con::angularCross<d>(A.inverseInertia0 * LA, p.ra) - vB -
+                con::angularCross<d>(B.inverseInertia0 * LB, p.rb));
+  };
+  auto apply = [&](const Point& p, const VecD& j) {  // bodies of infinite mass take no impulse
+    if (finiteA) vA += mA * j, LA += con::cross<d>(p.ra, j);
+    if (finiteB) vB -= mB * j, LB -= con::cross<d>(p.rb, j);
+  };
+  if (points.size() == 1) {
+    // One point: the impulse of notes 1.5 (sticking, else sliding along K(n - mu t)).
+    Point& p = points[0];
+    const VecD j = con::pointImpulse<d>(p.K, relativeVelocity(p), p.n, impulse);
+    apply(p, j);
+    p.normalImpulse = j.dot(p.n);
+    p.friction = j - p.normalImpulse * p.n;
+  } else {
+    // Several points (a face contact): the pair's impulses are solved together by projected
+    // Gauss-Seidel on accumulated impulses (normal >= 0, friction inside the Coulomb disk), so
+    // a box lying flat stops at all its corners at once instead of rocking between them as
+    // one-point-at-a-time impulses do.
+    for (int sweep = 0; sweep < iterations; ++sweep) {
+      double change = 0;
+      for (Point& p : points) {
+        const VecD vrel = relativeVelocity(p);
+        const double kn = p.n.dot(p.K * p.n);
+        const double lambda = std::max(0.0, p.normalImpulse + (p.target - vrel.dot(p.n)) / kn);
+        const double dl = lambda - p.normalImpulse;
+        p.normalImpulse = lambda;
+        apply(p, dl * p.n);
+        change = std::max(change, std::abs(dl) * kn);
+        if (impulse.friction > 0) {
+          const VecD v2 = relativeVelocity(p);
+          const VecD vt = v2 - v2.dot(p.n) * p.n;
+          const double speed = vt.norm();
+          if (speed > 0) {
+            const VecD t = vt / speed;
+            VecD f = p.friction - (speed / t.dot(p.K * t)) * t;
+            const double limit = impulse.friction * p.normalImpulse;
+            if (f.norm() > limit) f *= limit / f.norm();
+            apply(p, f - p.friction);
+            change = std::max(change, (f - p.friction).norm() * t.dot(p.K * t));
+            p.friction = f;
+          }
+        }
+      }
+      if (change < 1e-3 * settings.approachTolerance) break;
+    }
+  }
+  // Net impulse on A and its angular impulse about A's centre: J, tau = sum r_a x j.
+  VecD J = VecD::Zero();
+  con::AngVec<d> tau = con::AngVec<d>::Zero();
+  int active = 0;
+  for (const Point& p : points) {
+    const VecD j = p.normalImpulse * p.n + p.friction;
+    if (j.squaredNorm() == 0) continue;
+    ++active;
+    J += j;
+    tau += con::cross<d>(p.ra, j);
+  }
+  if (active == 0) return 0;
+  double scale = 1;
+  if (clamp) {
+    // Energy of the non-split base state; a partner of infinite mass that moves (kinematic)
+    // is handled in its frame: the dynamic body's velocity relative to its point velocity.
+    // The pair's impulse is J at A's centre plus the torque tau (and -J, -tau - (x_a - x_b) x J on B).
+    const VecD rb = A.candidate.x - B.candidate.x;
+    con::ClampBody<d> ca{A.inverseMass(), A.inverseInertia(), A.v, A.L, VecD::Zero()};
+    con::ClampBody<d> cb{B.inverseMass(), B.inverseInertia(), B.v, B.L, rb};
+    const VecD centre = points[0].ra;  // frame point for a kinematic partner's velocity
+    if (B.infinite()) ca.velocity = A.v - B.pointVelocity(points[0].rb), cb.velocity.setZero(), cb.angularMomentum.setZero();
+    if (A.infinite()) cb.velocity = B.v - A.pointVelocity(centre), ca.velocity.setZero(), ca.angularMomentum.setZero();
+    const con::ClampResult r = con::clampImpulseEnergy<d>(ca, cb, J, tau);
+    if (r.kind != con::ClampResult::Case::NoGain && clampsApplied) ++*clampsApplied;
+    if (clampEnergyChange) *clampEnergyChange += r.energyChange;
+    scale = r.scale;
+    if (scale == 0) return 0;
+  }
+  if (!A.infinite()) {
+    A.v += scale * A.inverseMass() * J;
+    A.L += scale * tau;
+    updateCandidate(A);
+  }
+  if (!B.infinite()) {
+    B.v -= scale * B.inverseMass() * J;
+    B.L -= scale * (tau + con::cross<d>(VecD(A.candidate.x - B.candidate.x), J));
+    updateCandidate(B);
+  }
+  if (!collision) pair.contacted = true;
+  return active;
+}
+
+template <int d>
+int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyContacted,
+                                        std::vector<col::ContactPoint<d>>& scratch, double* clampEnergyChange,
+                                        int* clampsApplied) {
+  int impulses = 0;
+  const auto& list = islandPairsByLevel[island];
+  for (std::size_t begin = 0; begin < list.size();) {
+    const int level = pairs[list[begin]].level;
+    std::size_t end = begin;
+    while (end < list.size() && pairs[list[end]].level == level) ++end;
+    for (int li = 0; li < settings.shockLevelIterations; ++li) {
+      const double eps = double(li + 1) / double(settings.shockLevelIterations);
+      for (std::size_t k = begin; k < end; ++k) {
+        ContactPairState& pair = pairs[list[k]];
+        if (onlyContacted && !pair.contacted) continue;
+        impulses += updatePair(pair, mode, eps, settings.shockPairIterations, settings.thickness, scratch,
+                               clampEnergyChange, clampsApplied);
+      }
+    }
+    for (std::size_t k = begin; k < end; ++k) {
+      const ContactPairState& p = pairs[list[k]];
+      if (levels.levelOf[p.a] == level) bodies[p.a].frozen = true;
+      if (levels.levelOf[p.b] == level) bodies[p.b].frozen = true;
+    }
+    begin = end;
+  }
+  for (int m : islands.members[island]) bodies[m].frozen = false;
+  return impulses;
 }
 
 template col::Geometry<2> collisionGeometryOf<2>(const Shape<2>&);

@@ -107,6 +107,12 @@ class ContactWorkspace {
                  std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
                  int* clampsApplied);
 
+  // Shock propagation over one island (GBF 2003; notes 1.6): bottom-up through the levels, each
+  // level's bodies frozen (infinite mass) once its pairs are done; all unfrozen at the end.
+  int propagateShock(int island, ImpulseMode mode, bool onlyContacted,
+                     std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
+                     int* clampsApplied);
+
   // Runs f(islandIndex) for every island in parallel (bodies of different islands are disjoint,
   // so results do not depend on the thread count).
   template <class F>

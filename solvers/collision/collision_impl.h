@@ -45,6 +45,10 @@ struct PreparedGeometry<d>::Impl {
   };
   std::vector<TreeNode> triangleTree;
   std::vector<int> triangleOrder;
+  // Mesh: for each triangle, which of its edges (vertex e to vertex e+1) no other triangle shares,
+  // i.e. lie on the mesh's border. An edge shared with a neighbour is no edge to be pushed across
+  // ("internal edge"): there a shape is pushed along the triangles' own normals.
+  std::vector<std::array<char, 3>> borderEdges;
   // FCL's copy of the shape (3-D, every type but the half-space, whose pairs are all exact).
   std::shared_ptr<fcl::CollisionGeometry<double>> fclGeometry;
 };
@@ -62,6 +66,7 @@ struct Hull3 {
 Hull3 convexHull3(const std::vector<Eigen::Vector3d>& points);
 
 // --- mesh triangle tree (triangle_tree.cpp) ------------------------------------------------
+// Fills triangleTree, triangleOrder and borderEdges.
 void buildTriangleTree(PreparedGeometry<3>::Impl& impl, const Geometry<3>& mesh);
 // Triangles whose bounding box meets `box` (body frame), in a fixed order.
 void trianglesNear(const PreparedGeometry<3>::Impl& impl, const Eigen::AlignedBox3d& box, std::vector<int>& out);
@@ -99,11 +104,14 @@ template <int d>
 void featurePoints(const PreparedGeometry<d>& g, const Pose<d>& pose, const Eigen::Matrix<double, d, 1>& deepest,
                    std::vector<FeaturePoint<d>>& out);
 
-// Every feature point inside S or within `margin` of it becomes a contact with S's surface
-// normal. shapeIsA: S is body A, the points belong to B, so the normal (out of B) is negated.
+// The thesis's vertex-in-level-set test: every feature point of F inside S, or within `margin`
+// of it, becomes a contact with S's surface normal. shapeIsA: S is body A and F is body B, so the
+// normal (out of B) is negated. `deepest` (world) is the direction in which S lies seen from F.
+// The points are generated directly in S's frame; `scratch` holds them.
 template <int d>
-void featuresInShape(const std::vector<FeaturePoint<d>>& points, const PreparedGeometry<d>& s, const Pose<d>& poseS,
-                     double margin, bool shapeIsA, std::vector<ContactPoint<d>>& out);
+void featureContacts(const PreparedGeometry<d>& f, const Pose<d>& poseF, const Eigen::Matrix<double, d, 1>& deepest,
+                     const PreparedGeometry<d>& s, const Pose<d>& poseS, double margin, bool shapeIsA,
+                     std::vector<FeaturePoint<d>>& scratch, std::vector<ContactPoint<d>>& out);
 
 // Merges points closer than `mergeDistance` with nearly equal normals (keeps the deeper) and caps
 // the manifold at maxPoints: the deepest point first, then the points farthest from those already

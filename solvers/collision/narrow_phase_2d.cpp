@@ -167,9 +167,7 @@ void orderedContacts(const PG& a, const Pose<2>& pa, const PG& b, const Pose<2>&
                      Scratch& s) {
   const GeometryType ta = a.geometry().type, tb = b.geometry().type;
   if (tb == GeometryType::HalfSpace || ta == GeometryType::Sphere) {
-    s.features.clear();
-    featurePoints<2>(a, pa, Vec2(pb.x - pa.x), s.features);
-    featuresInShape<2>(s.features, b, pb, margin, false, s.result);
+    featureContacts<2>(a, pa, Vec2(pb.x - pa.x), b, pb, margin, false, s.features, s.result);
     return;
   }
   toWorld(a, pa, s.a);

@@ -37,6 +37,7 @@ constexpr double kTriangleFaceCosine = 0.5;
 struct Scratch {
   std::vector<CP> main, extra, result;
   std::vector<int> triangles;
+  std::vector<Vec3> axes;
   std::vector<FeaturePoint<3>> features;
 };
 // Per thread: queries are const and run concurrently, and reuse their buffers once warm.
@@ -97,12 +98,8 @@ void capsulePair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
   const double depth = ra + rb - dist;
   if (depth >= -margin) s.main.push_back(midwayContact(ca - ra * n, cb + rb * n, n, depth));
   // The end caps: two points for capsules lying side by side.
-  s.features.clear();
-  featurePoints<3>(a, pa, -n, s.features);
-  featuresInShape<3>(s.features, b, pb, margin, false, s.extra);
-  s.features.clear();
-  featurePoints<3>(b, pb, n, s.features);
-  featuresInShape<3>(s.features, a, pa, margin, true, s.extra);
+  featureContacts<3>(a, pa, -n, b, pb, margin, false, s.features, s.extra);
+  featureContacts<3>(b, pb, n, a, pa, margin, true, s.features, s.extra);
   keepUnrepresented<3>(s.main, s.extra, kRedundantDepth * scale, s.result);
 }
 
@@ -132,15 +129,23 @@ void generalPair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
   // rest gets the feature points both ways.
   if (typeOf(b) != GeometryType::Mesh && !(boxBox && fclWorked && !(margin > 0))) {
     const Vec3 towardsB = s.main.empty() ? Vec3(pb.x - pa.x) : Vec3(-s.main[0].normal);
-    s.features.clear();
-    featurePoints<3>(a, pa, towardsB, s.features);
-    featuresInShape<3>(s.features, b, pb, margin, false, s.extra);
-    s.features.clear();
-    featurePoints<3>(b, pb, -towardsB, s.features);
-    featuresInShape<3>(s.features, a, pa, margin, true, s.extra);
+    featureContacts<3>(a, pa, towardsB, b, pb, margin, false, s.features, s.extra);
+    featureContacts<3>(b, pb, -towardsB, a, pa, margin, true, s.features, s.extra);
+    if (s.main.size() == 1) {
+      // The feature contacts' normals are face normals of A and B: candidate separating axes.
+      // The one along which the shapes overlap least (if less than along FCL's axis) carries the
+      // main contact, as the minimum-translation direction of the pair.
+      s.axes.clear();
+      for (const CP& c : s.extra) {
+        bool known = false;
+        for (const Vec3& axis : s.axes) known = known || std::abs(axis.dot(c.normal)) > 1 - 1e-12;
+        if (!known) s.axes.push_back(c.normal);
+      }
+      refineAxis(a, pa, b, pb, -1, s.axes, s.main[0]);
+    }
     if (!s.main.empty()) {
       // A vertex that went more than half way through picks the far face: its normal opposes
-      // FCL's (the minimum-translation direction of the pair) and would push the wrong way.
+      // the pair's minimum-translation direction and would push the wrong way.
       const Vec3 n = s.main[0].normal;
       std::size_t kept = 0;
       for (const CP& c : s.extra)
@@ -163,9 +168,7 @@ void orderedContacts(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>&
   const GeometryType ta = typeOf(a), tb = typeOf(b);
   if (tb == GeometryType::HalfSpace || (ta == GeometryType::Sphere && tb != GeometryType::Mesh)) {
     const Vec3 towardsB = tb == GeometryType::HalfSpace ? Vec3(-(pb.R * b.geometry().normal)) : Vec3(pb.x - pa.x);
-    s.features.clear();
-    featurePoints<3>(a, pa, towardsB, s.features);
-    featuresInShape<3>(s.features, b, pb, margin, false, s.result);
+    featureContacts<3>(a, pa, towardsB, b, pb, margin, false, s.features, s.result);
   } else if (ta == GeometryType::Capsule && tb == GeometryType::Capsule) {
     capsulePair(a, pa, b, pb, margin, scale, s);
   } else {

@@ -20,6 +20,8 @@
 #include <fcl/narrowphase/detail/gjk_solver_libccd.h>
 #include <fcl/narrowphase/distance.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <exception>
 
@@ -76,11 +78,12 @@ Eigen::Vector2d projection(const PreparedGeometry<3>& g, const Pose<3>& pose, co
   return {c - half, c + half};
 }
 
-// A contact on `axis` (either sign) near `near`: the normal takes the given sign, or with sign 0
-// the one along which the projections overlap least; depth is that overlap, and the point sits
-// on the middle of it. False when the overlap is below -margin.
+// A contact on `axis` (either sign) near `near`: the normal takes the sign along which the
+// projections of A and B overlap least, the depth is that overlap (exact along the axis: the
+// distance A must move along it to separate), and the point sits on the middle of the overlap.
+// False when the overlap is below -margin.
 bool contactOnAxis(const PreparedGeometry<3>& a, const Pose<3>& poseA, int triangleA, const PreparedGeometry<3>& b,
-                   const Pose<3>& poseB, int triangleB, const Vec3& near, const Vec3& axis, int sign, double margin,
+                   const Pose<3>& poseB, int triangleB, const Vec3& near, const Vec3& axis, double margin,
                    ContactPoint<3>& out) {
   const double len = axis.norm();
   if (!(len > 0) || !std::isfinite(len)) return false;
@@ -89,7 +92,7 @@ bool contactOnAxis(const PreparedGeometry<3>& a, const Pose<3>& poseA, int trian
   const Eigen::Vector2d pb = projection(b, poseB, n, triangleB);
   const double depthPlus = pb[1] - pa[0];   // normal +n: A lies on the + side of B
   const double depthMinus = pa[1] - pb[0];  // normal -n
-  const bool plus = sign != 0 ? sign > 0 : depthPlus <= depthMinus;
+  const bool plus = depthPlus <= depthMinus;
   out.normal = plus ? n : Vec3(-n);
   out.depth = plus ? depthPlus : depthMinus;
   const double middle = plus ? 0.5 * (pa[0] + pb[1]) : -0.5 * (pa[1] + pb[0]);  // along out.normal
@@ -127,10 +130,7 @@ bool fclContacts(const PreparedGeometry<3>& a, const Pose<3>& poseA, const Prepa
     }
     const int triangleB = meshB ? static_cast<int>(c.b1) : -1;
     const int triangleA = meshB && meshA ? static_cast<int>(c.b2) : -1;
-    // Shape pairs: FCL's normal points from A (o1) to B, so ours is its negative. Mesh pairs:
-    // the sign is unreliable, a triangle has no inside, the smaller overlap decides.
-    const int sign = meshB ? 0 : -1;
-    if (contactOnAxis(a, poseA, triangleA, b, poseB, triangleB, c.pos, c.normal, sign, 0.0, p)) {
+    if (contactOnAxis(a, poseA, triangleA, b, poseB, triangleB, c.pos, c.normal, 0.0, p)) {
       out.push_back(p);
       trianglesOfB.push_back(triangleB);
     }
@@ -164,7 +164,7 @@ bool fclMarginContact(const PreparedGeometry<3>& a, const Pose<3>& poseA, const 
   }
   triangleOfB = meshB ? result.b1 : -1;
   const int triangleA = meshB && meshA ? result.b2 : -1;
-  return contactOnAxis(a, poseA, triangleA, b, poseB, triangleOfB, 0.5 * (p + q), p - q, 0, margin, out);
+  return contactOnAxis(a, poseA, triangleA, b, poseB, triangleOfB, 0.5 * (p + q), p - q, margin, out);
 }
 
 namespace {
@@ -185,13 +185,79 @@ bool withFclShape(const PreparedGeometry<3>& g, Visit&& visit) {
 
 }  // namespace
 
+void refineAxis(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b, const Pose<3>& poseB,
+                int triangleB, const std::vector<Vec3>& axes, ContactPoint<3>& c) {
+  for (const Vec3& axis : axes) {
+    ContactPoint<3> candidate;
+    if (contactOnAxis(a, poseA, -1, b, poseB, triangleB, c.point, axis, kInfinity, candidate) &&
+        candidate.depth < c.depth)
+      c = candidate;
+  }
+}
+
+bool separatedFromTriangle(const PreparedGeometry<3>& a, const Pose<3>& poseAInMesh, const PreparedGeometry<3>& mesh,
+                           int triangle, double margin) {
+  const Geometry<3>& geo = mesh.geometry();
+  const auto& tri = geo.triangles[triangle];
+  const std::array<Vec3, 3> p = {geo.vertices[tri[0]], geo.vertices[tri[1]], geo.vertices[tri[2]]};
+  const Vec3 face = (p[1] - p[0]).cross(p[2] - p[0]);
+  std::array<Vec3, 4> axes = {face, face.cross(p[1] - p[0]), face.cross(p[2] - p[1]), face.cross(p[0] - p[2])};
+  for (Vec3& axis : axes) {
+    const double len = axis.norm();
+    if (!(len > 0)) continue;
+    axis /= len;
+    const Eigen::Vector2d shape = projection(a, poseAInMesh, axis, -1);
+    const double t0 = axis.dot(p[0]), t1 = axis.dot(p[1]), t2 = axis.dot(p[2]);
+    const double lo = std::min({t0, t1, t2}), hi = std::max({t0, t1, t2});
+    if (shape[0] > hi + margin || lo > shape[1] + margin) return true;
+  }
+  return false;
+}
+
+namespace {
+
+// The axis of a shape-triangle contact: the triangle's own normal, or FCL's axis if the shape
+// overlaps the triangle less along it and that axis pushes the shape out across a border edge of
+// the mesh (a shape beside the mesh's edge). Across an edge shared with a neighbour it would be an
+// artefact of the triangulation, not of the surface. `separated`: FCL found the shape apart from
+// the triangle (the margin case); an overlap along the normal then means the shape is beside the
+// triangle, below its plane, over a neighbour that has the contact.
+bool onTriangleAxis(const PreparedGeometry<3>& a, const Pose<3>& poseAInMesh, const PreparedGeometry<3>& mesh,
+                    int triangle, const Vec3& near, const Vec3& fclAxis, double margin, bool separated,
+                    ContactPoint<3>& out) {
+  const Geometry<3>& geo = mesh.geometry();
+  const auto& tri = geo.triangles[triangle];
+  const std::array<Vec3, 3> p = {geo.vertices[tri[0]], geo.vertices[tri[1]], geo.vertices[tri[2]]};
+  const Vec3 face = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
+  const Pose<3> meshFrame;
+  if (!contactOnAxis(a, poseAInMesh, -1, mesh, meshFrame, triangle, near, face, kInfinity, out)) return false;
+  ContactPoint<3> alternative = out;
+  refineAxis(a, poseAInMesh, mesh, meshFrame, triangle, {fclAxis}, alternative);
+  // The edge the alternative normal leaves through: the one whose outward in-plane normal it
+  // follows most.
+  const Vec3 inPlane = alternative.normal - alternative.normal.dot(face) * face;
+  int edge = 0;
+  double best = -kInfinity;
+  for (int e = 0; e < 3; ++e) {
+    const Vec3 outward = (p[(e + 1) % 3] - p[e]).cross(face).normalized();  // counter-clockwise about face
+    if (outward.dot(inPlane) > best) {
+      best = outward.dot(inPlane);
+      edge = e;
+    }
+  }
+  if (alternative.depth < out.depth && mesh.impl().borderEdges[triangle][edge]) out = alternative;
+  else if (separated && out.depth > 0) return false;
+  return out.depth >= -margin;
+}
+
+}  // namespace
+
 bool fclTriangleContact(const PreparedGeometry<3>& a, const Pose<3>& poseAInMesh, const PreparedGeometry<3>& mesh,
                         int triangle, double margin, ContactPoint<3>& out) {
   const Geometry<3>& geo = mesh.geometry();
   const auto& tri = geo.triangles[triangle];
   const Vec3 &p0 = geo.vertices[tri[0]], &p1 = geo.vertices[tri[1]], &p2 = geo.vertices[tri[2]];
-  const fcl::Transform3d tf = transformOf(poseAInMesh);
-  const Pose<3> meshFrame;  // identity: everything is in the mesh's frame
+  const fcl::Transform3d tf = transformOf(poseAInMesh);  // everything is in the mesh's frame
   fcl::detail::GJKSolver_libccd<double> solver;
   try {
     Vec3 position, normal;
@@ -199,7 +265,7 @@ bool fclTriangleContact(const PreparedGeometry<3>& a, const Pose<3>& poseAInMesh
     if (withFclShape(a, [&](const auto& shape) {
           return solver.shapeTriangleIntersect(shape, tf, p0, p1, p2, &position, &depth, &normal);
         }))
-      return contactOnAxis(a, poseAInMesh, -1, mesh, meshFrame, triangle, position, normal, 0, 0.0, out);
+      return onTriangleAxis(a, poseAInMesh, mesh, triangle, position, normal, 0.0, false, out);
     if (!(margin > 0)) return false;
     double distance = kInfinity;
     Vec3 onA, onTriangle;
@@ -208,8 +274,8 @@ bool fclTriangleContact(const PreparedGeometry<3>& a, const Pose<3>& poseAInMesh
         }))
       return false;
     if (!(distance > 0) || distance > margin) return false;
-    return contactOnAxis(a, poseAInMesh, -1, mesh, meshFrame, triangle, 0.5 * (onA + onTriangle), onA - onTriangle, 0,
-                         margin, out);
+    return onTriangleAxis(a, poseAInMesh, mesh, triangle, 0.5 * (onA + onTriangle), onA - onTriangle, margin, true,
+                          out);
   } catch (const std::exception&) {
     return false;
   }

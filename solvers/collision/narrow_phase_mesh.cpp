@@ -125,6 +125,7 @@ void meshContacts(const PreparedGeometry<3>& a, const Pose<3>& poseA, const Prep
   const double tolerance = kRepresentedDepth * scale;
   s.onFace.clear();
   for (int t : s.candidates) {
+    if (!sphere && separatedFromTriangle(a, rel, mesh, t, margin)) continue;
     CP c;
     bool onFace = false;
     if (sphere ? sphereTriangle(rel.x, a.geometry().radius, geo, t, margin, c, onFace)

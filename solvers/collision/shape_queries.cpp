@@ -93,6 +93,7 @@ SurfaceDistance<d> polytopeDistance(const typename PreparedGeometry<d>::Impl& im
     if (v > s) {
       s = v;
       k = static_cast<int>(i);
+      if (s > limit) break;  // already farther than the caller cares about
     }
   }
   SurfaceDistance<d> r;
@@ -231,22 +232,27 @@ void featurePoints(const PreparedGeometry<d>& g, const Pose<d>& pose, const Vec<
 }
 
 template <int d>
-void featuresInShape(const std::vector<FeaturePoint<d>>& points, const PreparedGeometry<d>& s, const Pose<d>& poseS,
-                     double margin, bool shapeIsA, std::vector<ContactPoint<d>>& out) {
+void featureContacts(const PreparedGeometry<d>& f, const Pose<d>& poseF, const Vec<d>& deepest,
+                     const PreparedGeometry<d>& s, const Pose<d>& poseS, double margin, bool shapeIsA,
+                     std::vector<FeaturePoint<d>>& scratch, std::vector<ContactPoint<d>>& out) {
+  Pose<d> rel;  // F in S's frame
+  rel.R = poseS.R.transpose() * poseF.R;
+  rel.x = poseS.R.transpose() * (poseF.x - poseS.x);
+  scratch.clear();
+  featurePoints<d>(f, rel, Vec<d>(poseS.R.transpose() * deepest), scratch);
   const auto& bounds = s.impl().localBounds;
-  for (const auto& f : points) {
-    const Vec<d> q = poseS.R.transpose() * (f.x - poseS.x);
+  for (const auto& p : scratch) {
     // Farther than margin + radius from S's box is farther from S: skip the exact query (big
     // hulls have many vertices and many faces).
-    if (bounds.exteriorDistance(q) > margin + f.radius) continue;
-    const SurfaceDistance<d> sd = signedDistance<d>(s, q, margin + f.radius);
-    const double depth = f.radius - sd.distance;
+    if (bounds.exteriorDistance(p.x) > margin + p.radius) continue;
+    const SurfaceDistance<d> sd = signedDistance<d>(s, p.x, margin + p.radius);
+    const double depth = p.radius - sd.distance;
     if (!(depth >= -margin)) continue;
     const Vec<d> n = poseS.R * sd.normal;
-    const Vec<d> onShape = poseS.R * sd.surfacePoint + poseS.x;
-    const Vec<d> onFeature = f.x - f.radius * n;
+    const Vec<d> onS = sd.surfacePoint;
+    const Vec<d> onF = p.x - p.radius * sd.normal;
     ContactPoint<d> c;
-    c.point = 0.5 * (onShape + onFeature);
+    c.point = poseS.R * (0.5 * (onS + onF)) + poseS.x;
     c.normal = shapeIsA ? Vec<d>(-n) : n;
     c.depth = depth;
     out.push_back(c);
@@ -359,10 +365,12 @@ template SurfaceDistance<2> signedDistance<2>(const PreparedGeometry<2>&, const 
 template SurfaceDistance<3> signedDistance<3>(const PreparedGeometry<3>&, const Vec<3>&, double);
 template void featurePoints<2>(const PreparedGeometry<2>&, const Pose<2>&, const Vec<2>&, std::vector<FeaturePoint<2>>&);
 template void featurePoints<3>(const PreparedGeometry<3>&, const Pose<3>&, const Vec<3>&, std::vector<FeaturePoint<3>>&);
-template void featuresInShape<2>(const std::vector<FeaturePoint<2>>&, const PreparedGeometry<2>&, const Pose<2>&,
-                                 double, bool, std::vector<ContactPoint<2>>&);
-template void featuresInShape<3>(const std::vector<FeaturePoint<3>>&, const PreparedGeometry<3>&, const Pose<3>&,
-                                 double, bool, std::vector<ContactPoint<3>>&);
+template void featureContacts<2>(const PreparedGeometry<2>&, const Pose<2>&, const Vec<2>&, const PreparedGeometry<2>&,
+                                 const Pose<2>&, double, bool, std::vector<FeaturePoint<2>>&,
+                                 std::vector<ContactPoint<2>>&);
+template void featureContacts<3>(const PreparedGeometry<3>&, const Pose<3>&, const Vec<3>&, const PreparedGeometry<3>&,
+                                 const Pose<3>&, double, bool, std::vector<FeaturePoint<3>>&,
+                                 std::vector<ContactPoint<3>>&);
 template void finishManifold<2>(std::vector<ContactPoint<2>>&, int, double);
 template void finishManifold<3>(std::vector<ContactPoint<3>>&, int, double);
 template void keepUnrepresented<2>(const std::vector<ContactPoint<2>>&, const std::vector<ContactPoint<2>>&, double,

@@ -1,5 +1,6 @@
 // Bounding-box tree over a mesh's triangles (issue 3), built once per PreparedGeometry: the mesh
-// narrow phase asks it for the triangles near a shape before running FCL on each of them.
+// narrow phase asks it for the triangles near a shape before running FCL on each of them. Also
+// marks the edges on the mesh's border.
 // Median splits along the longest axis of the triangle centroids, ties broken by index, so the
 // tree (and the candidate order) only depends on the mesh.
 #include <algorithm>
@@ -63,6 +64,20 @@ void buildTriangleTree(PreparedGeometry<3>::Impl& impl, const Geometry<3>& mesh)
   std::iota(impl.triangleOrder.begin(), impl.triangleOrder.end(), 0);
   impl.triangleTree.clear();
   builder.build(0, static_cast<int>(mesh.triangles.size()));
+  // Border edges: an (undirected) edge used by one triangle only.
+  std::vector<std::pair<std::pair<int, int>, int>> edges;  // (edge, 3 * triangle + e)
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (int e = 0; e < 3; ++e) {
+      const int a = mesh.triangles[t][e], b = mesh.triangles[t][(e + 1) % 3];
+      edges.push_back({{std::min(a, b), std::max(a, b)}, static_cast<int>(3 * t + e)});
+    }
+  std::sort(edges.begin(), edges.end());
+  impl.borderEdges.assign(mesh.triangles.size(), {0, 0, 0});
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    const bool shared = (i > 0 && edges[i - 1].first == edges[i].first) ||
+                        (i + 1 < edges.size() && edges[i + 1].first == edges[i].first);
+    if (!shared) impl.borderEdges[edges[i].second / 3][edges[i].second % 3] = 1;
+  }
 }
 
 void trianglesNear(const PreparedGeometry<3>::Impl& impl, const Eigen::AlignedBox3d& box, std::vector<int>& out) {

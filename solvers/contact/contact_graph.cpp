@@ -14,8 +14,8 @@ namespace {
 
 void checkNode(int node, int nodeCount) {
   if (node < 0 || node >= nodeCount) {
-    throw std::invalid_argument("contact graph: node " + std::to_string(node) +
-                                " outside [0, " + std::to_string(nodeCount) + ")");
+    throw std::invalid_argument("contact graph: node " + std::to_string(node) + " outside [0, " +
+                                std::to_string(nodeCount) + ")");
   }
 }
 
@@ -38,7 +38,8 @@ Adjacency buildAdjacency(int nodeCount, const std::vector<std::pair<int, int>>& 
 
 // Tarjan's strongly connected components with an explicit call stack, so that a chain of 10^5
 // bodies cannot overflow the machine stack. Returns the component of every node.
-std::vector<int> stronglyConnectedComponents(int nodeCount, const Adjacency& adj, int& componentCount) {
+std::vector<int> stronglyConnectedComponents(int nodeCount, const Adjacency& adj,
+                                             int& componentCount) {
   constexpr int kUnvisited = -1;
   std::vector<int> index(static_cast<std::size_t>(nodeCount), kUnvisited);
   std::vector<int> low(static_cast<std::size_t>(nodeCount), 0);

@@ -12,16 +12,16 @@ namespace monolith::solvers::contact {
 
 template <int d>
 struct ClampBody {
-  double inverseMass = 0;                        // 0: infinite mass (its terms vanish)
-  AngMat<d> inverseInertia = AngMat<d>::Zero();  // world, at the reference state's rotation
-  Vec<d> velocity = Vec<d>::Zero();              // reference state (p = m v)
-  AngVec<d> angularMomentum = AngVec<d>::Zero(); // reference state L
-  Vec<d> r = Vec<d>::Zero();                     // lever arm of the impulse (split state)
+  double inverseMass = 0;                         // 0: infinite mass (its terms vanish)
+  AngMat<d> inverseInertia = AngMat<d>::Zero();   // world, at the reference state's rotation
+  Vec<d> velocity = Vec<d>::Zero();               // reference state (p = m v)
+  AngVec<d> angularMomentum = AngVec<d>::Zero();  // reference state L
+  Vec<d> r = Vec<d>::Zero();                      // lever arm of the impulse (split state)
 };
 
 struct ClampResult {
-  double scale = 1;          // epsilon applied to the impulse, in [0, 1]
-  double energyChange = 0;   // KE' - KE of the reference state after the scaled impulse (<= ~0)
+  double scale = 1;         // epsilon applied to the impulse, in [0, 1]
+  double energyChange = 0;  // KE' - KE of the reference state after the scaled impulse (<= ~0)
   enum class Case { NoGain, Scaled, Discarded } kind = Case::NoGain;
 };
 

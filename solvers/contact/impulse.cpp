@@ -91,7 +91,9 @@ Vec<d> pointImpulse(const Mat<d>& K, const Vec<d>& relativeVelocity, const Vec<d
 
 template Mat<2> impulseFactor<2>(const ImpulseBody<2>&);
 template Mat<3> impulseFactor<3>(const ImpulseBody<3>&);
-template Vec<2> pointImpulse<2>(const Mat<2>&, const Vec<2>&, const Vec<2>&, const ImpulseSettings&);
-template Vec<3> pointImpulse<3>(const Mat<3>&, const Vec<3>&, const Vec<3>&, const ImpulseSettings&);
+template Vec<2> pointImpulse<2>(const Mat<2>&, const Vec<2>&, const Vec<2>&,
+                                const ImpulseSettings&);
+template Vec<3> pointImpulse<3>(const Mat<3>&, const Vec<3>&, const Vec<3>&,
+                                const ImpulseSettings&);
 
 }  // namespace monolith::solvers::contact

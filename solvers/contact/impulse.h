@@ -30,8 +30,12 @@ struct ImpulseSettings {
 // The impulse j on A (-j on B) that makes the normal relative velocity -e min(0, v_rel.n) with
 // Coulomb friction: the sticking impulse if it lies in the friction cone, else the sliding one
 // (velocity change along K(n - mu t) scaled to the target normal velocity), as in notes 1.5.
-// K = K_A + K_B must be invertible (at least one body finite).
+// K = K_A + K_B must be invertible (at least one body finite). A pair that is not approaching
+// (v_rel.n >= 0) gets zero. Where no sliding impulse reaches the target normal velocity
+// (n.K(n - mu t) <= 0, friction coupled through K pulling the bodies together) the impulse is
+// the frictionless one. Restitution may be negative (contact's -1 + eps).
 template <int d>
-Vec<d> pointImpulse(const Mat<d>& K, const Vec<d>& relativeVelocity, const Vec<d>& normal, const ImpulseSettings& s);
+Vec<d> pointImpulse(const Mat<d>& K, const Vec<d>& relativeVelocity, const Vec<d>& normal,
+                    const ImpulseSettings& s);
 
 }  // namespace monolith::solvers::contact

@@ -27,35 +27,36 @@ struct PushOutCentral {
 template <int d>
 struct PushOutOuter {
   bool isStatic = false;
-  Vec<d> r = Vec<d>::Zero();       // c's centre of mass -> p_o
-  Vec<d> q = Vec<d>::Zero();       // o's centre of mass -> p_o
-  double mass = 1;                 // o's mass (static: the finite mass of K_hat_s; if not
-                                   // finite, K_hat_s = identity as in the original code)
+  Vec<d> r = Vec<d>::Zero();  // c's centre of mass -> p_o
+  Vec<d> q = Vec<d>::Zero();  // o's centre of mass -> p_o
+  double mass = 1;            // o's mass (static: the finite mass of K_hat_s; if not
+                              // finite, K_hat_s = identity as in the original code)
   AngMat<d> inertia = AngMat<d>::Identity();  // o's world inertia (static: that of K_hat_s)
   Vec<d> displacement = Vec<d>::Zero();       // d_o
 };
 
 enum class PushOutCase {
-  AllDynamic = 0,       // (B.2)
-  CentralStatic = 1,    // B.3 second easy case
-  OneStatic = 2,        // B.3.1 (also: all statics coincident)
-  StaticsCollinear = 3, // B.3.2-B.3.3, 3-D only
-  StaticsGeneral = 4,   // A_s nonsingular: statics fix the central body
+  AllDynamic = 0,        // (B.2)
+  CentralStatic = 1,     // B.3 second easy case
+  OneStatic = 2,         // B.3.1 (also: all statics coincident)
+  StaticsCollinear = 3,  // B.3.2-B.3.3, 3-D only
+  StaticsGeneral = 4,    // A_s nonsingular: statics fix the central body
 };
 
 template <int d>
 struct PushOutResult {
   PushOutCase kind = PushOutCase::AllDynamic;
-  Vec<d> centralDisplacement = Vec<d>::Zero();       // dtau * dv  (zero if central is static)
-  AngVec<d> centralRotation = AngVec<d>::Zero();     // dtau * dw (rotation vector)
-  std::vector<Vec<d>> outerImpulses;                 // dtau * j_o per outer (zero for statics)
-  std::vector<Vec<d>> outerDisplacements;            // dtau m_o^{-1} j_o (zero for statics)
-  std::vector<AngVec<d>> outerRotations;             // dtau I_o^{-1} (q_o x j_o) (zero for statics)
+  Vec<d> centralDisplacement = Vec<d>::Zero();    // dtau * dv  (zero if central is static)
+  AngVec<d> centralRotation = AngVec<d>::Zero();  // dtau * dw (rotation vector)
+  std::vector<Vec<d>> outerImpulses;              // dtau * j_o per outer (zero for statics)
+  std::vector<Vec<d>> outerDisplacements;         // dtau m_o^{-1} j_o (zero for statics)
+  std::vector<AngVec<d>> outerRotations;          // dtau I_o^{-1} (q_o x j_o) (zero for statics)
 };
 
 // Solves for the push with dtau = 1 (only products dtau*v appear, so displacements come out
 // directly). Requires at least one outer body.
 template <int d>
-PushOutResult<d> solvePushOut(const PushOutCentral<d>& central, const std::vector<PushOutOuter<d>>& outers);
+PushOutResult<d> solvePushOut(const PushOutCentral<d>& central,
+                              const std::vector<PushOutOuter<d>>& outers);
 
 }  // namespace monolith::solvers::contact

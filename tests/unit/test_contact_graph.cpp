@@ -1,12 +1,12 @@
 // Tests for the contact-graph levels (strongly connected components in topological order, notes
 // 1.6) and the islands of finite-mass bodies.
-#include "solvers/contact/contact_graph.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <random>
 #include <stdexcept>
+
+#include "solvers/contact/contact_graph.h"
 
 namespace {
 
@@ -83,7 +83,8 @@ TEST(ContactLevels, RandomGraphsIndependentOfEdgeOrder) {
         ASSERT_EQ(levels.levelOf[a] == levels.levelOf[b], sameComponent) << a << " " << b;
       }
     }
-    for (const auto& [below, above] : edges) EXPECT_LE(levels.levelOf[below], levels.levelOf[above]);
+    for (const auto& [below, above] : edges)
+      EXPECT_LE(levels.levelOf[below], levels.levelOf[above]);
     for (int l = 0; l < levels.count(); ++l) {
       EXPECT_TRUE(std::is_sorted(levels.nodes[l].begin(), levels.nodes[l].end()));
       for (int v : levels.nodes[l]) EXPECT_EQ(levels.levelOf[v], l);

@@ -1,8 +1,6 @@
 // Tests for the impulse factor and the point impulse with restitution and Coulomb friction
 // (thesis Sec. 2.3, notes 1.5): every check is on the bodies' velocities after applying the
 // impulse, not on the formula that produced it.
-#include "solvers/contact/impulse.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -10,6 +8,8 @@
 #include <cmath>
 #include <random>
 #include <type_traits>
+
+#include "solvers/contact/impulse.h"
 
 namespace {
 
@@ -38,7 +38,9 @@ struct Body {
     return b;
   }
   Vec<d> linearMomentum() const { return mass * v; }
-  AngVec<d> angularMomentumAboutOrigin() const { return cross<d>(x, Vec<d>(mass * v)) + inertia * w; }
+  AngVec<d> angularMomentumAboutOrigin() const {
+    return cross<d>(x, Vec<d>(mass * v)) + inertia * w;
+  }
 };
 
 template <int d>
@@ -152,9 +154,10 @@ TYPED_TEST(ContactImpulse, FrictionlessRestitutionAndMomentum) {
       pair.apply(j);
       EXPECT_NEAR(pair.relative().dot(pair.n), -e * vnBefore, 1e-12);
       EXPECT_LT((pair.a.linearMomentum() + pair.b.linearMomentum() - pBefore).norm(), 1e-12);
-      EXPECT_LT((pair.a.angularMomentumAboutOrigin() + pair.b.angularMomentumAboutOrigin() -
-                 lBefore).norm(),
-                1e-12);
+      EXPECT_LT(
+          (pair.a.angularMomentumAboutOrigin() + pair.b.angularMomentumAboutOrigin() - lBefore)
+              .norm(),
+          1e-12);
     }
   }
 }
@@ -303,6 +306,37 @@ TYPED_TEST(ContactImpulse, FrictionMagnitudeClampNeverCreatesSliding) {
   const Vec<d> free = pointImpulse<d>(pair.k(), pair.relative(), pair.n, s);
   s.clampFrictionMagnitude = true;
   EXPECT_EQ(pointImpulse<d>(pair.k(), pair.relative(), pair.n, s), free);
+}
+
+// Large friction coupled through K can make n.K(n - mu t) <= 0: no sliding impulse reaches the
+// target normal velocity. The impulse is then the frictionless one (no energy from friction).
+TEST(ContactImpulse3D, SlidingWithoutSolutionFallsBackToFrictionless) {
+  std::mt19937 rng(19);
+  int found = 0;
+  for (int trial = 0; trial < 10000 && found < 5; ++trial) {
+    Pair<3> pair = randomApproachingPair<3>(rng);
+    pair.b.infinite = true;
+    pair.a.inertia = pair.a.inertia / 20;  // light in rotation: strong coupling in K
+    pair.a.v += 2 * tangential<3>(randomVec<3>(rng), pair.n);
+    makeApproaching(pair);
+    const Mat<3> k = pair.k();
+    const Vec<3> v = pair.relative();
+    const Vec<3> t = tangential<3>(v, pair.n).normalized();
+    const double mu = 2.5;
+    const Vec<3> stick = k.inverse() * (-0.5 * v.dot(pair.n) * pair.n - v);  // e = 0.5
+    const bool slides = tangential<3>(stick, pair.n).norm() > mu * stick.dot(pair.n);
+    if (!slides || pair.n.dot(k * (pair.n - mu * t)) > 0) continue;
+    ++found;
+    ImpulseSettings s;
+    s.restitution = 0.5;
+    const Vec<3> frictionless = pointImpulse<3>(k, v, pair.n, s);
+    s.friction = mu;
+    const Vec<3> j = pointImpulse<3>(k, v, pair.n, s);
+    EXPECT_LT((j - frictionless).norm(), 1e-14 * frictionless.norm());
+    pair.apply(j);
+    EXPECT_NEAR(pair.relative().dot(pair.n), -0.5 * v.dot(pair.n), 1e-12);
+  }
+  EXPECT_EQ(found, 5);
 }
 
 }  // namespace

@@ -1,13 +1,13 @@
 // Tests for the energy clamp of thesis Sec. 2.3.2: the kinetic energy of the reference state,
 // measured by applying the scaled impulse to explicit bodies, never rises.
-#include "solvers/contact/energy_clamp.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <random>
 #include <type_traits>
+
+#include "solvers/contact/energy_clamp.h"
 
 namespace {
 
@@ -74,11 +74,13 @@ double energyBefore(const ClampBody<d>& a, const ClampBody<d>& b) {
 template <int d>
 Vec<d> elasticImpulse(const ClampBody<d>& a, const ClampBody<d>& b, const Vec<d>& n) {
   auto pointVelocity = [](const ClampBody<d>& body) {
-    return Vec<d>(body.velocity + angularCross<d>(AngVec<d>(body.inverseInertia * body.angularMomentum), body.r));
+    return Vec<d>(body.velocity +
+                  angularCross<d>(AngVec<d>(body.inverseInertia * body.angularMomentum), body.r));
   };
   auto factor = [](const ClampBody<d>& body) {
     const CrossMat<d> rs = crossMatrix<d>(body.r);
-    return Mat<d>(body.inverseMass * Mat<d>::Identity() + rs.transpose() * body.inverseInertia * rs);
+    return Mat<d>(body.inverseMass * Mat<d>::Identity() +
+                  rs.transpose() * body.inverseInertia * rs);
   };
   const double vn = (pointVelocity(a) - pointVelocity(b)).dot(n);
   return (-2 * vn / n.dot((factor(a) + factor(b)) * n)) * n;
@@ -241,7 +243,8 @@ TYPED_TEST(EnergyClamp, RandomSplitStatesNeverGainEnergy) {
     if (unit(rng) < 0.2) b = ClampBody<d>();  // static partner now and then
     // An impulse from some other (split) state: arbitrary direction and size.
     const Vec<d> j = randomVec<d>(rng, 3);
-    const AngVec<d> torque = unit(rng) < 0.5 ? AngVec<d>::Zero() : AngVec<d>(randomVec<kAngularDim<d>>(rng));
+    const AngVec<d> torque =
+        unit(rng) < 0.5 ? AngVec<d>::Zero() : AngVec<d>(randomVec<kAngularDim<d>>(rng));
     const ClampResult r = clampImpulseEnergy<d>(a, b, j, torque);
     ++counts[static_cast<int>(r.kind)];
     ASSERT_GE(r.scale, 0.0);

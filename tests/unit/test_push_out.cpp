@@ -2,8 +2,6 @@
 // reference: static bodies become finite bodies of mass m/eps and inertia I/eps, and the full
 // dense system (B.1) is solved for every j_o at once. As eps -> 0 it must converge to the
 // special-case solves of B.3.
-#include "solvers/contact/push_out.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -11,6 +9,8 @@
 #include <limits>
 #include <random>
 #include <type_traits>
+
+#include "solvers/contact/push_out.h"
 
 namespace {
 
@@ -93,8 +93,8 @@ Reference<d> bruteForce(const PushOutCentral<d>& c, const std::vector<PushOutOut
     for (int col = 0; col < n; ++col) {
       const PushOutOuter<d>& p = outers[active[col]];
       // m_c^{-1} j + r_o*^T I_c^{-1} j_tau with j = -sum j_p, j_tau = -sum r_p* j_p.
-      Mat<d> block = -Mat<d>::Identity() / mc -
-                     crossMatrix<d>(o.r).transpose() * icInv * crossMatrix<d>(p.r);
+      Mat<d> block =
+          -Mat<d>::Identity() / mc - crossMatrix<d>(o.r).transpose() * icInv * crossMatrix<d>(p.r);
       if (row == col) block -= factor<d>(o.mass * scale, AngMat<d>(o.inertia * scale), o.q);
       a.block<d, d>(row * d, col * d) = block;
     }
@@ -188,10 +188,12 @@ void checkExactlySolved(const PushOutCentral<d>& c, const std::vector<PushOutOut
                 "(B.1) residual");
     // The outer's motion is that of the impulse: m_o^{-1} j_o and I_o^{-1}(q_o x j_o).
     if (!outers[i].isStatic) {
-      expectClose(r.outerDisplacements[i], Vec<d>(r.outerImpulses[i] / outers[i].mass), 1e-14, "dx_o");
-      expectClose(r.outerRotations[i],
-                  AngVec<d>(outers[i].inertia.inverse() * cross<d>(outers[i].q, r.outerImpulses[i])),
-                  1e-13, "dw_o");
+      expectClose(r.outerDisplacements[i], Vec<d>(r.outerImpulses[i] / outers[i].mass), 1e-14,
+                  "dx_o");
+      expectClose(
+          r.outerRotations[i],
+          AngVec<d>(outers[i].inertia.inverse() * cross<d>(outers[i].q, r.outerImpulses[i])), 1e-13,
+          "dw_o");
     }
     linear -= r.outerImpulses[i];
     angular -= cross<d>(outers[i].r, r.outerImpulses[i]);
@@ -346,7 +348,8 @@ TEST(PushOut3D, CollinearStatics) {
     EXPECT_EQ(r.kind, PushOutCase::StaticsCollinear);
     checkAgainstBruteForce<3>(c, outers, r);
     for (std::size_t i : {1u, 4u}) {
-      expectClose(relativeDisplacement<3>(r, outers[i], i), outers[i].displacement, 1e-12, "dynamic");
+      expectClose(relativeDisplacement<3>(r, outers[i], i), outers[i].displacement, 1e-12,
+                  "dynamic");
     }
   }
 }
@@ -371,7 +374,7 @@ TYPED_TEST(PushOut, PushesApartInTheRightDirection) {
   box.mass = 2;
   PushOutOuter<d> ground;
   ground.isStatic = true;
-  ground.r = -up;                 // contact below the box's centre
+  ground.r = -up;                  // contact below the box's centre
   ground.displacement = 0.1 * up;  // box bottom (inside) -> ground surface: upwards
   const PushOutResult<d> rise = solvePushOut<d>(box, {ground});
   expectClose(rise.centralDisplacement, Vec<d>(0.1 * up), 1e-14, "box rises");
@@ -379,10 +382,10 @@ TYPED_TEST(PushOut, PushesApartInTheRightDirection) {
 
   box.isStatic = true;
   PushOutOuter<d> ball;
-  ball.r = up;                      // contact on the box's top
-  ball.q = -0.5 * up;               // below the ball's centre
+  ball.r = up;         // contact on the box's top
+  ball.q = -0.5 * up;  // below the ball's centre
   ball.mass = 3;
-  ball.displacement = -0.1 * up;    // box top (inside the ball) -> ball bottom (inside the box)
+  ball.displacement = -0.1 * up;  // box top (inside the ball) -> ball bottom (inside the box)
   const PushOutResult<d> push = solvePushOut<d>(box, {ball});
   expectClose(push.outerDisplacements[0], Vec<d>(0.1 * up), 1e-14, "ball rises");
   expectClose(push.outerImpulses[0], Vec<d>(0.3 * up), 1e-14, "ball impulse");
