@@ -45,9 +45,9 @@ struct ContactSettings {
   int collisionPairIterations = 20;  // impulses per pair per sweep
   int contactIterations = 10;        // outer contact sweeps (Step III), epsilon-scaled
   int contactLevelIterations = 2;    // per level and sweep
-  int contactPairIterations = 20;
+  int contactPairIterations = 20;    // Gauss-Seidel sweeps of one pair's manifold solve
   bool shockPropagation = true;      // GBF 2003 shock propagation after contact
-  int shockLevelIterations = 2;
+  int shockLevelIterations = 8;      // thesis code: 2; see docs/architecture.md
   int shockPairIterations = 10;
   bool pushOut = true;               // interpenetration resolution, Sec. 4.6.1 / App. B
   int pushOutLevelIterations = 2;

@@ -158,8 +158,12 @@ void parseShapeComponent(World<d>& world, Entity e, const Config& c) {
           if (!t[i].is_array() || t[i].size() != 3)
             triangles.element(i).fail("three vertex indices", describeJson(t[i]));
           for (int k = 0; k < 3; ++k) {
-            if (!t[i][k].is_number_integer() || t[i][k].get<long>() < 0 || t[i][k].get<long>() >= shape.vertexCount())
-              triangles.element(i).fail("indices of existing vertices (0-based)", describeJson(t[i]));
+            if (!t[i][k].is_number_integer())
+              triangles.element(i).fail("integer vertex indices (0-based)", describeJson(t[i][k]));
+            if (t[i][k].get<long>() < 0 || t[i][k].get<long>() >= shape.vertexCount())
+              triangles.element(i).fail("indices of existing vertices (0-based)",
+                                        "index " + std::to_string(t[i][k].get<long>()) + " (the mesh has " +
+                                            std::to_string(shape.vertexCount()) + " vertices)");
             shape.triangles.push_back(t[i][k].get<int>());
           }
         }

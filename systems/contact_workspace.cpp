@@ -57,6 +57,18 @@ Eigen::Matrix<double, d, d> rotationOf(const Orientation<d>& q) {
   else return Eigen::Rotation2Dd(q).toRotationMatrix();
 }
 
+// r x j and w x r written out (the PGS inner loop below is the hot path of contact).
+template <int d>
+inline con::AngVec<d> crossFast(const Eigen::Matrix<double, d, 1>& r, const Eigen::Matrix<double, d, 1>& j) {
+  if constexpr (d == 3) return r.cross(j);
+  else return con::AngVec<d>(r.x() * j.y() - r.y() * j.x());
+}
+template <int d>
+inline Eigen::Matrix<double, d, 1> spinFast(const con::AngVec<d>& w, const Eigen::Matrix<double, d, 1>& r) {
+  if constexpr (d == 3) return w.cross(r);
+  else return Eigen::Vector2d(-w(0) * r.y(), w(0) * r.x());
+}
+
 }  // namespace
 
 template <int d>
@@ -133,12 +145,15 @@ void ContactWorkspace<d>::updateCandidate(ContactBody<d>& b) const {
   if (b.isStatic) {
     b.candidate.x = b.x0;
     b.candidate.R = b.R0;
+    b.inverseInertiaCandidate = b.inverseInertia0;
     return;
   }
   const double k = kick ? 1.0 : 0.0;
   b.candidate.x = b.x0 + dt * (b.v + k * b.dv);
   const con::AngVec<d> w = b.inverseInertia0 * (b.L + k * b.dL);
   b.candidate.R = rotationOf<d>(rotated<d>(b.q0, dt * w));
+  if constexpr (d == 3) b.inverseInertiaCandidate = b.candidate.R * b.body->inertiaBodyInverse * b.candidate.R.transpose();
+  else b.inverseInertiaCandidate = b.inverseInertia0;
 }
 
 template <int d>
@@ -150,6 +165,7 @@ template <int d>
 void ContactWorkspace<d>::setCandidateToBase(ContactBody<d>& b) const {
   b.candidate.x = b.x0;
   b.candidate.R = b.R0;
+  b.inverseInertiaCandidate = b.inverseInertia0;
 }
 
 template <int d>
@@ -263,11 +279,20 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
   // positions, as GBF 2003 and Sec. 2.3.2 compute them; mapping points back through the body's
   // rotation to time n, as the level-set code does for surface vertices, is wrong for round
   // shapes: a rolling disk's deepest point is not a material point).
+  using TangentBasis = Eigen::Matrix<double, d, d - 1>;
+  using TangentVec = Eigen::Matrix<double, d - 1, 1>;
+  using TangentMat = Eigen::Matrix<double, d - 1, d - 1>;
   struct Point {
     VecD ra, rb, n;
     Eigen::Matrix<double, d, d> K;
     double target = 0, normalImpulse = 0;
     VecD friction = VecD::Zero();
+    // Projected Gauss-Seidel data: K n, n.K n, tangent basis T, (T^T K T)^{-1}, friction in T.
+    VecD Kn = VecD::Zero();
+    double kn = 1;
+    TangentBasis T;
+    TangentMat tangentMass;
+    TangentVec tangentImpulse = TangentVec::Zero();
   };
   thread_local std::vector<Point> points;
   points.clear();
@@ -278,32 +303,45 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
     p.ra = c.point - A.candidate.x;
     p.rb = c.point - B.candidate.x;
     p.n = c.normal;
-    const double vn = (A.pointVelocity(p.ra) - B.pointVelocity(p.rb)).dot(p.n);
+    const double vn = (A.v + spinFast<d>(A.inverseInertiaCandidate * A.L, p.ra) - B.v -
+                       spinFast<d>(B.inverseInertiaCandidate * B.L, p.rb)).dot(p.n);
     const bool approaching = vn < -settings.approachTolerance;
     anyApproaching = anyApproaching || approaching;
     // Target normal velocity -e min(0, v_n); contact's e = -1 + eps removes the fraction eps
     // of the approach (notes 1.6). Points not approaching must not start to.
     p.target = approaching ? -impulse.restitution * vn : 0.0;
-    p.K = con::impulseFactor(con::ImpulseBody<d>{A.inverseMass(), A.inverseInertia(), p.ra}) +
-          con::impulseFactor(con::ImpulseBody<d>{B.inverseMass(), B.inverseInertia(), p.rb});
+    p.K = con::impulseFactor(con::ImpulseBody<d>{A.inverseMass(), A.splitInverseInertia(), p.ra}) +
+          con::impulseFactor(con::ImpulseBody<d>{B.inverseMass(), B.splitInverseInertia(), p.rb});
+    p.Kn = p.K * p.n;
+    p.kn = p.n.dot(p.Kn);
+    if constexpr (d == 3) {
+      const VecD t1 = (std::abs(p.n.x()) < 0.6 ? VecD::UnitX() : VecD::UnitY()).cross(p.n).normalized();
+      p.T.col(0) = t1;
+      p.T.col(1) = p.n.cross(t1);
+    } else {
+      p.T.col(0) = VecD(-p.n.y(), p.n.x());
+    }
+    p.tangentMass = (p.T.transpose() * p.K * p.T).inverse();
     points.push_back(p);
   }
   if (!anyApproaching) return 0;
 
   // Working copies: the impulse of the whole pair is found first, then (second contact step,
   // collisions) clamped as one against the state before it (Sec. 2.3.2) and applied.
-  VecD vA = A.v, vB = B.v;
-  con::AngVec<d> LA = A.L, LB = B.L;
-  const double mA = A.inverseMass(), mB = B.inverseMass();
   const bool finiteA = !A.infinite(), finiteB = !B.infinite();
-  auto relativeVelocity = [&](const Point& p) {
-    return VecD(vA + con::angularCross<d>(A.inverseInertia0 * LA, p.ra) - vB -
-                con::angularCross<d>(B.inverseInertia0 * LB, p.rb));
+  const double mA = A.inverseMass(), mB = B.inverseMass();
+  VecD vA = A.v, vB = B.v;
+  con::AngVec<d> wA = A.inverseInertiaCandidate * A.L, wB = B.inverseInertiaCandidate * B.L;
+  auto relativeVelocity = [&](const Point& p) -> VecD {
+    return vA + spinFast<d>(wA, p.ra) - vB - spinFast<d>(wB, p.rb);
   };
   auto apply = [&](const Point& p, const VecD& j) {  // bodies of infinite mass take no impulse
-    if (finiteA) vA += mA * j, LA += con::cross<d>(p.ra, j);
-    if (finiteB) vB -= mB * j, LB -= con::cross<d>(p.rb, j);
+    if (finiteA) vA += mA * j, wA += A.inverseInertiaCandidate * crossFast<d>(p.ra, j);
+    if (finiteB) vB -= mB * j, wB -= B.inverseInertiaCandidate * crossFast<d>(p.rb, j);
   };
+  double speedScale = 0;
+  for (const Point& p : points) speedScale = std::max(speedScale, std::abs(p.target) + std::abs(relativeVelocity(p).dot(p.n)));
+  const double tolerance = 1e-7 * speedScale + 1e-12;
   if (points.size() == 1) {
     // One point: the impulse of notes 1.5 (sticking, else sliding along K(n - mu t)).
     Point& p = points[0];
@@ -320,29 +358,31 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
       double change = 0;
       for (Point& p : points) {
         const VecD vrel = relativeVelocity(p);
-        const double kn = p.n.dot(p.K * p.n);
-        const double lambda = std::max(0.0, p.normalImpulse + (p.target - vrel.dot(p.n)) / kn);
+        const double lambda = std::max(0.0, p.normalImpulse + (p.target - vrel.dot(p.n)) / p.kn);
         const double dl = lambda - p.normalImpulse;
         p.normalImpulse = lambda;
-        apply(p, dl * p.n);
-        change = std::max(change, std::abs(dl) * kn);
+        VecD j = dl * p.n;
+        change = std::max(change, std::abs(dl) * p.kn);
         if (impulse.friction > 0) {
-          const VecD v2 = relativeVelocity(p);
-          const VecD vt = v2 - v2.dot(p.n) * p.n;
-          const double speed = vt.norm();
-          if (speed > 0) {
-            const VecD t = vt / speed;
-            VecD f = p.friction - (speed / t.dot(p.K * t)) * t;
-            const double limit = impulse.friction * p.normalImpulse;
-            if (f.norm() > limit) f *= limit / f.norm();
-            apply(p, f - p.friction);
-            change = std::max(change, (f - p.friction).norm() * t.dot(p.K * t));
-            p.friction = f;
-          }
+          // Sticking step in the tangent plane (the point velocity after the normal change is
+          // vrel + K n dl), then the Coulomb disk |f| <= mu lambda.
+          const TangentVec vt = p.T.transpose() * (vrel + p.Kn * dl);
+          TangentVec f = p.tangentImpulse - p.tangentMass * vt;
+          const double limit = impulse.friction * p.normalImpulse;
+          // Sliding: the friction opposes the slip (maximal dissipation), not the direction of
+          // the sticking impulse, which the rotational coupling in K skews (a sliding cube
+          // would yaw and drift sideways).
+          if (f.norm() > limit) f = vt.norm() > 0 ? TangentVec(-limit * vt.normalized()) : TangentVec(f * (limit / f.norm()));
+          const TangentVec df = f - p.tangentImpulse;
+          p.tangentImpulse = f;
+          j += p.T * df;
+          change = std::max(change, (p.T * df).norm() / p.tangentMass.norm());
         }
+        apply(p, j);
       }
-      if (change < 1e-3 * settings.approachTolerance) break;
+      if (change < tolerance) break;
     }
+    for (Point& p : points) p.friction = p.T * p.tangentImpulse;
   }
   // Net impulse on A and its angular impulse about A's centre: J, tau = sum r_a x j.
   VecD J = VecD::Zero();

@@ -52,12 +52,16 @@ struct ContactBody {
   VecD vCollided = VecD::Zero();  // \hat v^n after Step II, restored after Step IV
   AngV LCollided = AngV::Zero();
   solvers::collision::Pose<d> candidate;
+  // World inverse inertia at the candidate orientation: impulses are computed in the split
+  // state (GBF 2003; Sec. 2.3.2), the energy clamp measures with the base state's inertia.
+  AngM inverseInertiaCandidate = AngM::Zero();
   long movedStamp = 0;
 
   bool infinite() const { return isStatic || kinematic || frozen; }
   double inverseMass() const { return infinite() ? 0.0 : 1.0 / mass; }
   AngM inverseInertia() const { return infinite() ? AngM::Zero() : inverseInertia0; }
   AngV omega() const { return inverseInertia0 * L; }
+  AngM splitInverseInertia() const { return infinite() ? AngM::Zero() : inverseInertiaCandidate; }
   // Velocity at a point with lever arm r (from the centre of mass).
   VecD pointVelocity(const VecD& r) const { return v + solvers::contact::angularCross<d>(omega(), r); }
   double kineticEnergy() const { return infinite() ? 0.0 : 0.5 * mass * v.squaredNorm() + 0.5 * L.dot(omega()); }

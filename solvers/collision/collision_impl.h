@@ -45,10 +45,11 @@ struct PreparedGeometry<d>::Impl {
   };
   std::vector<TreeNode> triangleTree;
   std::vector<int> triangleOrder;
-  // Mesh: for each triangle, which of its edges (vertex e to vertex e+1) no other triangle shares,
-  // i.e. lie on the mesh's border. An edge shared with a neighbour is no edge to be pushed across
-  // ("internal edge"): there a shape is pushed along the triangles' own normals.
-  std::vector<std::array<char, 3>> borderEdges;
+  // Mesh: for each triangle and edge e (vertex e to vertex e+1), the other triangle sharing that
+  // edge, or -1 on the mesh's border (also for an edge of more than two triangles). Whether a
+  // shape may be pushed across an edge, rather than along the faces' normals, depends on it
+  // (narrow_phase_fcl.cpp, "internal edges").
+  std::vector<std::array<int, 3>> edgeNeighbours;
   // FCL's copy of the shape (3-D, every type but the half-space, whose pairs are all exact).
   std::shared_ptr<fcl::CollisionGeometry<double>> fclGeometry;
 };
@@ -66,7 +67,7 @@ struct Hull3 {
 Hull3 convexHull3(const std::vector<Eigen::Vector3d>& points);
 
 // --- mesh triangle tree (triangle_tree.cpp) ------------------------------------------------
-// Fills triangleTree, triangleOrder and borderEdges.
+// Fills triangleTree, triangleOrder and edgeNeighbours.
 void buildTriangleTree(PreparedGeometry<3>::Impl& impl, const Geometry<3>& mesh);
 // Triangles whose bounding box meets `box` (body frame), in a fixed order.
 void trianglesNear(const PreparedGeometry<3>::Impl& impl, const Eigen::AlignedBox3d& box, std::vector<int>& out);
@@ -94,12 +95,13 @@ SurfaceDistance<d> signedDistance(const PreparedGeometry<d>& g, const Eigen::Mat
 // generalised: the point is "inside" the other shape when its signed distance < radius.
 template <int d>
 struct FeaturePoint {
-  Eigen::Matrix<double, d, 1> x;  // world
+  Eigen::Matrix<double, d, 1> x;  // in the frame `pose` maps into (featurePoints)
   double radius = 0;
 };
 
-// Feature points of a posed shape. `deepest` (world, any length) is the direction in which the
-// other shape lies: cylinders pick their rim points extreme along it. Half-spaces have none.
+// Feature points of a posed shape. `deepest` (same frame, any length) is the direction in which
+// the other shape lies: cylinders pick their rim points extreme along it. Half-spaces have none;
+// a mesh gives its vertices.
 template <int d>
 void featurePoints(const PreparedGeometry<d>& g, const Pose<d>& pose, const Eigen::Matrix<double, d, 1>& deepest,
                    std::vector<FeaturePoint<d>>& out);
@@ -119,8 +121,28 @@ void featureContacts(const PreparedGeometry<d>& f, const Pose<d>& poseF, const E
 template <int d>
 void finishManifold(std::vector<ContactPoint<d>>& points, int maxPoints, double mergeDistance);
 
+// The contact between surface points onA and onB: midway, with the given normal and depth.
+template <int d>
+ContactPoint<d> midwayContact(const Eigen::Matrix<double, d, 1>& onA, const Eigen::Matrix<double, d, 1>& onB,
+                              const Eigen::Matrix<double, d, 1>& normal, double depth) {
+  ContactPoint<d> c;
+  c.point = 0.5 * (onA + onB);
+  c.normal = normal;
+  c.depth = depth;
+  return c;
+}
+
+// Whether some `extra` point represents `main`: as deep (within `tolerance`) along nearly the
+// same normal (2.5 degrees: FCL's MPR axis matches a face normal to ~1e-7 rad in a face contact).
+template <int d>
+bool isRepresented(const ContactPoint<d>& main, const std::vector<ContactPoint<d>>& extra, double tolerance) {
+  for (const auto& e : extra)
+    if (e.depth >= main.depth - tolerance && e.normal.dot(main.normal) >= 0.999) return true;
+  return false;
+}
+
 // Appends the `main` points (FCL's or the closest features') that no `extra` point already
-// represents (as deep, within `tolerance`, along nearly the same normal), then the extra points.
+// represents, then the extra points.
 template <int d>
 void keepUnrepresented(const std::vector<ContactPoint<d>>& main, const std::vector<ContactPoint<d>>& extra,
                        double tolerance, std::vector<ContactPoint<d>>& out);

@@ -14,6 +14,7 @@
 #include <cmath>
 
 #include "solvers/collision/collision_impl.h"
+#include "solvers/collision/contact_axis.h"
 #include "solvers/collision/narrow_phase_fcl.h"
 
 namespace monolith::solvers::collision {
@@ -30,9 +31,6 @@ constexpr double kRedundantDepth = 1e-6;  // times the pair's length scale
 // Contacts closer than this (times the length scale) are duplicates, e.g. a corner found both by
 // FCL's box-box clipping and by the vertex test.
 constexpr double kMergeDistance = 1e-6;
-// A mesh triangle's own normal must be within 60 degrees of FCL's contact normal for the shape to
-// rest on the triangle's face (rather than touch its edge), where feature points make sense.
-constexpr double kTriangleFaceCosine = 0.5;
 
 struct Scratch {
   std::vector<CP> main, extra, result;
@@ -47,35 +45,6 @@ Scratch& scratch() {
 }
 
 GeometryType typeOf(const PG& g) { return g.geometry().type; }
-
-CP midwayContact(const Vec3& onA, const Vec3& onB, const Vec3& normal, double depth) {
-  CP c;
-  c.point = 0.5 * (onA + onB);
-  c.normal = normal;
-  c.depth = depth;
-  return c;
-}
-
-// Closest points of the segments p1-q1 and p2-q2 (Ericson, Real-Time Collision Detection, 5.1.9).
-void closestSegmentPoints(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2, Vec3& c1, Vec3& c2) {
-  const Vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
-  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
-  const double c = d1.dot(r), b = d1.dot(d2);
-  const double denom = a * e - b * b;
-  // Parallel segments (denom ~ 0): any s works; 0 is as good as another, the end caps supply
-  // the rest of the line contact.
-  double s = denom > 1e-12 * a * e ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
-  double t = (b * s + f) / e;
-  if (t < 0) {
-    t = 0;
-    s = std::clamp(-c / a, 0.0, 1.0);
-  } else if (t > 1) {
-    t = 1;
-    s = std::clamp((b - c) / a, 0.0, 1.0);
-  }
-  c1 = p1 + s * d1;
-  c2 = p2 + t * d2;
-}
 
 void capsulePair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb, double margin, double scale,
                  Scratch& s) {
@@ -96,7 +65,7 @@ void capsulePair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
   s.main.clear();
   s.extra.clear();
   const double depth = ra + rb - dist;
-  if (depth >= -margin) s.main.push_back(midwayContact(ca - ra * n, cb + rb * n, n, depth));
+  if (depth >= -margin) s.main.push_back(midwayContact<3>(ca - ra * n, cb + rb * n, n, depth));
   // The end caps: two points for capsules lying side by side.
   featureContacts<3>(a, pa, -n, b, pb, margin, false, s.features, s.extra);
   featureContacts<3>(b, pb, n, a, pa, margin, true, s.features, s.extra);
@@ -116,6 +85,7 @@ void generalPair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
   s.triangles.clear();
   const bool fclWorked = fclContacts(a, pa, b, pb, s.main, s.triangles);
   const bool clippedManifold = boxBox && !s.main.empty();  // FCL's box-box points: all kept
+  const bool fromFcl = !s.main.empty();                     // else from fcl::distance (exact axis)
   if (fclWorked && s.main.empty()) {
     if (!(margin > 0)) return;
     CP c;
@@ -142,6 +112,9 @@ void generalPair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
         if (!known) s.axes.push_back(c.normal);
       }
       refineAxis(a, pa, b, pb, -1, s.axes, s.main[0]);
+      // Still not represented by a feature point (an edge contact): search for the axis of least
+      // overlap around it, which is what MPR approximates.
+      if (fromFcl && !isRepresented<3>(s.main[0], s.extra, tolerance)) descendToMinimumOverlap(a, pa, b, pb, s.main[0]);
     }
     if (!s.main.empty()) {
       // A vertex that went more than half way through picks the far face: its normal opposes

@@ -1,14 +1,15 @@
 // FCL glue for the 3-D narrow phase (issue 3).
 //
 // FCL 0.7's conventions differ between its algorithms (checked against this build, see
-// tests/unit/test_narrow_phase.cpp): Contact::normal points from o1 to o2 for the shape pairs,
+// tests/unit/test_narrow_phase.cpp): Contact::normal points from o1 to o2 for the shape pairs and
 // box-box (ODE's dBoxBox) puts each point midway between the surfaces with its own depth, but
-// libccd's MPR (every other convex pair) returns a point somewhere inside the overlap and an
-// approximate depth, and the mesh routines report the normal and the sign of the depth
-// inconsistently with the argument order (sphere-triangle: depth < 0). Distance queries return
-// the nearest points in world coordinates for shape pairs but in each object's own frame for
-// sphere-mesh. So apart from box-box we keep only FCL's axis (and its sign for shape pairs) and
-// recompute depth and point exactly along it from the shapes' projections.
+// libccd's MPR (every other convex pair) returns a point somewhere inside the overlap, an
+// approximate depth and an axis that can be degrees from the minimum-translation one, and the
+// mesh routines report the normal and the sign of the depth inconsistently with the argument
+// order (sphere-triangle: depth < 0). Distance queries return the nearest points in world
+// coordinates for shape pairs but in each object's own frame for sphere-mesh. So apart from
+// box-box only FCL's axis and point are kept, and the contact is rebuilt on that axis exactly
+// (contact_axis.h); the callers refine the axis further.
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/geometry/shape/box.h>
 #include <fcl/geometry/shape/capsule.h>
@@ -20,11 +21,11 @@
 #include <fcl/narrowphase/detail/gjk_solver_libccd.h>
 #include <fcl/narrowphase/distance.h>
 
-#include <algorithm>
 #include <array>
 #include <cmath>
 #include <exception>
 
+#include "solvers/collision/contact_axis.h"
 #include "solvers/collision/narrow_phase_fcl.h"
 
 namespace monolith::solvers::collision {
@@ -43,61 +44,6 @@ fcl::Transform3d transformOf(const Pose<3>& pose) {
   t.linear() = pose.R;
   t.translation() = pose.x;
   return t;
-}
-
-// [min, max] of n.x over the posed shape (over one triangle of a mesh when `triangle` >= 0).
-Eigen::Vector2d projection(const PreparedGeometry<3>& g, const Pose<3>& pose, const Vec3& n, int triangle) {
-  const Geometry<3>& geo = g.geometry();
-  const double c = n.dot(pose.x);
-  const Vec3 nb = pose.R.transpose() * n;  // n in the body frame
-  double half = 0;
-  switch (geo.type) {
-    case GeometryType::Box: half = nb.cwiseAbs().dot(geo.halfExtents); break;
-    case GeometryType::Sphere: half = geo.radius; break;
-    case GeometryType::Capsule: half = geo.halfHeight * std::abs(nb.z()) + geo.radius; break;
-    case GeometryType::Cylinder:
-      half = geo.halfHeight * std::abs(nb.z()) + geo.radius * std::sqrt(std::max(0.0, 1 - nb.z() * nb.z()));
-      break;
-    case GeometryType::HalfSpace: return {-kInfinity, kInfinity};
-    case GeometryType::Convex:
-    case GeometryType::Mesh: {
-      double lo = kInfinity, hi = -kInfinity;
-      auto visit = [&](const Vec3& v) {
-        const double t = nb.dot(v);
-        lo = std::min(lo, t);
-        hi = std::max(hi, t);
-      };
-      if (geo.type == GeometryType::Mesh && triangle >= 0 && triangle < static_cast<int>(geo.triangles.size())) {
-        for (int v : geo.triangles[triangle]) visit(geo.vertices[v]);
-      } else {
-        for (const auto& v : g.impl().vertices) visit(v);
-      }
-      return {c + lo, c + hi};
-    }
-  }
-  return {c - half, c + half};
-}
-
-// A contact on `axis` (either sign) near `near`: the normal takes the sign along which the
-// projections of A and B overlap least, the depth is that overlap (exact along the axis: the
-// distance A must move along it to separate), and the point sits on the middle of the overlap.
-// False when the overlap is below -margin.
-bool contactOnAxis(const PreparedGeometry<3>& a, const Pose<3>& poseA, int triangleA, const PreparedGeometry<3>& b,
-                   const Pose<3>& poseB, int triangleB, const Vec3& near, const Vec3& axis, double margin,
-                   ContactPoint<3>& out) {
-  const double len = axis.norm();
-  if (!(len > 0) || !std::isfinite(len)) return false;
-  const Vec3 n = axis / len;
-  const Eigen::Vector2d pa = projection(a, poseA, n, triangleA);
-  const Eigen::Vector2d pb = projection(b, poseB, n, triangleB);
-  const double depthPlus = pb[1] - pa[0];   // normal +n: A lies on the + side of B
-  const double depthMinus = pa[1] - pb[0];  // normal -n
-  const bool plus = depthPlus <= depthMinus;
-  out.normal = plus ? n : Vec3(-n);
-  out.depth = plus ? depthPlus : depthMinus;
-  const double middle = plus ? 0.5 * (pa[0] + pb[1]) : -0.5 * (pa[1] + pb[0]);  // along out.normal
-  out.point = near + (middle - out.normal.dot(near)) * out.normal;
-  return out.depth >= -margin;
 }
 
 }  // namespace
@@ -185,68 +131,70 @@ bool withFclShape(const PreparedGeometry<3>& g, Visit&& visit) {
 
 }  // namespace
 
-void refineAxis(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b, const Pose<3>& poseB,
-                int triangleB, const std::vector<Vec3>& axes, ContactPoint<3>& c) {
-  for (const Vec3& axis : axes) {
-    ContactPoint<3> candidate;
-    if (contactOnAxis(a, poseA, -1, b, poseB, triangleB, c.point, axis, kInfinity, candidate) &&
-        candidate.depth < c.depth)
-      c = candidate;
-  }
-}
-
-bool separatedFromTriangle(const PreparedGeometry<3>& a, const Pose<3>& poseAInMesh, const PreparedGeometry<3>& mesh,
-                           int triangle, double margin) {
-  const Geometry<3>& geo = mesh.geometry();
-  const auto& tri = geo.triangles[triangle];
-  const std::array<Vec3, 3> p = {geo.vertices[tri[0]], geo.vertices[tri[1]], geo.vertices[tri[2]]};
-  const Vec3 face = (p[1] - p[0]).cross(p[2] - p[0]);
-  std::array<Vec3, 4> axes = {face, face.cross(p[1] - p[0]), face.cross(p[2] - p[1]), face.cross(p[0] - p[2])};
-  for (Vec3& axis : axes) {
-    const double len = axis.norm();
-    if (!(len > 0)) continue;
-    axis /= len;
-    const Eigen::Vector2d shape = projection(a, poseAInMesh, axis, -1);
-    const double t0 = axis.dot(p[0]), t1 = axis.dot(p[1]), t2 = axis.dot(p[2]);
-    const double lo = std::min({t0, t1, t2}), hi = std::max({t0, t1, t2});
-    if (shape[0] > hi + margin || lo > shape[1] + margin) return true;
-  }
-  return false;
-}
-
 namespace {
 
+// Whether contact axis `c` may leave triangle t across the edge it points to (in the triangle's
+// plane), rather than along the face normal n1 (oriented towards the shape). Yes across the mesh's
+// border, and across a convex ridge when c lies between the two faces' normals (the edge's
+// Voronoi region). Across a flat or concave shared edge no: the edge belongs to the
+// triangulation, not to the surface ("internal edge").
+bool mayLeaveAcrossEdge(const PreparedGeometry<3>& mesh, int t, const Vec3& n1, const Vec3& c) {
+  const Geometry<3>& geo = mesh.geometry();
+  const auto& tri = geo.triangles[t];
+  const std::array<Vec3, 3> p = {geo.vertices[tri[0]], geo.vertices[tri[1]], geo.vertices[tri[2]]};
+  const Vec3 face = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
+  const Vec3 inPlane = c - c.dot(face) * face;
+  int e = 0;
+  double best = -kInfinity;
+  for (int k = 0; k < 3; ++k) {
+    const double along = (p[(k + 1) % 3] - p[k]).cross(face).normalized().dot(inPlane);  // outward edge normal
+    if (along > best) {
+      best = along;
+      e = k;
+    }
+  }
+  const int other = mesh.impl().edgeNeighbours[t][e];
+  if (other < 0) return true;
+  const auto& tri2 = geo.triangles[other];
+  const int a = tri[e], b = tri[(e + 1) % 3];
+  int far = tri2[0];
+  for (int v : tri2)
+    if (v != a && v != b) far = v;
+  const Vec3 edge = (p[(e + 1) % 3] - p[e]).normalized();
+  // Convex seen from the shape: the neighbour falls away below this face's plane.
+  if (!(n1.dot(geo.vertices[far] - p[e]) < -1e-9 * (p[(e + 1) % 3] - p[e]).norm())) return false;
+  // The neighbour's normal on the shape's side: opposite to the direction from the edge to the
+  // far vertex's side, i.e. the face normal of the neighbour that points away from this face.
+  Vec3 n2 = (geo.vertices[tri2[1]] - geo.vertices[tri2[0]]).cross(geo.vertices[tri2[2]] - geo.vertices[tri2[0]]);
+  n2.normalize();
+  const Vec3 intoThis = (p[(e + 2) % 3] - p[e]) - (p[(e + 2) % 3] - p[e]).dot(edge) * edge;  // from the edge into t
+  if (n2.dot(intoThis) < 0) n2 = -n2;  // the ridge: both normals lean away from each other
+  const Vec3 cc = c - c.dot(edge) * edge;
+  const double s12 = n1.cross(n2).dot(edge), s1 = n1.cross(cc).dot(edge), s2 = cc.cross(n2).dot(edge);
+  return s1 * s12 >= 0 && s2 * s12 >= 0;
+}
+
 // The axis of a shape-triangle contact: the triangle's own normal, or FCL's axis if the shape
-// overlaps the triangle less along it and that axis pushes the shape out across a border edge of
-// the mesh (a shape beside the mesh's edge). Across an edge shared with a neighbour it would be an
-// artefact of the triangulation, not of the surface. `separated`: FCL found the shape apart from
-// the triangle (the margin case); an overlap along the normal then means the shape is beside the
-// triangle, below its plane, over a neighbour that has the contact.
+// overlaps the triangle less along it and it may leave the triangle across that edge (above). If
+// it may not, the shape lies beyond an internal edge, over the neighbour, whose contact it is:
+// none here. `separated`: FCL found the shape apart from the triangle (the margin case); an
+// overlap along the normal then means the shape is beside the triangle as well.
 bool onTriangleAxis(const PreparedGeometry<3>& a, const Pose<3>& poseAInMesh, const PreparedGeometry<3>& mesh,
                     int triangle, const Vec3& near, const Vec3& fclAxis, double margin, bool separated,
                     ContactPoint<3>& out) {
   const Geometry<3>& geo = mesh.geometry();
   const auto& tri = geo.triangles[triangle];
-  const std::array<Vec3, 3> p = {geo.vertices[tri[0]], geo.vertices[tri[1]], geo.vertices[tri[2]]};
-  const Vec3 face = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
+  const Vec3 face = (geo.vertices[tri[1]] - geo.vertices[tri[0]]).cross(geo.vertices[tri[2]] - geo.vertices[tri[0]]);
   const Pose<3> meshFrame;
   if (!contactOnAxis(a, poseAInMesh, -1, mesh, meshFrame, triangle, near, face, kInfinity, out)) return false;
   ContactPoint<3> alternative = out;
   refineAxis(a, poseAInMesh, mesh, meshFrame, triangle, {fclAxis}, alternative);
-  // The edge the alternative normal leaves through: the one whose outward in-plane normal it
-  // follows most.
-  const Vec3 inPlane = alternative.normal - alternative.normal.dot(face) * face;
-  int edge = 0;
-  double best = -kInfinity;
-  for (int e = 0; e < 3; ++e) {
-    const Vec3 outward = (p[(e + 1) % 3] - p[e]).cross(face).normalized();  // counter-clockwise about face
-    if (outward.dot(inPlane) > best) {
-      best = outward.dot(inPlane);
-      edge = e;
-    }
+  if (alternative.depth < out.depth) {
+    if (!mayLeaveAcrossEdge(mesh, triangle, out.normal, alternative.normal)) return false;
+    out = alternative;
+  } else if (separated && out.depth > 0) {
+    return false;
   }
-  if (alternative.depth < out.depth && mesh.impl().borderEdges[triangle][edge]) out = alternative;
-  else if (separated && out.depth > 0) return false;
   return out.depth >= -margin;
 }
 

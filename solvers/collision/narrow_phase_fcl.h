@@ -21,21 +21,11 @@ bool fclMarginContact(const PreparedGeometry<3>& a, const Pose<3>& poseA, const 
 
 // Shape A (box, capsule, cylinder or convex), posed in the mesh's frame, against triangle t of
 // the mesh (FCL's libccd shape-triangle test; within `margin`, its GJK distance). The contact is
-// in the mesh's frame, its normal out of the triangle towards A.
+// in the mesh's frame, its normal out of the triangle towards A: the triangle's own normal, or
+// FCL's axis where A lies beside the mesh's border or on a convex ridge. False also when A lies
+// beyond an edge the triangle shares with a flat or concave neighbour (the neighbour's contact).
 bool fclTriangleContact(const PreparedGeometry<3>& a, const Pose<3>& poseAInMesh, const PreparedGeometry<3>& mesh,
                         int triangle, double margin, ContactPoint<3>& out);
-
-// Moves contact `c` onto whichever of `axes` (either sign) A and B overlap least along, if that
-// is less than along its own normal: the separating-axis choice among candidate axes (FCL's MPR
-// axis is only approximately the minimum-translation one). triangleB: B is that triangle of a mesh.
-void refineAxis(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b, const Pose<3>& poseB,
-                int triangleB, const std::vector<Eigen::Vector3d>& axes, ContactPoint<3>& c);
-
-// True when an axis among the triangle's normal and its in-plane edge normals separates shape A
-// (posed in the mesh's frame) from triangle t by more than `margin`: a cheap exact rejection
-// before FCL's test.
-bool separatedFromTriangle(const PreparedGeometry<3>& a, const Pose<3>& poseAInMesh, const PreparedGeometry<3>& mesh,
-                           int triangle, double margin);
 
 // fcl::collide without contact generation. Neither shape may be a half-space.
 bool fclOverlap(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b,

@@ -1,12 +1,14 @@
 // A shape against a triangle mesh (issue 3). A mesh has no inside (it is a surface, meant for
 // static ground and walls), so contacts come from the triangles near the shape (triangle_tree.cpp):
-// a sphere gets the exact closest point of each triangle; other shapes get FCL's libccd
-// shape-triangle contact, completed by their feature points above that triangle (inside its
-// prism), so that a box resting on a mesh keeps its four corners as on a half-space. Everything
-// is computed in the mesh's frame and turned to the world at the end.
+// a sphere gets the exact closest point of each triangle; other shapes get their feature points
+// above each triangle (inside its prism, along its normal), so that a box resting on a mesh keeps
+// its four corners as on a half-space, and FCL's libccd shape-triangle contact where those do not
+// settle it (no feature point over the triangle, or the mesh's border). Everything is computed in
+// the mesh's frame and turned to the world at the end.
 #include <cmath>
 
 #include "solvers/collision/collision_impl.h"
+#include "solvers/collision/contact_axis.h"
 #include "solvers/collision/narrow_phase_fcl.h"
 
 namespace monolith::solvers::collision {
@@ -36,14 +38,6 @@ Scratch& scratch() {
   return s;
 }
 
-CP midwayContact(const Vec3& onA, const Vec3& onB, const Vec3& normal, double depth) {
-  CP c;
-  c.point = 0.5 * (onA + onB);
-  c.normal = normal;
-  c.depth = depth;
-  return c;
-}
-
 std::array<Vec3, 3> corners(const Geometry<3>& mesh, int t) {
   const auto& tri = mesh.triangles[t];
   return {mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]};
@@ -62,7 +56,7 @@ bool sphereTriangle(const Vec3& centre, double radius, const Geometry<3>& mesh, 
   const Vec3 faceNormal = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
   const Vec3 n = dist > 0 ? Vec3(diff / dist) : faceNormal;
   onFace = std::abs(n.dot(faceNormal)) > kFaceRegionCosine;
-  out = midwayContact(centre - radius * n, closest, n, depth);
+  out = midwayContact<3>(centre - radius * n, closest, n, depth);
   return true;
 }
 
@@ -101,7 +95,26 @@ void featuresOnTriangle(const std::vector<FeaturePoint<3>>& features, const Geom
     bool inside = true;
     for (int e = 0; e < 3 && inside; ++e)
       inside = (p[(e + 1) % 3] - p[e]).cross(onPlane - p[e]).dot(faceNormal) >= -1e-9 * twiceArea;
-    if (inside) out.push_back(midwayContact(f.x - f.radius * n, onPlane, n, -separation));
+    if (inside) out.push_back(midwayContact<3>(f.x - f.radius * n, onPlane, n, -separation));
+  }
+}
+
+// The triangle's vertices inside the shape (or within the margin), with the shape's face normal
+// reversed: the other half of the vertex test, for a mesh bump poking into a shape's face. Normals
+// that do not face the shape from the triangle's side (a vertex deep enough to pick a far face)
+// are left out.
+void triangleVerticesInShape(const PreparedGeometry<3>& a, const Pose<3>& poseAInMesh, const Geometry<3>& mesh, int t,
+                             const Vec3& towardsA, double margin, std::vector<CP>& out) {
+  const auto& bounds = a.impl().localBounds;
+  for (int v : mesh.triangles[t]) {
+    const Vec3& x = mesh.vertices[v];
+    const Vec3 q = poseAInMesh.R.transpose() * (x - poseAInMesh.x);
+    if (bounds.exteriorDistance(q) > margin) continue;
+    const SurfaceDistance<3> sd = signedDistance<3>(a, q, margin);
+    if (!(-sd.distance >= -margin)) continue;
+    const Vec3 n = -(poseAInMesh.R * sd.normal);
+    if (n.dot(towardsA) <= 0) continue;
+    out.push_back(midwayContact<3>(poseAInMesh.R * sd.surfacePoint + poseAInMesh.x, x, n, -sd.distance));
   }
 }
 
@@ -124,19 +137,31 @@ void meshContacts(const PreparedGeometry<3>& a, const Pose<3>& poseA, const Prep
   const bool sphere = a.geometry().type == GeometryType::Sphere;
   const double tolerance = kRepresentedDepth * scale;
   s.onFace.clear();
+  const auto& neighbours = mesh.impl().edgeNeighbours;
   for (int t : s.candidates) {
-    if (!sphere && separatedFromTriangle(a, rel, mesh, t, margin)) continue;
     CP c;
-    bool onFace = false;
-    if (sphere ? sphereTriangle(rel.x, a.geometry().radius, geo, t, margin, c, onFace)
-               : fclTriangleContact(a, rel, mesh, t, margin, c)) {
-      s.main.push_back(c);
-      s.onFace.push_back(onFace);
-      if (sphere) continue;
-      s.features.clear();
-      featurePoints<3>(a, rel, Vec3(-c.normal), s.features);
-      featuresOnTriangle(s.features, geo, t, c, margin, tolerance, s.extra);
+    if (sphere) {
+      bool onFace = false;
+      if (sphereTriangle(rel.x, a.geometry().radius, geo, t, margin, c, onFace)) {
+        s.main.push_back(c);
+        s.onFace.push_back(onFace);
+      }
+      continue;
     }
+    if (separatedFromTriangle(a, rel, mesh, t, margin)) continue;
+    // The vertex test both ways: the shape's feature points over the triangle, the triangle's
+    // vertices in the shape. Inside the mesh, when these find the contact, FCL's test would only
+    // add a point they represent; otherwise (edges crossing, or the mesh's border) FCL decides,
+    // and its point stays if nothing represents it.
+    if (!triangleNormalContact(a, rel, mesh, t, margin, c)) continue;
+    const std::size_t before = s.extra.size();
+    s.features.clear();
+    featurePoints<3>(a, rel, Vec3(-c.normal), s.features);
+    featuresOnTriangle(s.features, geo, t, c, margin, tolerance, s.extra);
+    if (a.geometry().type != GeometryType::Mesh) triangleVerticesInShape(a, rel, geo, t, c.normal, margin, s.extra);
+    const bool interior = neighbours[t][0] >= 0 && neighbours[t][1] >= 0 && neighbours[t][2] >= 0;
+    if (s.extra.size() > before && interior) continue;
+    if (fclTriangleContact(a, rel, mesh, t, margin, c)) s.main.push_back(c);
   }
   if (sphere) dropInternalEdgeContacts(s.main, s.onFace);
   s.result.clear();

@@ -14,9 +14,6 @@ namespace {
 
 // Contacts at (almost) the same place whose normals agree to within ~8 degrees are one contact.
 constexpr double kSameNormalCosine = 0.99;
-// FCL's point is represented by a feature point as deep along a normal within 2.5 degrees: MPR's
-// axis matches a face normal to ~1e-7 rad when the contact is a face contact.
-constexpr double kRepresentedCosine = 0.999;
 
 template <int d>
 using Vec = Eigen::Matrix<double, d, 1>;
@@ -34,7 +31,7 @@ Vec<d> closestOnSegment(const Vec<d>& q, const Vec<d>& a, const Vec<d>& b) {
 // Closest point of triangle abc to q (Ericson, Real-Time Collision Detection, 5.1.5: Voronoi
 // regions of the vertices, then of the edges, else the face).
 Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& q, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                  const Eigen::Vector3d& c) {
+                                       const Eigen::Vector3d& c) {
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = q - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0 && d2 <= 0) return a;
@@ -349,15 +346,8 @@ void finishManifold(std::vector<ContactPoint<d>>& points, int maxPoints, double 
 template <int d>
 void keepUnrepresented(const std::vector<ContactPoint<d>>& main, const std::vector<ContactPoint<d>>& extra,
                        double tolerance, std::vector<ContactPoint<d>>& out) {
-  for (const auto& m : main) {
-    bool represented = false;
-    for (const auto& e : extra)
-      if (e.depth >= m.depth - tolerance && e.normal.dot(m.normal) >= kRepresentedCosine) {
-        represented = true;
-        break;
-      }
-    if (!represented) out.push_back(m);
-  }
+  for (const auto& m : main)
+    if (!isRepresented<d>(m, extra, tolerance)) out.push_back(m);
   out.insert(out.end(), extra.begin(), extra.end());
 }
 

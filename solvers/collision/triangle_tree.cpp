@@ -1,6 +1,6 @@
 // Bounding-box tree over a mesh's triangles (issue 3), built once per PreparedGeometry: the mesh
 // narrow phase asks it for the triangles near a shape before running FCL on each of them. Also
-// marks the edges on the mesh's border.
+// finds each triangle's neighbours across its edges.
 // Median splits along the longest axis of the triangle centroids, ties broken by index, so the
 // tree (and the candidate order) only depends on the mesh.
 #include <algorithm>
@@ -64,7 +64,7 @@ void buildTriangleTree(PreparedGeometry<3>::Impl& impl, const Geometry<3>& mesh)
   std::iota(impl.triangleOrder.begin(), impl.triangleOrder.end(), 0);
   impl.triangleTree.clear();
   builder.build(0, static_cast<int>(mesh.triangles.size()));
-  // Border edges: an (undirected) edge used by one triangle only.
+  // Neighbours across each edge: the (undirected) edges sorted, a run of exactly two is shared.
   std::vector<std::pair<std::pair<int, int>, int>> edges;  // (edge, 3 * triangle + e)
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
     for (int e = 0; e < 3; ++e) {
@@ -72,11 +72,16 @@ void buildTriangleTree(PreparedGeometry<3>::Impl& impl, const Geometry<3>& mesh)
       edges.push_back({{std::min(a, b), std::max(a, b)}, static_cast<int>(3 * t + e)});
     }
   std::sort(edges.begin(), edges.end());
-  impl.borderEdges.assign(mesh.triangles.size(), {0, 0, 0});
-  for (std::size_t i = 0; i < edges.size(); ++i) {
-    const bool shared = (i > 0 && edges[i - 1].first == edges[i].first) ||
-                        (i + 1 < edges.size() && edges[i + 1].first == edges[i].first);
-    if (!shared) impl.borderEdges[edges[i].second / 3][edges[i].second % 3] = 1;
+  impl.edgeNeighbours.assign(mesh.triangles.size(), {-1, -1, -1});
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    if (j - i == 2) {
+      const int u = edges[i].second, v = edges[i + 1].second;
+      impl.edgeNeighbours[u / 3][u % 3] = v / 3;
+      impl.edgeNeighbours[v / 3][v % 3] = u / 3;
+    }
+    i = j;
   }
 }
 

@@ -25,7 +25,10 @@ struct ClampResult {
   enum class Case { NoGain, Scaled, Discarded } kind = Case::NoGain;
 };
 
-// Linear and angular impulse on A: j and j_tau = r_A x j (+ optional pure torque jTau).
+// Linear and angular impulse on A: j and j_tau = r_A x j (+ optional pure torque jTau); on B:
+// -j and -(r_B x j) - jTau. Cases of the thesis's epsilon = -2 (linear) / (quadratic): no
+// quadratic term or epsilon >= 1 -> NoGain (scale 1); 0 < epsilon < 1 -> Scaled;
+// epsilon <= 0 (energy rises for every small scale) -> Discarded (scale 0).
 template <int d>
 ClampResult clampImpulseEnergy(const ClampBody<d>& a, const ClampBody<d>& b, const Vec<d>& j,
                                const AngVec<d>& pureTorque = AngVec<d>::Zero());

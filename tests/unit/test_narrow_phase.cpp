@@ -4,6 +4,8 @@
 // determinism and thread safety.
 #include "solvers/collision/geometry.h"
 #include "solvers/collision/narrow_phase.h"
+// White box: the exact point-to-shape distance, to check where contact points lie.
+#include "solvers/collision/collision_impl.h"
 
 #include <fcl/geometry/shape/box.h>
 #include <fcl/geometry/shape/capsule.h>
@@ -411,6 +413,100 @@ TEST(NarrowPhase3, BoxOnTriangleMeshGroundGivesFourCorners) {
   const Mat3 R = rot(0.3, Vec3::UnitY());
   const auto got = contacts<3>(box3(0.4, 0.5, 0.3), at(Vec3(0.2, 0.49, -0.1), R), groundMesh(), at(Vec3::Zero()));
   expectManifold<3>(got, boxCornersXZ(0.4, 0.3, -0.005, R, Vec3(0.2, 0, -0.1)), Vec3::UnitY(), 0.01, 1e-9);
+}
+
+TEST(NarrowPhase3, BoxAcrossTheSharedEdgeOfATiltedMeshIsPushedAlongItsNormal) {
+  // The two-triangle ground turned 0.5 rad about z and moved: a box straddling the diagonal
+  // shared by the triangles must not be pushed sideways across that (internal) edge.
+  const Mat3 Rm = rot(0.5, Vec3::UnitZ());
+  const Vec3 up = Rm * Vec3::UnitY();
+  const Pose<3> ground = at(Vec3(0.1, -0.05, 0.3), Rm);
+  const Mat3 Rb = Rm * rot(0.9, Vec3::UnitY());  // flat on the ground, turned about its normal
+  const Vec3 centre = ground.x + Rm * Vec3(0.2, 0.3 - 0.02, 0.25);  // 0.02 deep, over the diagonal
+  const auto got = contacts<3>(box3(0.5, 0.3, 0.4), at(centre, Rb), groundMesh(), ground);
+  std::vector<Vec3> corners;
+  for (double sx : {-1, 1})
+    for (double sz : {-1, 1}) corners.push_back(Vec3(centre + Rb * Vec3(sx * 0.5, -0.3, sz * 0.4) + 0.01 * up));
+  expectManifold<3>(got, corners, up, 0.02, 1e-9);
+}
+
+TEST(NarrowPhase3, BoxWithinMarginAboveMesh) {
+  const auto got = contacts<3>(box3(0.4, 0.5, 0.3), at(Vec3(0.2, 0.504, -0.1)), groundMesh(), at(Vec3::Zero()), 0.01);
+  expectManifold<3>(got, boxCornersXZ(0.4, 0.3, 0.002, Mat3::Identity(), Vec3(0.2, 0, -0.1)), Vec3::UnitY(), -0.004, 1e-9);
+  EXPECT_TRUE(contacts<3>(box3(0.4, 0.5, 0.3), at(Vec3(0.2, 0.504, -0.1)), groundMesh(), at(Vec3::Zero()), 0.003).empty());
+}
+
+TEST(NarrowPhase3, MeshPeakPokingIntoABox) {
+  // A pyramid of four triangles, apex at (0, 0.3, 0); a box whose bottom face is at y = 0.27:
+  // the apex is the contact, 0.03 deep, pushing the box up.
+  Geometry<3> pyramid;
+  pyramid.type = GeometryType::Mesh;
+  pyramid.vertices = {Vec3(-1, 0, -1), Vec3(1, 0, -1), Vec3(1, 0, 1), Vec3(-1, 0, 1), Vec3(0, 0.3, 0)};
+  pyramid.triangles = {{0, 4, 1}, {1, 4, 2}, {2, 4, 3}, {3, 4, 0}};
+  const auto got = contacts<3>(box3(0.5, 0.5, 0.5), at(Vec3(0.1, 0.77, -0.05)), pyramid, at(Vec3::Zero()));
+  ASSERT_GE(got.size(), 1u);
+  double deepest = 0;
+  for (const auto& c : got) {
+    EXPECT_GT(c.normal.y(), 0.7);
+    deepest = std::max(deepest, c.depth);
+  }
+  EXPECT_NEAR(deepest, 0.03, 1e-9);
+}
+
+TEST(NarrowPhase3, ShallowRandomContactsAreConsistent) {
+  // A shape moved towards another along a random direction until they just touch (bisection on
+  // overlaps), then 0.01 further: every contact must push A back against that direction, no
+  // depth may exceed 0.01 by much (the true penetration depth is at most 0.01), and the contact's
+  // points must lie on the surfaces. Polytopes, capsules and spheres: FCL's MPR axis refined to
+  // the least overlap, the vertex tests exact. (Cylinders are approximate: rim samples.)
+  std::vector<Geometry<3>> shapes = {box3(0.5, 0.3, 0.4), capsule3(0.2, 0.4), convexCube(0.4), sphere3(0.3)};
+  {
+    Geometry<3> ball;
+    ball.type = GeometryType::Convex;
+    std::mt19937 rng(5);
+    std::normal_distribution<double> n(0, 1);
+    for (int i = 0; i < 30; ++i) ball.vertices.push_back(0.5 * Vec3(n(rng), n(rng), n(rng)).normalized());
+    shapes.push_back(ball);
+  }
+  std::vector<std::unique_ptr<PreparedGeometry<3>>> prepared;
+  for (const auto& g : shapes) prepared.push_back(std::make_unique<PreparedGeometry<3>>(g));
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double push = 0.01;
+  int cases = 0, tooDeep = 0, offSurface = 0;
+  for (int it = 0; it < 1000; ++it) {
+    const int ia = it % 5, ib = (it / 5) % 5;
+    const PreparedGeometry<3>& A = *prepared[ia];
+    const PreparedGeometry<3>& B = *prepared[ib];
+    const Pose<3> pb = at(Vec3::Zero(), rot(3 * u(rng), Vec3(u(rng), u(rng), u(rng) + 2)));
+    Pose<3> pa = at(Vec3::Zero(), rot(3 * u(rng), Vec3(u(rng) + 2, u(rng), u(rng))));
+    const Vec3 d = Vec3(u(rng), u(rng), u(rng)).normalized();
+    double in = 0, out = 3;
+    for (int k = 0; k < 50; ++k) {
+      pa.x = 0.5 * (in + out) * d;
+      (overlaps<3>(A, pa, B, pb) ? in : out) = 0.5 * (in + out);
+    }
+    pa.x = (out - push) * d;
+    std::vector<ContactPoint<3>> got;
+    findContacts<3>(A, pa, B, pb, ContactQuery{}, got);
+    ASSERT_FALSE(got.empty()) << ia << "-" << ib;
+    ++cases;
+    double deepest = 0;
+    bool off = false;
+    for (const auto& c : got) {
+      ASSERT_TRUE(c.point.allFinite() && std::isfinite(c.depth));
+      EXPECT_NEAR(c.normal.norm(), 1, 1e-12);
+      EXPECT_GT(c.normal.dot(d), 0) << ia << "-" << ib;
+      deepest = std::max(deepest, c.depth);
+      const auto onA = signedDistance<3>(A, pa.R.transpose() * (c.pointOnA() - pa.x), 1e9);
+      const auto onB = signedDistance<3>(B, pb.R.transpose() * (c.pointOnB() - pb.x), 1e9);
+      off = off || std::abs(onA.distance) > 1e-3 || std::abs(onB.distance) > 1e-3;
+    }
+    tooDeep += deepest > push + 2e-3;
+    offSurface += off;
+  }
+  EXPECT_LE(tooDeep, cases / 100);
+  EXPECT_LE(offSurface, cases * 4 / 100);
 }
 
 // --- general behaviour ---------------------------------------------------------------------------
