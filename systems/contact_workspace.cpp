@@ -428,20 +428,177 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
 }
 
 template <int d>
+int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const std::vector<int>& pairList, ImpulseMode mode,
+                                                 double epsilon, int iterations, double margin,
+                                                 std::vector<col::ContactPoint<d>>& scratch,
+                                                 double* clampEnergyChange, int* clampsApplied) {
+  // Shock propagation with a body resting on several bodies of lower levels (a pyramid box on
+  // the two below it): the lower bodies are frozen, so the body's contacts with all of them form
+  // one small problem for this body alone, solved jointly by projected Gauss-Seidel. Solving
+  // them pair after pair instead leaves a residual slip that shows as a slow creep.
+  ContactBody<d>& C = bodies[c];
+  if (C.infinite()) return 0;
+  using TangentBasis = Eigen::Matrix<double, d, d - 1>;
+  using TangentVec = Eigen::Matrix<double, d - 1, 1>;
+  using TangentMat = Eigen::Matrix<double, d - 1, d - 1>;
+  struct Point {
+    VecD r, n, partnerVelocity, Kn;
+    double target = 0, normalImpulse = 0, kn = 1, friction = 0;
+    TangentBasis T;
+    TangentMat tangentMass;
+    TangentVec tangentImpulse = TangentVec::Zero();
+  };
+  thread_local std::vector<Point> points;
+  points.clear();
+  col::ContactQuery query;
+  query.margin = margin;
+  const double restitution = -1.0 + epsilon;
+  const con::AngMat<d> Iinv = C.inverseInertiaCandidate;
+  const VecD v0 = C.v;
+  const con::AngVec<d> w0 = Iinv * C.L;
+  bool anyApproaching = false;
+  VecD frameVelocity = VecD::Zero();
+  bool frameSet = false;
+  for (int pi : pairList) {
+    ContactPairState& pair = pairs[pi];
+    const bool cIsA = pair.a == c;
+    const ContactBody<d>& P = bodies[cIsA ? pair.b : pair.a];
+    scratch.clear();
+    if (col::findContacts(*C.geometry, C.candidate, *P.geometry, P.candidate, query, scratch) == 0) continue;
+    const double mu = std::min(C.friction, P.friction);
+    for (const auto& cp : scratch) {
+      if (cp.depth < -margin) continue;
+      Point p;
+      p.r = cp.point - C.candidate.x;
+      p.n = cp.normal;  // out of P towards C: C is "A" in findContacts above
+      p.partnerVelocity = P.v + spinFast<d>(P.inverseInertiaCandidate * P.L, VecD(cp.point - P.candidate.x));
+      if (!frameSet) frameVelocity = p.partnerVelocity, frameSet = true;
+      const double vn = (v0 + spinFast<d>(w0, p.r) - p.partnerVelocity).dot(p.n);
+      const bool approaching = vn < -settings.approachTolerance;
+      anyApproaching = anyApproaching || approaching;
+      p.target = approaching ? -restitution * vn : 0.0;
+      p.friction = mu;
+      const Eigen::Matrix<double, d, d> K =
+          con::impulseFactor(con::ImpulseBody<d>{C.inverseMass(), C.splitInverseInertia(), p.r});
+      p.Kn = K * p.n;
+      p.kn = p.n.dot(p.Kn);
+      if constexpr (d == 3) {
+        const VecD t1 = (std::abs(p.n.x()) < 0.6 ? VecD::UnitX() : VecD::UnitY()).cross(p.n).normalized();
+        p.T.col(0) = t1;
+        p.T.col(1) = p.n.cross(t1);
+      } else {
+        p.T.col(0) = VecD(-p.n.y(), p.n.x());
+      }
+      p.tangentMass = (p.T.transpose() * K * p.T).inverse();
+      points.push_back(p);
+    }
+    if (mode != ImpulseMode::Collision) pair.contacted = true;
+  }
+  if (!anyApproaching) return 0;
+  VecD v = v0;
+  con::AngVec<d> w = w0;
+  double speedScale = 0;
+  for (const Point& p : points) speedScale = std::max(speedScale, std::abs(p.target));
+  const double tolerance = 1e-7 * speedScale + 1e-12;
+  const double m = C.inverseMass();
+  for (int sweep = 0; sweep < iterations; ++sweep) {
+    double change = 0;
+    for (Point& p : points) {
+      const VecD vrel = v + spinFast<d>(w, p.r) - p.partnerVelocity;
+      const double lambda = std::max(0.0, p.normalImpulse + (p.target - vrel.dot(p.n)) / p.kn);
+      const double dl = lambda - p.normalImpulse;
+      p.normalImpulse = lambda;
+      VecD j = dl * p.n;
+      change = std::max(change, std::abs(dl) * p.kn);
+      if (p.friction > 0) {
+        const TangentVec vt = p.T.transpose() * (vrel + p.Kn * dl);
+        TangentVec f = p.tangentImpulse - p.tangentMass * vt;
+        const double limit = p.friction * p.normalImpulse;
+        if (f.norm() > limit) f = vt.norm() > 0 ? TangentVec(-limit * vt.normalized()) : TangentVec(f * (limit / f.norm()));
+        const TangentVec df = f - p.tangentImpulse;
+        p.tangentImpulse = f;
+        j += p.T * df;
+        change = std::max(change, (p.T * df).norm() / p.tangentMass.norm());
+      }
+      v += m * j;
+      w += Iinv * crossFast<d>(p.r, j);
+    }
+    if (change < tolerance) break;
+  }
+  VecD J = VecD::Zero();
+  con::AngVec<d> tau = con::AngVec<d>::Zero();
+  int active = 0;
+  for (const Point& p : points) {
+    const VecD j = p.normalImpulse * p.n + p.T * p.tangentImpulse;
+    if (j.squaredNorm() == 0) continue;
+    ++active;
+    J += j;
+    tau += crossFast<d>(p.r, j);
+  }
+  if (active == 0) return 0;
+  double scale = 1;
+  if (settings.energyClamp && mode == ImpulseMode::ClampedContact) {
+    // The partners have infinite mass here; energy is measured in the frame of the first one
+    // (they move together, or not at all, in a resting stack).
+    con::ClampBody<d> cc{C.inverseMass(), C.inverseInertia(), VecD(C.v - frameVelocity), C.L, VecD::Zero()};
+    con::ClampBody<d> partner;
+    const con::ClampResult r = con::clampImpulseEnergy<d>(cc, partner, J, tau);
+    if (r.kind != con::ClampResult::Case::NoGain && clampsApplied) ++*clampsApplied;
+    if (clampEnergyChange) *clampEnergyChange += r.energyChange;
+    scale = r.scale;
+    if (scale == 0) return 0;
+  }
+  C.v += scale * C.inverseMass() * J;
+  C.L += scale * tau;
+  updateCandidate(C);
+  return active;
+}
+
+template <int d>
 int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyContacted,
                                         std::vector<col::ContactPoint<d>>& scratch, double* clampEnergyChange,
                                         int* clampsApplied) {
   int impulses = 0;
   const auto& list = islandPairsByLevel[island];
+  std::vector<int> own;
   for (std::size_t begin = 0; begin < list.size();) {
     const int level = pairs[list[begin]].level;
     std::size_t end = begin;
     while (end < list.size() && pairs[list[end]].level == level) ++end;
+    // Bodies of this level whose every pair here is with a body of infinite mass (lower levels
+    // are frozen) are solved jointly; pairs inside the level (a cycle) pairwise.
     for (int li = 0; li < settings.shockLevelIterations; ++li) {
       const double eps = double(li + 1) / double(settings.shockLevelIterations);
       for (std::size_t k = begin; k < end; ++k) {
         ContactPairState& pair = pairs[list[k]];
         if (onlyContacted && !pair.contacted) continue;
+        const int upper = levels.levelOf[pair.a] == level ? pair.a : pair.b;
+        const int other = upper == pair.a ? pair.b : pair.a;
+        if (bodies[other].infinite() && !bodies[upper].infinite()) {
+          // Handled once per body, at its first such pair.
+          bool first = true;
+          for (std::size_t q = begin; q < k && first; ++q) {
+            const ContactPairState& earlier = pairs[list[q]];
+            if (onlyContacted && !earlier.contacted) continue;
+            const int u = levels.levelOf[earlier.a] == level ? earlier.a : earlier.b;
+            const int o = u == earlier.a ? earlier.b : earlier.a;
+            first = !(u == upper && bodies[o].infinite());
+          }
+          if (!first) continue;
+          own.clear();
+          for (std::size_t q = k; q < end; ++q) {
+            const ContactPairState& later = pairs[list[q]];
+            if (onlyContacted && !later.contacted) continue;
+            const int u = levels.levelOf[later.a] == level ? later.a : later.b;
+            const int o = u == later.a ? later.b : later.a;
+            if (u == upper && bodies[o].infinite() && !bodies[o].kinematic) own.push_back(list[q]);
+          }
+          if (own.size() > 1 && !bodies[other].kinematic) {
+            impulses += updateBodyAgainstFrozen(upper, own, mode, eps, settings.shockPairIterations,
+                                                settings.thickness, scratch, clampEnergyChange, clampsApplied);
+            continue;
+          }
+        }
         impulses += updatePair(pair, mode, eps, settings.shockPairIterations, settings.thickness, scratch,
                                clampEnergyChange, clampsApplied);
       }

@@ -111,6 +111,11 @@ class ContactWorkspace {
                  std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
                  int* clampsApplied);
 
+  // Joint contact solve of body c against the bodies of infinite mass in pairList.
+  int updateBodyAgainstFrozen(int c, const std::vector<int>& pairList, ImpulseMode mode, double epsilon, int iterations,
+                              double margin, std::vector<solvers::collision::ContactPoint<d>>& scratch,
+                              double* clampEnergyChange, int* clampsApplied);
+
   // Shock propagation over one island (GBF 2003; notes 1.6): bottom-up through the levels, each
   // level's bodies frozen (infinite mass) once its pairs are done; all unfrozen at the end.
   int propagateShock(int island, ImpulseMode mode, bool onlyContacted,
