@@ -158,7 +158,7 @@ void meshContacts(const PreparedGeometry<3>& a, const Pose<3>& poseA, const Prep
     s.features.clear();
     featurePoints<3>(a, rel, Vec3(-c.normal), s.features);
     featuresOnTriangle(s.features, geo, t, c, margin, tolerance, s.extra);
-    if (a.geometry().type != GeometryType::Mesh) triangleVerticesInShape(a, rel, geo, t, c.normal, margin, s.extra);
+    triangleVerticesInShape(a, rel, geo, t, c.normal, margin, s.extra);
     const bool interior = neighbours[t][0] >= 0 && neighbours[t][1] >= 0 && neighbours[t][2] >= 0;
     if (s.extra.size() > before && interior) continue;
     if (fclTriangleContact(a, rel, mesh, t, margin, c)) s.main.push_back(c);
