@@ -12,24 +12,10 @@ void Contact<d>::run(World<d>&, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (ws.bodies.empty()) return;
   ws.updateAllCandidates();
-  const ContactSettings& s = ws.settings;
   std::vector<int> impulses(ws.islands.members.size(), 0);
   ws.forEachIsland([&](int island) {
     std::vector<solvers::collision::ContactPoint<d>> scratch;
-    const auto& list = ws.islandPairsByLevel[island];
-    for (int it = 0; it < s.contactIterations; ++it) {
-      for (std::size_t begin = 0; begin < list.size();) {
-        std::size_t end = begin;
-        while (end < list.size() && ws.pairs[list[end]].level == ws.pairs[list[begin]].level) ++end;
-        for (int li = 0; li < s.contactLevelIterations; ++li) {
-          const double eps = double((it + 1) * (li + 1)) / double(s.contactIterations * s.contactLevelIterations);
-          for (std::size_t k = begin; k < end; ++k)
-            impulses[island] += ws.updatePair(ws.pairs[list[k]], ImpulseMode::Contact, eps, s.contactPairIterations,
-                                              s.thickness, scratch, nullptr, nullptr);
-        }
-        begin = end;
-      }
-    }
+    impulses[island] = ws.contactSweeps(island, ImpulseMode::Contact, false, scratch, nullptr, nullptr);
   });
   ws.unpack(false);
   int total = 0;

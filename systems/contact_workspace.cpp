@@ -39,18 +39,6 @@ col::Geometry<d> collisionGeometryOf(const Shape<d>& shape) {
 
 namespace {
 
-// exp(theta*) q: rotation by the rotation vector theta applied in the world frame.
-template <int d>
-Orientation<d> rotated(const Orientation<d>& q, const con::AngVec<d>& theta) {
-  if constexpr (d == 3) {
-    const double angle = theta.norm();
-    if (angle == 0) return q;
-    return (Eigen::Quaterniond(Eigen::AngleAxisd(angle, theta / angle)) * q).normalized();
-  } else {
-    return q + theta(0);
-  }
-}
-
 template <int d>
 Eigen::Matrix<double, d, d> rotationOf(const Orientation<d>& q) {
   if constexpr (d == 3) return q.toRotationMatrix();
@@ -68,6 +56,66 @@ inline Eigen::Matrix<double, d, 1> spinFast(const con::AngVec<d>& w, const Eigen
   if constexpr (d == 3) return w.cross(r);
   else return Eigen::Vector2d(-w(0) * r.y(), w(0) * r.x());
 }
+
+
+// One point of a projected Gauss-Seidel contact solve: impulse factor data prepared once, the
+// accumulated normal and tangent impulses updated by pgsStep.
+template <int d>
+struct PgsPoint {
+  using VecD = Eigen::Matrix<double, d, 1>;
+  using TangentBasis = Eigen::Matrix<double, d, d - 1>;
+  using TangentVec = Eigen::Matrix<double, d - 1, 1>;
+  using TangentMat = Eigen::Matrix<double, d - 1, d - 1>;
+  VecD ra = VecD::Zero(), rb = VecD::Zero(), n = VecD::Zero();  // lever arms, normal out of b
+  VecD partnerVelocity = VecD::Zero();  // joint solve: the frozen partner's point velocity
+  Eigen::Matrix<double, d, d> K = Eigen::Matrix<double, d, d>::Zero();
+  VecD Kn = VecD::Zero();
+  double kn = 1, target = 0, normalImpulse = 0, mu = 0;
+  TangentBasis T = TangentBasis::Zero();
+  TangentMat tangentMass = TangentMat::Zero();
+  TangentVec tangentImpulse = TangentVec::Zero();
+
+  void prepare(const Eigen::Matrix<double, d, d>& impulseFactor) {
+    K = impulseFactor;
+    Kn = K * n;
+    kn = n.dot(Kn);
+    if constexpr (d == 3) {
+      const VecD t1 = (std::abs(n.x()) < 0.6 ? VecD::UnitX() : VecD::UnitY()).cross(n).normalized();
+      T.col(0) = t1;
+      T.col(1) = n.cross(t1);
+    } else {
+      T.col(0) = VecD(-n.y(), n.x());
+    }
+    tangentMass = (T.transpose() * K * T).inverse();
+  }
+  VecD impulse() const { return normalImpulse * n + T * tangentImpulse; }
+
+  // Given the relative velocity at the point, the impulse increment j of this sweep; returns
+  // the size of the velocity change (for the convergence test). Normal: accumulated impulse
+  // >= 0 reaching the target normal velocity. Friction: the sticking step in the tangent plane
+  // (the point velocity after the normal change is vrel + K n dl), limited to the Coulomb disk
+  // |f| <= mu lambda; when sliding the friction opposes the slip (maximal dissipation) rather
+  // than following the sticking impulse, which the rotational coupling in K skews (a sliding
+  // cube would yaw and drift sideways).
+  double step(const VecD& vrel, VecD& j) {
+    const double lambda = std::max(0.0, normalImpulse + (target - vrel.dot(n)) / kn);
+    const double dl = lambda - normalImpulse;
+    normalImpulse = lambda;
+    j = dl * n;
+    double change = std::abs(dl) * kn;
+    if (mu > 0) {
+      const TangentVec vt = T.transpose() * (vrel + Kn * dl);
+      TangentVec f = tangentImpulse - tangentMass * vt;
+      const double limit = mu * normalImpulse;
+      if (f.norm() > limit) f = vt.norm() > 0 ? TangentVec(-limit * vt.normalized()) : TangentVec(f * (limit / f.norm()));
+      const TangentVec df = f - tangentImpulse;
+      tangentImpulse = f;
+      j += T * df;
+      change = std::max(change, (T * df).norm() / tangentMass.norm());
+    }
+    return change;
+  }
+};
 
 }  // namespace
 
@@ -151,7 +199,7 @@ void ContactWorkspace<d>::updateCandidate(ContactBody<d>& b) const {
   const double k = kick ? 1.0 : 0.0;
   b.candidate.x = b.x0 + dt * (b.v + k * b.dv);
   const con::AngVec<d> w = b.inverseInertia0 * (b.L + k * b.dL);
-  b.candidate.R = rotationOf<d>(rotated<d>(b.q0, dt * w));
+  b.candidate.R = rotationOf<d>(rotatedBy<d>(b.q0, dt * w));
   if constexpr (d == 3) b.inverseInertiaCandidate = b.candidate.R * b.body->inertiaBodyInverse * b.candidate.R.transpose();
   else b.inverseInertiaCandidate = b.inverseInertia0;
 }
@@ -188,7 +236,11 @@ void ContactWorkspace<d>::findPairs() {
     boxes_[i] = box;
     infinite_[i] = (b.isStatic || b.kinematic) ? 1 : 0;
   }
-  if (!broadPhase_) broadPhase_ = std::make_unique<col::BroadPhase<d>>();
+  // Sweep and prune is the faster of the two below about 500 boxes, FCL's dynamic AABB tree
+  // above (bench_narrow_phase); both return the same sorted pairs.
+  if (!broadPhase_)
+    broadPhase_ = std::make_unique<col::BroadPhase<d>>(n > 500 ? col::BroadPhaseMethod::FclDynamicTree
+                                                               : col::BroadPhaseMethod::SweepAndPrune);
   const auto& found = broadPhase_->findPairs(boxes_, infinite_);
   pairs.assign(found.size(), ContactPairState{});
   for (std::size_t k = 0; k < found.size(); ++k) {
@@ -213,7 +265,7 @@ void ContactWorkspace<d>::computeLevels() {
       return p;
     }
     p.x = b.x0 + dt * (b.v + k * b.dv);
-    p.R = rotationOf<d>(rotated<d>(b.q0, dt * (b.inverseInertia0 * (b.L + k * b.dL))));
+    p.R = rotationOf<d>(rotatedBy<d>(b.q0, dt * (b.inverseInertia0 * (b.L + k * b.dL))));
     return p;
   };
   // The same test also completes the processed list (notes 1.4, "contact pairs" gathered on the
@@ -279,21 +331,7 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
   // positions, as GBF 2003 and Sec. 2.3.2 compute them; mapping points back through the body's
   // rotation to time n, as the level-set code does for surface vertices, is wrong for round
   // shapes: a rolling disk's deepest point is not a material point).
-  using TangentBasis = Eigen::Matrix<double, d, d - 1>;
-  using TangentVec = Eigen::Matrix<double, d - 1, 1>;
-  using TangentMat = Eigen::Matrix<double, d - 1, d - 1>;
-  struct Point {
-    VecD ra, rb, n;
-    Eigen::Matrix<double, d, d> K;
-    double target = 0, normalImpulse = 0;
-    VecD friction = VecD::Zero();
-    // Projected Gauss-Seidel data: K n, n.K n, tangent basis T, (T^T K T)^{-1}, friction in T.
-    VecD Kn = VecD::Zero();
-    double kn = 1;
-    TangentBasis T;
-    TangentMat tangentMass;
-    TangentVec tangentImpulse = TangentVec::Zero();
-  };
+  using Point = PgsPoint<d>;
   thread_local std::vector<Point> points;
   points.clear();
   bool anyApproaching = false;
@@ -310,18 +348,9 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
     // Target normal velocity -e min(0, v_n); contact's e = -1 + eps removes the fraction eps
     // of the approach (notes 1.6). Points not approaching must not start to.
     p.target = approaching ? -impulse.restitution * vn : 0.0;
-    p.K = con::impulseFactor(con::ImpulseBody<d>{A.inverseMass(), A.splitInverseInertia(), p.ra}) +
-          con::impulseFactor(con::ImpulseBody<d>{B.inverseMass(), B.splitInverseInertia(), p.rb});
-    p.Kn = p.K * p.n;
-    p.kn = p.n.dot(p.Kn);
-    if constexpr (d == 3) {
-      const VecD t1 = (std::abs(p.n.x()) < 0.6 ? VecD::UnitX() : VecD::UnitY()).cross(p.n).normalized();
-      p.T.col(0) = t1;
-      p.T.col(1) = p.n.cross(t1);
-    } else {
-      p.T.col(0) = VecD(-p.n.y(), p.n.x());
-    }
-    p.tangentMass = (p.T.transpose() * p.K * p.T).inverse();
+    p.mu = impulse.friction;
+    p.prepare(con::impulseFactor(con::ImpulseBody<d>{A.inverseMass(), A.splitInverseInertia(), p.ra}) +
+              con::impulseFactor(con::ImpulseBody<d>{B.inverseMass(), B.splitInverseInertia(), p.rb}));
     points.push_back(p);
   }
   if (!anyApproaching) return 0;
@@ -348,7 +377,7 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
     const VecD j = con::pointImpulse<d>(p.K, relativeVelocity(p), p.n, impulse);
     apply(p, j);
     p.normalImpulse = j.dot(p.n);
-    p.friction = j - p.normalImpulse * p.n;
+    p.tangentImpulse = p.T.transpose() * (j - p.normalImpulse * p.n);
   } else {
     // Several points (a face contact): the pair's impulses are solved together by projected
     // Gauss-Seidel on accumulated impulses (normal >= 0, friction inside the Coulomb disk), so
@@ -356,40 +385,20 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
     // one-point-at-a-time impulses do.
     for (int sweep = 0; sweep < iterations; ++sweep) {
       double change = 0;
+      VecD j;
       for (Point& p : points) {
-        const VecD vrel = relativeVelocity(p);
-        const double lambda = std::max(0.0, p.normalImpulse + (p.target - vrel.dot(p.n)) / p.kn);
-        const double dl = lambda - p.normalImpulse;
-        p.normalImpulse = lambda;
-        VecD j = dl * p.n;
-        change = std::max(change, std::abs(dl) * p.kn);
-        if (impulse.friction > 0) {
-          // Sticking step in the tangent plane (the point velocity after the normal change is
-          // vrel + K n dl), then the Coulomb disk |f| <= mu lambda.
-          const TangentVec vt = p.T.transpose() * (vrel + p.Kn * dl);
-          TangentVec f = p.tangentImpulse - p.tangentMass * vt;
-          const double limit = impulse.friction * p.normalImpulse;
-          // Sliding: the friction opposes the slip (maximal dissipation), not the direction of
-          // the sticking impulse, which the rotational coupling in K skews (a sliding cube
-          // would yaw and drift sideways).
-          if (f.norm() > limit) f = vt.norm() > 0 ? TangentVec(-limit * vt.normalized()) : TangentVec(f * (limit / f.norm()));
-          const TangentVec df = f - p.tangentImpulse;
-          p.tangentImpulse = f;
-          j += p.T * df;
-          change = std::max(change, (p.T * df).norm() / p.tangentMass.norm());
-        }
+        change = std::max(change, p.step(relativeVelocity(p), j));
         apply(p, j);
       }
       if (change < tolerance) break;
     }
-    for (Point& p : points) p.friction = p.T * p.tangentImpulse;
   }
   // Net impulse on A and its angular impulse about A's centre: J, tau = sum r_a x j.
   VecD J = VecD::Zero();
   con::AngVec<d> tau = con::AngVec<d>::Zero();
   int active = 0;
   for (const Point& p : points) {
-    const VecD j = p.normalImpulse * p.n + p.friction;
+    const VecD j = p.impulse();
     if (j.squaredNorm() == 0) continue;
     ++active;
     J += j;
@@ -438,16 +447,7 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const std::vector<int>& 
   // them pair after pair instead leaves a residual slip that shows as a slow creep.
   ContactBody<d>& C = bodies[c];
   if (C.infinite()) return 0;
-  using TangentBasis = Eigen::Matrix<double, d, d - 1>;
-  using TangentVec = Eigen::Matrix<double, d - 1, 1>;
-  using TangentMat = Eigen::Matrix<double, d - 1, d - 1>;
-  struct Point {
-    VecD r, n, partnerVelocity, Kn;
-    double target = 0, normalImpulse = 0, kn = 1, friction = 0;
-    TangentBasis T;
-    TangentMat tangentMass;
-    TangentVec tangentImpulse = TangentVec::Zero();
-  };
+  using Point = PgsPoint<d>;
   thread_local std::vector<Point> points;
   points.clear();
   col::ContactQuery query;
@@ -469,27 +469,16 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const std::vector<int>& 
     for (const auto& cp : scratch) {
       if (cp.depth < -margin) continue;
       Point p;
-      p.r = cp.point - C.candidate.x;
+      p.ra = cp.point - C.candidate.x;
       p.n = cp.normal;  // out of P towards C: C is "A" in findContacts above
       p.partnerVelocity = P.v + spinFast<d>(P.inverseInertiaCandidate * P.L, VecD(cp.point - P.candidate.x));
       if (!frameSet) frameVelocity = p.partnerVelocity, frameSet = true;
-      const double vn = (v0 + spinFast<d>(w0, p.r) - p.partnerVelocity).dot(p.n);
+      const double vn = (v0 + spinFast<d>(w0, p.ra) - p.partnerVelocity).dot(p.n);
       const bool approaching = vn < -settings.approachTolerance;
       anyApproaching = anyApproaching || approaching;
       p.target = approaching ? -restitution * vn : 0.0;
-      p.friction = mu;
-      const Eigen::Matrix<double, d, d> K =
-          con::impulseFactor(con::ImpulseBody<d>{C.inverseMass(), C.splitInverseInertia(), p.r});
-      p.Kn = K * p.n;
-      p.kn = p.n.dot(p.Kn);
-      if constexpr (d == 3) {
-        const VecD t1 = (std::abs(p.n.x()) < 0.6 ? VecD::UnitX() : VecD::UnitY()).cross(p.n).normalized();
-        p.T.col(0) = t1;
-        p.T.col(1) = p.n.cross(t1);
-      } else {
-        p.T.col(0) = VecD(-p.n.y(), p.n.x());
-      }
-      p.tangentMass = (p.T.transpose() * K * p.T).inverse();
+      p.mu = mu;
+      p.prepare(con::impulseFactor(con::ImpulseBody<d>{C.inverseMass(), C.splitInverseInertia(), p.ra}));
       points.push_back(p);
     }
     if (mode != ImpulseMode::Collision) pair.contacted = true;
@@ -503,25 +492,11 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const std::vector<int>& 
   const double m = C.inverseMass();
   for (int sweep = 0; sweep < iterations; ++sweep) {
     double change = 0;
+    VecD j;
     for (Point& p : points) {
-      const VecD vrel = v + spinFast<d>(w, p.r) - p.partnerVelocity;
-      const double lambda = std::max(0.0, p.normalImpulse + (p.target - vrel.dot(p.n)) / p.kn);
-      const double dl = lambda - p.normalImpulse;
-      p.normalImpulse = lambda;
-      VecD j = dl * p.n;
-      change = std::max(change, std::abs(dl) * p.kn);
-      if (p.friction > 0) {
-        const TangentVec vt = p.T.transpose() * (vrel + p.Kn * dl);
-        TangentVec f = p.tangentImpulse - p.tangentMass * vt;
-        const double limit = p.friction * p.normalImpulse;
-        if (f.norm() > limit) f = vt.norm() > 0 ? TangentVec(-limit * vt.normalized()) : TangentVec(f * (limit / f.norm()));
-        const TangentVec df = f - p.tangentImpulse;
-        p.tangentImpulse = f;
-        j += p.T * df;
-        change = std::max(change, (p.T * df).norm() / p.tangentMass.norm());
-      }
+      change = std::max(change, p.step(VecD(v + spinFast<d>(w, p.ra) - p.partnerVelocity), j));
       v += m * j;
-      w += Iinv * crossFast<d>(p.r, j);
+      w += Iinv * crossFast<d>(p.ra, j);
     }
     if (change < tolerance) break;
   }
@@ -529,11 +504,11 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const std::vector<int>& 
   con::AngVec<d> tau = con::AngVec<d>::Zero();
   int active = 0;
   for (const Point& p : points) {
-    const VecD j = p.normalImpulse * p.n + p.T * p.tangentImpulse;
+    const VecD j = p.impulse();
     if (j.squaredNorm() == 0) continue;
     ++active;
     J += j;
-    tau += crossFast<d>(p.r, j);
+    tau += crossFast<d>(p.ra, j);
   }
   if (active == 0) return 0;
   double scale = 1;
@@ -552,6 +527,32 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const std::vector<int>& 
   C.L += scale * tau;
   updateCandidate(C);
   return active;
+}
+
+template <int d>
+int ContactWorkspace<d>::contactSweeps(int island, ImpulseMode mode, bool onlyContacted,
+                                       std::vector<col::ContactPoint<d>>& scratch, double* clampEnergyChange,
+                                       int* clampsApplied) {
+  int impulses = 0;
+  const auto& list = islandPairsByLevel[island];
+  const int iterations = settings.contactIterations, levelIterations = settings.contactLevelIterations;
+  for (int it = 0; it < iterations; ++it) {
+    for (std::size_t begin = 0; begin < list.size();) {
+      std::size_t end = begin;
+      while (end < list.size() && pairs[list[end]].level == pairs[list[begin]].level) ++end;
+      for (int li = 0; li < levelIterations; ++li) {
+        const double eps = double((it + 1) * (li + 1)) / double(iterations * levelIterations);
+        for (std::size_t k = begin; k < end; ++k) {
+          ContactPairState& pair = pairs[list[k]];
+          if (onlyContacted && !pair.contacted) continue;
+          impulses += updatePair(pair, mode, eps, settings.contactPairIterations, settings.thickness, scratch,
+                                 clampEnergyChange, clampsApplied);
+        }
+      }
+      begin = end;
+    }
+  }
+  return impulses;
 }
 
 template <int d>

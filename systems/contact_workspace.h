@@ -28,6 +28,18 @@ namespace monolith {
 template <int d>
 solvers::collision::Geometry<d> collisionGeometryOf(const Shape<d>& shape);
 
+// exp(theta*) q: an orientation turned by the world rotation vector theta (2-D: an angle).
+template <int d>
+Orientation<d> rotatedBy(const Orientation<d>& q, const solvers::contact::AngVec<d>& theta) {
+  if constexpr (d == 3) {
+    const double angle = theta.norm();
+    if (angle == 0) return q;
+    return (Eigen::Quaterniond(Eigen::AngleAxisd(angle, theta / angle)) * q).normalized();
+  } else {
+    return q + theta(0);
+  }
+}
+
 template <int d>
 struct ContactBody {
   using VecD = Eigen::Matrix<double, d, 1>;
@@ -110,6 +122,12 @@ class ContactWorkspace {
   int updatePair(ContactPairState& pair, ImpulseMode mode, double epsilon, int iterations, double margin,
                  std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
                  int* clampsApplied);
+
+  // The epsilon-scaled contact sweeps of notes 1.6 over one island: contact iterations, each
+  // level from the bottom, level iterations, eps = (it+1)(li+1)/(iterations*level iterations).
+  int contactSweeps(int island, ImpulseMode mode, bool onlyContacted,
+                    std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
+                    int* clampsApplied);
 
   // Joint contact solve of body c against the bodies of infinite mass in pairList.
   int updateBodyAgainstFrozen(int c, const std::vector<int>& pairList, ImpulseMode mode, double epsilon, int iterations,

@@ -20,17 +20,6 @@ namespace con = solvers::contact;
 namespace {
 
 template <int d>
-Orientation<d> rotatedBy(const Orientation<d>& q, const con::AngVec<d>& theta) {
-  if constexpr (d == 3) {
-    const double angle = theta.norm();
-    if (angle == 0) return q;
-    return (Eigen::Quaterniond(Eigen::AngleAxisd(angle, theta / angle)) * q).normalized();
-  } else {
-    return q + theta(0);
-  }
-}
-
-template <int d>
 void setBasePose(ContactBody<d>& b, const Eigen::Matrix<double, d, 1>& x, const Orientation<d>& q) {
   b.x0 = x;
   b.q0 = q;

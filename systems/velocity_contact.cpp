@@ -23,23 +23,8 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
   std::vector<double> change(ws.islands.members.size(), 0.0);
   ws.forEachIsland([&](int island) {
     std::vector<solvers::collision::ContactPoint<d>> scratch;
-    const auto& list = ws.islandPairsByLevel[island];
-    for (int it = 0; it < s.contactIterations; ++it) {
-      for (std::size_t begin = 0; begin < list.size();) {
-        std::size_t end = begin;
-        while (end < list.size() && ws.pairs[list[end]].level == ws.pairs[list[begin]].level) ++end;
-        for (int li = 0; li < s.contactLevelIterations; ++li) {
-          const double eps = double((it + 1) * (li + 1)) / double(s.contactIterations * s.contactLevelIterations);
-          for (std::size_t k = begin; k < end; ++k) {
-            ContactPairState& pair = ws.pairs[list[k]];
-            if (!pair.contacted) continue;
-            impulses[island] += ws.updatePair(pair, ImpulseMode::ClampedContact, eps, s.contactPairIterations,
-                                              s.thickness, scratch, &change[island], &clamps[island]);
-          }
-        }
-        begin = end;
-      }
-    }
+    impulses[island] = ws.contactSweeps(island, ImpulseMode::ClampedContact, true, scratch, &change[island],
+                                        &clamps[island]);
     // Shock propagation here too (not in the thesis's Step V): the sweeps end with the top
     // levels, whose last impulses push the lower bodies down, so a resting stack would keep a
     // downward velocity of the order of dt g / levels. A bottom-up pass with each level frozen

@@ -8,7 +8,7 @@
 #include <array>
 #include <cmath>
 
-#include "solvers/collision/contact_axis.h"
+#include "solvers/collision/contact_axis_impl.h"
 
 namespace monolith::solvers::collision {
 

@@ -9,7 +9,7 @@
 // order (sphere-triangle: depth < 0). Distance queries return the nearest points in world
 // coordinates for shape pairs but in each object's own frame for sphere-mesh. So apart from
 // box-box only FCL's axis and point are kept, and the contact is rebuilt on that axis exactly
-// (contact_axis.h); the callers refine the axis further.
+// (contact_axis_impl.h); the callers refine the axis further.
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/geometry/shape/box.h>
 #include <fcl/geometry/shape/capsule.h>
@@ -25,8 +25,8 @@
 #include <cmath>
 #include <exception>
 
-#include "solvers/collision/contact_axis.h"
-#include "solvers/collision/narrow_phase_fcl.h"
+#include "solvers/collision/contact_axis_impl.h"
+#include "solvers/collision/narrow_phase_fcl_impl.h"
 
 namespace monolith::solvers::collision {
 

@@ -8,8 +8,8 @@
 #include <cmath>
 
 #include "solvers/collision/collision_impl.h"
-#include "solvers/collision/contact_axis.h"
-#include "solvers/collision/narrow_phase_fcl.h"
+#include "solvers/collision/contact_axis_impl.h"
+#include "solvers/collision/narrow_phase_fcl_impl.h"
 
 namespace monolith::solvers::collision {
 
