@@ -9,6 +9,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "components/rigid_body.h"
@@ -251,4 +253,33 @@ TEST(EnergyClamp, SliverShardsGainEnergyOnlyWithoutTheClamp) {
   on.expectNoGain(std::abs(on.initialTotal));
   EXPECT_GT(std::max(off.worstCollisionGain, off.worstContactGain), 1e-6)
       << "without the clamp frame-rate slivers should show energy gain in some impulse";
+}
+
+TEST(MeshGround, SphereAndBoxComeToRestOnAnObjMesh) {
+  // A ground read from a Wavefront OBJ file (two triangles, path relative to the scene):
+  // a sphere and a box dropped on it rest at their half heights.
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "monolith_mesh_ground";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream obj(dir / "ground.obj");
+    obj << "v -5 0 -5\nv 5 0 -5\nv 5 0 5\nv -5 0 5\nf 1 3 2\nf 1 4 3\n";
+    std::ofstream scene(dir / "scene.json");
+    scene << R"({"dimension": 3, "time": {"dt": 0.016666666666666666, "end": 1.5}, "gravity": [0, -9.81, 0],
+      "entities": [
+        {"name": "ground", "shape": {"type": "mesh", "file": "ground.obj"}, "rigid_body": {"static": true},
+         "collider": {"restitution": 0, "friction": 0.5}},
+        {"name": "ball", "shape": {"type": "sphere", "radius": 0.5}, "rigid_body": {"mass": 1, "position": [-2, 1, 0]},
+         "collider": {"restitution": 0, "friction": 0.5}},
+        {"name": "box", "shape": {"type": "box", "half_extents": [0.3, 0.2, 0.3]}, "rigid_body": {"mass": 1, "position": [2, 0.8, 0]},
+         "collider": {"restitution": 0, "friction": 0.5}}]})";
+  }
+  const Registry registry = builtins();
+  Simulation<3> sim(loadScene((dir / "scene.json").string()), registry);
+  EnergyWatch watch;
+  while (!sim.finished()) watch.observe(sim.step());
+  EXPECT_NEAR(positionOf(sim, "ball").y(), 0.5, 2e-3);
+  EXPECT_NEAR(positionOf(sim, "box").y(), 0.2, 2e-3);
+  EXPECT_LT(bodyOf(sim, "ball").v.norm(), 1e-3);
+  EXPECT_LT(bodyOf(sim, "box").v.norm(), 1e-3);
+  watch.expectNoGain(std::abs(watch.initialTotal));
 }
