@@ -45,7 +45,7 @@ struct ContactSettings {
   int collisionPairIterations = 20;  // impulses per pair per sweep
   int contactIterations = 10;        // outer contact sweeps (Step III), epsilon-scaled
   int contactLevelIterations = 2;    // per level and sweep
-  int contactPairIterations = 20;    // Gauss-Seidel sweeps of one pair's manifold solve
+  int contactPairIterations = 10;    // Gauss-Seidel sweeps of one pair's manifold solve (measured)
   bool shockPropagation = true;      // GBF 2003 shock propagation after contact
   int shockLevelIterations = 8;      // thesis code: 2; see docs/architecture.md
   int shockPairIterations = 10;
