@@ -10,30 +10,18 @@
 #include <random>
 #include <type_traits>
 
+#include "support/random_rigid.h"
 #include "solvers/contact/push_out.h"
 
 namespace {
 
 using namespace monolith::solvers::contact;
 
-template <int d>
-Vec<d> randomVec(std::mt19937& rng, double scale = 1) {
-  std::uniform_real_distribution<double> u(-scale, scale);
-  Vec<d> r;
-  for (int i = 0; i < d; ++i) r(i) = u(rng);
-  return r;
-}
+using monolith::test::randomVec;
 
 template <int d>
 AngMat<d> randomInertia(std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(0.3, 2.0);
-  if constexpr (d == 3) {
-    const Eigen::Quaterniond q(Eigen::Vector4d(randomVec<4>(rng)).normalized());
-    const Eigen::Matrix3d rot = q.toRotationMatrix();
-    return rot * Eigen::Vector3d(u(rng), u(rng), u(rng)).asDiagonal() * rot.transpose();
-  } else {
-    return AngMat<d>::Constant(u(rng));
-  }
+  return monolith::test::randomInertiaLike<d>(rng, 0.3, 2.0);
 }
 
 template <int d>
