@@ -117,6 +117,23 @@ struct PgsPoint {
   }
 };
 
+// The net impulse J of a solved set of points on the body they act on, its angular impulse
+// about that body's centre tau = sum r_a x j, and how many points carry an impulse.
+template <int d>
+int netImpulse(const std::vector<PgsPoint<d>>& points, Eigen::Matrix<double, d, 1>& J, con::AngVec<d>& tau) {
+  J.setZero();
+  tau.setZero();
+  int active = 0;
+  for (const auto& p : points) {
+    const Eigen::Matrix<double, d, 1> j = p.impulse();
+    if (j.squaredNorm() == 0) continue;
+    ++active;
+    J += j;
+    tau += crossFast<d>(p.ra, j);
+  }
+  return active;
+}
+
 }  // namespace
 
 template <int d>
@@ -393,17 +410,10 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
       if (change < tolerance) break;
     }
   }
-  // Net impulse on A and its angular impulse about A's centre: J, tau = sum r_a x j.
-  VecD J = VecD::Zero();
-  con::AngVec<d> tau = con::AngVec<d>::Zero();
-  int active = 0;
-  for (const Point& p : points) {
-    const VecD j = p.impulse();
-    if (j.squaredNorm() == 0) continue;
-    ++active;
-    J += j;
-    tau += con::cross<d>(p.ra, j);
-  }
+  // Net impulse on A and its angular impulse about A's centre.
+  VecD J;
+  con::AngVec<d> tau;
+  const int active = netImpulse<d>(points, J, tau);
   if (active == 0) return 0;
   double scale = 1;
   if (clamp) {
@@ -500,16 +510,9 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const std::vector<int>& 
     }
     if (change < tolerance) break;
   }
-  VecD J = VecD::Zero();
-  con::AngVec<d> tau = con::AngVec<d>::Zero();
-  int active = 0;
-  for (const Point& p : points) {
-    const VecD j = p.impulse();
-    if (j.squaredNorm() == 0) continue;
-    ++active;
-    J += j;
-    tau += crossFast<d>(p.ra, j);
-  }
+  VecD J;
+  con::AngVec<d> tau;
+  const int active = netImpulse<d>(points, J, tau);
   if (active == 0) return 0;
   double scale = 1;
   if (settings.energyClamp && mode == ImpulseMode::ClampedContact) {
