@@ -227,13 +227,6 @@ void ContactWorkspace<d>::updateAllCandidates() {
 }
 
 template <int d>
-void ContactWorkspace<d>::setCandidateToBase(ContactBody<d>& b) const {
-  b.candidate.x = b.x0;
-  b.candidate.R = b.R0;
-  b.inverseInertiaCandidate = b.inverseInertia0;
-}
-
-template <int d>
 void ContactWorkspace<d>::findPairs() {
   const int n = static_cast<int>(bodies.size());
   boxes_.resize(n);

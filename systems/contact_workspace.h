@@ -109,8 +109,6 @@ class ContactWorkspace {
   // candidates only decide which pairs touch).
   void updateCandidate(ContactBody<d>& b) const;
   void updateAllCandidates();
-  // Candidate pose from the current components (Step IV: the actual x^{n+1}).
-  void setCandidateToBase(ContactBody<d>& b) const;
 
   // Broad phase at the candidate poses, then islands; resets pair flags.
   void findPairs();
