@@ -4,6 +4,7 @@
 // normal to their axis (layout of solvers/mac_layout.h: axis 0 faces first, x fastest), the
 // solid flags of cells covered by obstacles and the domain's boundary conditions.
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross product of ObstacleMotion
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -21,10 +22,30 @@ enum class DomainSide : int {
 template <int d>
 struct SideCondition {
   DomainSide type = DomainSide::Wall;
-  bool slip = false;                                                 // walls
+  bool slip = false;                                                 // walls, inflow: zero tangential shear
   Eigen::Matrix<double, d, 1> velocity = Eigen::Matrix<double, d, 1>::Zero();  // wall velocity / uniform inflow
   bool parabolic = false;                                            // inflow profile
   double peakVelocity = 0;                                           // parabolic inflow: centre speed
+};
+
+// Where an obstacle is and how it moves, as the fluid sees it (rigid motion v + w x (x - c)).
+// 2-D uses only the z component of w.
+template <int d>
+struct ObstacleMotion {
+  Eigen::Matrix<double, d, 1> centre = Eigen::Matrix<double, d, 1>::Zero();
+  Eigen::Matrix<double, d, 1> velocity = Eigen::Matrix<double, d, 1>::Zero();
+  Eigen::Vector3d angularVelocity = Eigen::Vector3d::Zero();
+  double reach = 0;  // bounding radius about the centre
+
+  Eigen::Matrix<double, d, 1> velocityAt(const Eigen::Matrix<double, d, 1>& x) const {
+    Eigen::Vector3d r = Eigen::Vector3d::Zero();
+    r.head<d>() = x - centre;
+    return velocity + angularVelocity.cross(r).template head<d>();
+  }
+  bool moving() const { return !velocity.isZero(0) || !angularVelocity.isZero(0); }
+  bool operator==(const ObstacleMotion& o) const {
+    return centre == o.centre && velocity == o.velocity && angularVelocity == o.angularVelocity && reach == o.reach;
+  }
 };
 
 template <int d>
@@ -44,6 +65,26 @@ struct MacGrid {
   std::vector<double> uPrevious;  // face velocities at the end of the previous step (steady-state test)
   std::vector<double> p;          // cell pressures (from the last projection)
   std::vector<std::uint8_t> solid;  // per cell: 1 = covered by an obstacle
+
+  // --- derived every step by rasterize_obstacles from the obstacles' bodies (not checkpointed) ---
+  std::vector<ObstacleMotion<d>> obstacleMotions;
+
+  // Velocity of the obstacle nearest to x (the one whose bounding sphere x is deepest in); zero
+  // without obstacles. Solid faces take its normal component (Sec. 5.4.1).
+  Eigen::Matrix<double, d, 1> obstacleVelocityAt(const Eigen::Matrix<double, d, 1>& x) const {
+    const ObstacleMotion<d>* best = nullptr;
+    double bestDistance = 0;
+    for (const auto& m : obstacleMotions) {
+      const double distance = (x - m.centre).norm() - m.reach;
+      if (!best || distance < bestDistance) best = &m, bestDistance = distance;
+    }
+    return best ? best->velocityAt(x) : Eigen::Matrix<double, d, 1>::Zero().eval();
+  }
+  bool obstaclesMove() const {
+    for (const auto& m : obstacleMotions)
+      if (m.moving()) return true;
+    return false;
+  }
 
   template <class V>
   void visitFields(V& visit) {

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "components/fluid_obstacle.h"
+#include "components/kinematic.h"
 #include "components/mac_grid.h"
 #include "components/rigid_body.h"
 #include "components/shape.h"
@@ -27,6 +28,7 @@ SideCondition<d> parseSide(const Config& c) {
     s.velocity = c.vector("velocity", Eigen::VectorXd::Zero(d));  // a moving wall (cavity lid)
   } else if (type == "inflow") {
     s.type = DomainSide::Inflow;
+    s.slip = c.boolean("slip", false);  // tangential velocity free (zero shear) instead of prescribed
     s.parabolic = c.oneOf("profile", {"uniform", "parabolic"}, "uniform") == "parabolic";
     if (s.parabolic) s.peakVelocity = c.number("peak_velocity");
     else s.velocity = c.vector("velocity", d);
@@ -122,16 +124,21 @@ void parseFluidMaterial(World<d>& world, Entity e, const Config& c) {
   world.add(e, m);
 }
 
-// A static obstacle in the fluid: needs the entity's shape and static rigid_body (parsed
+// An obstacle in the fluid: needs the entity's shape and a static or kinematic rigid_body (parsed
 // before this component; registerFluidComponents runs after their registration).
 template <int d>
 void parseFluidObstacle(World<d>& world, Entity e, const Config& c) {
   if (!world.template has<Shape<d>>(e)) c.fail("fluid_obstacle on an entity with a \"shape\"", "no shape");
   const RigidBody<d>* body = world.template get<RigidBody<d>>(e);
   if (!body) c.fail("fluid_obstacle on an entity with a \"rigid_body\" (its position/orientation)", "no rigid_body");
-  if (!body->isStatic)
-    c.fail("fluid_obstacle on a static rigid_body (\"static\": true; moving obstacles are not supported)",
+  // The fluid does not push obstacles (one-way coupling): they are static or scripted.
+  if (!body->isStatic && !world.template has<KinematicMotion<d>>(e))
+    c.fail("fluid_obstacle on a static rigid_body (\"static\": true) or a kinematic one (one-way coupling)",
            "a dynamic rigid_body");
+  const ShapeType type = world.template get<Shape<d>>(e)->type;
+  if (type != ShapeType::Box && type != ShapeType::Sphere)
+    c.fail(std::string("fluid_obstacle on a ") + (d == 3 ? "box or sphere" : "box or disk") + " shape",
+           "another shape type");
   world.add(e, FluidObstacle{});
 }
 

@@ -43,13 +43,18 @@ solvers::FluidDomain<d> fluidDomainOf(const MacGrid<d>& grid) {
             return v;
           }));
         }
+        box[side].noSlip = !c.slip;
         break;
     }
   }
   solvers::FluidDomain<d> domain = solvers::boxDomain(layout, box);
   bool anySolid = false;
   for (auto s : grid.solid) anySolid = anySolid || s;
-  if (anySolid) solvers::markSolid(domain, grid.solid);
+  if (anySolid) {
+    solvers::VelocityField<d> obstacleVelocity;
+    if (grid.obstaclesMove()) obstacleVelocity = [&grid](const Vec& x) { return grid.obstacleVelocityAt(x); };
+    solvers::markSolid(domain, grid.solid, obstacleVelocity);
+  }
   return domain;
 }
 

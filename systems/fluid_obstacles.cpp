@@ -85,7 +85,7 @@ Eigen::Matrix<double, d, 1> obstacleForce(const World<d>& world, Entity obstacle
   }
 
   // Wall shear: a free face of axis a (fluid on both sides) whose neighbours across axis b lie
-  // in the obstacle has the no-slip wall at distance dx/2; stress mu u / (dx/2) drags the body
+  // in the obstacle has the no-slip wall at distance dx/2; stress mu (u - u_wall) / (dx/2) drags the body
   // along u. Weighted by the fraction of the face's span (half of each adjacent cell) covered.
   if (viscosity > 0) {
     for (int g = 0; g < layout.totalFaces(); ++g) {
@@ -100,7 +100,12 @@ Eigen::Matrix<double, d, 1> obstacleForce(const World<d>& world, Entity obstacle
           double covered = 0;
           if (neighbour(layout, c0, b, dir, n0) && mine[layout.cellIndex(n0)]) covered += 0.5;
           if (neighbour(layout, c1, b, dir, n1) && mine[layout.cellIndex(n1)]) covered += 0.5;
-          if (covered > 0) force[a] += viscosity * grid.u[g] / (0.5 * layout.dx) * area * covered;
+          if (covered == 0) continue;
+          // Relative to the wall's own velocity at the wall point (dx/2 away along b).
+          Eigen::Matrix<double, d, 1> wallPoint = layout.faceCenter(a, fi);
+          wallPoint[b] += dir * 0.5 * layout.dx;
+          const double wall = grid.obstacleVelocityAt(wallPoint)[a];
+          force[a] += viscosity * (grid.u[g] - wall) / (0.5 * layout.dx) * area * covered;
         }
       }
     }
@@ -118,10 +123,31 @@ bool RasterizeObstacles<d>::needed(const World<d>& w) const {
   return w.template count<MacGrid<d>>() > 0 && w.template count<FluidObstacle>() > 0;
 }
 
+// Pose and rigid velocity of every obstacle (static: at rest; kinematic: its scripted motion).
+template <int d>
+std::vector<ObstacleMotion<d>> obstacleMotions(const World<d>& world) {
+  std::vector<ObstacleMotion<d>> motions;
+  forEachObstacle(world, [&](Entity, const Shape<d>& shape, const RigidBody<d>& body) {
+    ObstacleMotion<d> m;
+    m.centre = body.x;
+    m.reach = shape.type == ShapeType::Box ? shape.halfExtents.norm() : shape.radius;
+    if (!body.isStatic) {
+      m.velocity = body.v;
+      const AngularVec<d> w = body.omega();
+      if constexpr (d == 3) m.angularVelocity = w;
+      else m.angularVelocity.z() = w(0);
+    }
+    motions.push_back(m);
+  });
+  return motions;
+}
+
 template <int d>
 void RasterizeObstacles<d>::run(World<d>& world, StepContext&) {
   auto& pool = world.template pool<MacGrid<d>>();
+  const std::vector<ObstacleMotion<d>> motions = obstacleMotions(world);
   for (MacGrid<d>& grid : pool.components()) {
+    grid.obstacleMotions = motions;
     std::vector<std::uint8_t> mask = obstacleMask(world, grid);
     if (mask != grid.solid) grid.solid = std::move(mask);  // unchanged: keep the projection's cache
   }

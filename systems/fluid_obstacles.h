@@ -1,12 +1,13 @@
 #pragma once
-// Static obstacles in a MAC grid fluid (thesis Sec. 5.4.1: a staircase of solid cells whose
-// faces carry the obstacle velocity, here 0).
+// Static and kinematic obstacles in a MAC grid fluid (thesis Sec. 5.4.1: a staircase of solid
+// cells whose faces carry the obstacle's velocity at the face centre, first order).
 //  - rasterize_obstacles: grid.solid[c] = 1 for the cells whose centre lies inside any entity
-//    with shape + static rigid_body + fluid_obstacle; writes only when the mask changes (the
-//    projection caches its operators keyed on the mask).
+//    with shape + (static or kinematic) rigid_body + fluid_obstacle; writes the mask only when
+//    it changes (the projection caches its operators keyed on the mask and on the obstacles'
+//    motions), and grid.obstacleMotions (pose + rigid velocity) every step.
 //  - obstacle_forces: the fluid's force on each obstacle, a first-order stress integral over the
 //    staircase boundary (pressure of the fluid cell on every fluid-solid face, and the wall
-//    shear mu u / (dx/2) of the free faces next to solid cells); diagnostics
+//    shear mu (u - u_wall) / (dx/2) of the free faces next to solid cells); diagnostics
 //    obstacle_<name>_force_x, _y (, _z).
 #include "components/mac_grid.h"
 #include "components/rigid_body.h"

@@ -11,6 +11,7 @@ namespace monolith {
 template <int d>
 struct FluidProjection<d>::Cache {
   std::vector<std::uint8_t> solid;  // geometry the operators were built for
+  std::vector<ObstacleMotion<d>> motions;  // moving obstacles' velocities sit in the operators' RHS terms
   double dt = -1, density = 0, viscosity = -1;
   solvers::PoissonPreconditionerKind kind = solvers::PoissonPreconditionerKind::None;
   std::unique_ptr<solvers::FluidOperators<d>> ops;
@@ -46,10 +47,12 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
     const FluidMaterial* material = world.template get<FluidMaterial>(pool.entities()[g]);
     const double rho = material ? material->density : 1.0, mu = material ? material->viscosity : 0.0;
 
-    // Rebuild the operators only when what they depend on changed (CFL steps change dt).
+    // Rebuild the operators only when what they depend on changed (CFL steps change dt; a moving
+    // obstacle changes the prescribed face velocities folded into them).
     Cache& c = *cache_;
     const auto kind = preconditionerKind(settings.preconditioner);
-    if (!c.ops || c.dt != ctx.dt || c.density != rho || c.viscosity != mu || c.solid != grid.solid || c.kind != kind) {
+    if (!c.ops || c.dt != ctx.dt || c.density != rho || c.viscosity != mu || c.solid != grid.solid || c.kind != kind ||
+        ((grid.obstaclesMove() || !c.motions.empty()) && c.motions != grid.obstacleMotions)) {
       c.ops = std::make_unique<solvers::FluidOperators<d>>(
           solvers::buildFluidOperators(fluidDomainOf(grid), solvers::FluidParameters{rho, mu, ctx.dt}));
       c.preconditioner = std::make_unique<solvers::PoissonPreconditioner<d>>(*c.ops, kind);
@@ -57,6 +60,7 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
       c.density = rho;
       c.viscosity = mu;
       c.solid = grid.solid;
+      c.motions = grid.obstaclesMove() ? grid.obstacleMotions : std::vector<ObstacleMotion<d>>{};
       c.kind = kind;
     }
     solvers::ProjectionSettings ps;

@@ -33,7 +33,8 @@ using VelocityField = std::function<Eigen::Matrix<double, d, 1>(const Eigen::Mat
 //  * Wall: normal velocity = velocity(x)·n on the boundary faces (0 for a wall at rest; a lid moves
 //    tangentially so its normal velocity is 0). Tangentially, noSlip: the viscous operator sees the
 //    wall velocity at the wall (mirrored ghost, see operators.h); slip: zero shear (row dropped).
-//  * Inflow: boundary faces prescribed with velocity(x)·n; tangential: Dirichlet velocity(x).
+//  * Inflow: boundary faces prescribed with velocity(x)·n; tangential: Dirichlet velocity(x), or
+//    with noSlip = false zero shear (the thesis's "slipping u_2" inflow of Sec. 5.11.3-4).
 //  * Outflow: ghost cells outside have p = 0, so the boundary faces are free; zero shear.
 //  * Periodic: both sides of the axis, and the layout's axis must be periodic.
 template <int d>
@@ -54,7 +55,7 @@ struct SideSpec {
 
   Vec velocityAt(const Vec& x) const { return velocity ? velocity(x) : Vec::Zero(); }
   // Tangential velocity is Dirichlet for the viscous operator (else the row is dropped).
-  bool tangentialDirichlet() const { return kind == Kind::Inflow || (kind == Kind::Wall && noSlip); }
+  bool tangentialDirichlet() const { return (kind == Kind::Inflow || kind == Kind::Wall) && noSlip; }
   // Boundary faces of this side are prescribed (else free, or periodic interior faces).
   bool normalPrescribed() const { return kind == Kind::Wall || kind == Kind::Inflow; }
 };

@@ -4,7 +4,12 @@
 // scenarios/scenes/dfg_2d1.json through the real pipeline to steady state
 // (max|du|/dt < 1e-6, the scene's stop criterion).
 //
-// usage: bench_dfg [max cells across the channel: 41|82|164] [threads] [end time, default the scene's 30] [first cells across, default 41]
+// With the first argument "2d2" it runs the periodic benchmark 2D-2 (dfg_2d2.json, Re 100)
+// instead: maximum c_D and c_L and the Strouhal number St = D f / Ubar of the lift, measured over
+// the second half of the run (the shedding has settled by then).
+//
+// usage: bench_dfg [2d2] [max cells across the channel: 41|82|164] [threads] [end time, default the scene's]
+//                  [first cells across, default 41]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +19,7 @@
 #include "components/mac_grid.h"
 #include "scenarios/fluid_fields.h"
 #include "scenarios/simulation.h"
+#include "support/oscillation.h"
 
 using namespace monolith;
 
@@ -83,15 +89,55 @@ Row run(const Registry& registry, int ny, int threads, const std::string& end) {
   r.dPraw = samplePressure(grid, Eigen::Vector2d(0.15, 0.2)) - samplePressure(grid, Eigen::Vector2d(0.25, 0.2));
   return r;
 }
+// DFG 2D-2 (Re 100, periodic): references c_D,max = 3.23, c_L,max = 1.00, St in [0.295, 0.305].
+constexpr double kCDmax = 3.23, kCLmax = 1.00, kSt = 0.300, kUbar2 = 1.0;
+
+void runPeriodic(const Registry& registry, int ny, int threads, const std::string& end) {
+  const std::string file = std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/dfg_2d2.json";
+  const int nx = ny * 220 / 41;
+  std::vector<Override> overrides = {
+      {"entities.fluid.mac_grid.cells", "[" + std::to_string(nx) + "," + std::to_string(ny) + "]"}};
+  char dt[32];
+  std::snprintf(dt, sizeof dt, "%.17g", 0.004 * 41 / ny);  // CFL about 0.9 at every resolution
+  overrides.push_back({"time.dt", dt});
+  if (!end.empty()) overrides.push_back({"time.end", end});
+  const SceneSpec scene = loadScene(file, overrides);
+  Simulation<2> sim(scene, registry, threads);
+  std::vector<double> t, cD, cL;
+  const double scale = 2 / (kRho * kUbar2 * kUbar2 * kD);
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!sim.finished()) {
+    const auto& diag = sim.step();
+    t.push_back(sim.time());
+    cD.push_back(scale * diag.at("obstacle_cylinder_force_x"));
+    cL.push_back(scale * diag.at("obstacle_cylinder_force_y"));
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const test::Oscillation lift = test::analyseOscillation(t, cL, 0.5 * sim.time());
+  const test::Oscillation drag = test::analyseOscillation(t, cD, 0.5 * sim.time());
+  const double st = lift.frequency() * kD / kUbar2;
+  std::printf("| %dx%d | %.2f | %ld | %.1f | %d | %.4f | %+.1f%% | %.4f | %+.1f%% | %.4f | %+.1f%% |\n", nx, ny, sim.time(),
+              sim.stepsDone(), seconds, lift.crossings - 1, drag.max, 100 * (drag.max - kCDmax) / kCDmax, lift.max,
+              100 * (lift.max - kCLmax) / kCLmax, st, 100 * (st - kSt) / kSt);
+  std::fflush(stdout);
+}
 }  // namespace
 
 int main(int argc, char** argv) {
+  const bool periodic = argc > 1 && std::string(argv[1]) == "2d2";
+  if (periodic) --argc, ++argv;
   const int maxNy = argc > 1 ? std::atoi(argv[1]) : 164;
   const int threads = argc > 2 ? std::atoi(argv[2]) : 2;
   const std::string end = argc > 3 ? argv[3] : "";
   const int firstNy = argc > 4 ? std::atoi(argv[4]) : 41;
   Registry registry;
   registerBuiltins(registry);
+  if (periodic) {
+    std::printf("| cells | t end | steps | wall s | periods | c_D max | err | c_L max | err | St | err |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (int ny = firstNy; ny <= maxNy; ny *= 2) runPeriodic(registry, ny, threads, end);
+    return 0;
+  }
   std::printf("| cells | steady | t | final max du/dt | steps | wall s | c_D | err c_D | c_L | err c_L | dP | err dP | dP (samplePressure) |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (int ny = firstNy; ny <= maxNy; ny *= 2) {
