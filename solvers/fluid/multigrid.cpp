@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -127,7 +128,13 @@ Level<d> coarsen(const Level<d>& fine) {
   using Index = typename MacLayout<d>::Index;
   Level<d> coarse;
   MacLayout<d> layout = fine.layout;
-  layout.cells = fine.layout.cells / 2;
+  // An odd count n coarsens to (n + 1) / 2 cells: the last coarse cell has one fine child, its
+  // missing half counts as solid (closed), and the coarse boundary face takes the fine one's
+  // state. The coarse grid then overhangs the domain by one fine cell; a preconditioner only
+  // needs a symmetric positive coarse operator with R = P^T, which this keeps. Without it a
+  // 220 x 41 channel could not coarsen at all and "multigrid" degenerated to 20 Gauss-Seidel
+  // sweeps per application on the full grid (measured 5 ms per CG iteration at 9k cells).
+  for (int a = 0; a < d; ++a) layout.cells[a] = (fine.layout.cells[a] + 1) / 2;
   layout.dx = 2 * fine.layout.dx;
   coarse.layout = layout;
   coarse.coef = fine.coef * std::pow(2.0, d - 2);
@@ -145,12 +152,15 @@ Level<d> coarsen(const Level<d>& fine) {
     auto [a, F] = layout.faceCoord(f);
     for (int k = 0; k < (1 << (d - 1)) && !coarse.open[f]; ++k) {
       Index ff = 2 * F;
+      ff[a] = std::min(ff[a], fine.layout.cells[a]);  // the upper boundary face of an odd axis
       int bit = 0;
+      bool exists = true;
       for (int b = 0; b < d; ++b) {
         if (b == a) continue;
         ff[b] += (k >> bit++) & 1;
+        exists &= ff[b] < fine.layout.cells[b];  // the missing half of an odd axis' last cell
       }
-      if (fine.open[fine.layout.faceIndex(a, ff)]) coarse.open[f] = 1;
+      if (exists && fine.open[fine.layout.faceIndex(a, ff)]) coarse.open[f] = 1;
     }
   }
   coarse.finalize();
@@ -281,7 +291,8 @@ PoissonMultigrid<d>::PoissonMultigrid(const FluidOperators<d>& ops, const Multig
   for (;;) {
     const Level<d>& L = levels.back();
     bool canCoarsen = L.unknowns() > settings.coarsestUnknowns;
-    for (int a = 0; a < d; ++a) canCoarsen &= L.layout.cells[a] % 2 == 0 && L.layout.cells[a] >= 4;
+    for (int a = 0; a < d; ++a)
+      canCoarsen &= L.layout.cells[a] >= 3 && (L.layout.cells[a] % 2 == 0 || !L.layout.periodic[a]);
     if (!canCoarsen) break;
     Level<d> next = coarsen(L);
     if (next.unknowns() == 0) break;

@@ -6,9 +6,12 @@
 //  * Level 0 is exactly the assembled Poisson block: a face is open iff it is Free, with coefficient
 //    A^2 beta^-1 = h^(d-2) / rho; open faces to a non-unknown cell (Dirichlet cell, outflow ghost)
 //    add to the diagonal only.
-//  * Coarsening by 2 per axis (while all counts are even and >= 4): a coarse cell is Dirichlet if any
-//    child is, else a pressure unknown if any child is, else solid; a coarse face is open if any of
-//    the 2^(d-1) fine faces it covers is open; the operator is rediscretized with h^(d-2) / rho.
+//  * Coarsening by 2 per axis (while every count is >= 3, and even on periodic axes): n cells become
+//    (n + 1) / 2, so on an odd axis the last coarse cell has one child and the coarse grid overhangs
+//    the box by one fine cell (its boundary face copies the fine boundary face). A coarse cell is
+//    Dirichlet if any child is, else a pressure unknown if any child is, else solid; a coarse face
+//    is open if any of the existing fine faces it covers is open; the operator is rediscretized
+//    with h^(d-2) / rho.
 //  * Prolongation P: cell-centred (bi/tri)linear interpolation, weights 3/4 and 1/4 per axis; a
 //    weight that would refer to a solid coarse cell or to a closed side of the box moves to the
 //    parent (constant extrapolation = Neumann), one referring to a Dirichlet cell or an open side is

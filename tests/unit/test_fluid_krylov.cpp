@@ -92,6 +92,7 @@ void expectSymmetricPositive(const FluidDomain<d>& domain) {
 TEST(FluidKrylov, PreconditionersAreSymmetricPositive) {
   expectSymmetricPositive(closedBox2(32));
   expectSymmetricPositive(obstacleChannel2(48, 32));
+  expectSymmetricPositive(obstacleChannel2(45, 21));  // odd counts: coarse cells with one child
   expectSymmetricPositive(closedBox3(16));
 }
 
@@ -160,6 +161,18 @@ TEST(FluidKrylov, MultigridOnOtherDomains) {
     const CgReport r = solvePoisson(ops, mg, poissonRhs(ops, 4), x);
     std::printf("obstacle channel 192x64: MG-PCG %d iterations, %d levels\n", r.iterations, mg.multigrid()->levelCount());
     EXPECT_TRUE(r.converged);
+    EXPECT_LT(r.iterations, 30);
+  }
+  {
+    // The DFG channel's 220 x 41 cells: 41 is odd. Coarsening (n + 1) / 2 keeps the V-cycle deep;
+    // without it the hierarchy had a single level (20 Gauss-Seidel pairs per application).
+    const FluidOperators<2> ops = buildFluidOperators(obstacleChannel2(220, 41), FluidParameters{});
+    const PoissonPreconditioner<2> mg(ops, Kind::Multigrid);
+    VectorXd x;
+    const CgReport r = solvePoisson(ops, mg, poissonRhs(ops, 6), x);
+    std::printf("obstacle channel 220x41: MG-PCG %d iterations, %d levels\n", r.iterations, mg.multigrid()->levelCount());
+    EXPECT_TRUE(r.converged);
+    EXPECT_GE(mg.multigrid()->levelCount(), 4);
     EXPECT_LT(r.iterations, 30);
   }
   {
