@@ -32,10 +32,17 @@ inline Oscillation analyseOscillation(const std::vector<double>& t, const std::v
     o.min = std::min(o.min, y[i]);
   }
   o.mean = sum / double(t.size() - first);
+  // Schmitt trigger: a crossing counts only after the signal has been below the mean by a
+  // quarter of its peak-to-peak range, so small high-frequency noise (the staircase boundary's
+  // pressure jitter) does not add crossings.
+  const double band = 0.25 * (o.max - o.min);
+  bool armed = false;
   double firstCrossing = 0, lastCrossing = 0;
   for (std::size_t i = first + 1; i < t.size(); ++i) {
     const double a = y[i - 1] - o.mean, b = y[i] - o.mean;
-    if (a < 0 && b >= 0) {
+    if (y[i - 1] < o.mean - band) armed = true;
+    if (armed && a < 0 && b >= 0) {
+      armed = false;
       const double crossing = t[i - 1] + (t[i] - t[i - 1]) * (-a) / (b - a);
       if (o.crossings == 0) firstCrossing = crossing;
       lastCrossing = crossing;
