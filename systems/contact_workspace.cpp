@@ -6,6 +6,7 @@
 
 #include "solvers/contact/energy_clamp.h"
 #include "solvers/contact/impulse.h"
+#include "solvers/contact/manifold_pgs.h"
 
 namespace monolith {
 
@@ -45,82 +46,25 @@ Eigen::Matrix<double, d, d> rotationOf(const Orientation<d>& q) {
   else return Eigen::Rotation2Dd(q).toRotationMatrix();
 }
 
-// r x j and w x r written out (the PGS inner loop below is the hot path of contact).
-template <int d>
-inline con::AngVec<d> crossFast(const Eigen::Matrix<double, d, 1>& r, const Eigen::Matrix<double, d, 1>& j) {
-  if constexpr (d == 3) return r.cross(j);
-  else return con::AngVec<d>(r.x() * j.y() - r.y() * j.x());
-}
+// w x r written out (2-D: w is a 1-vector about z).
 template <int d>
 inline Eigen::Matrix<double, d, 1> spinFast(const con::AngVec<d>& w, const Eigen::Matrix<double, d, 1>& r) {
   if constexpr (d == 3) return w.cross(r);
   else return Eigen::Vector2d(-w(0) * r.y(), w(0) * r.x());
 }
 
-
-// One point of a projected Gauss-Seidel contact solve: impulse factor data prepared once, the
-// accumulated normal and tangent impulses updated by pgsStep.
+// False when the bodies' bounding balls (about their centres of mass, at the candidate poses)
+// are farther apart than the margin: no contact is possible, the narrow phase can be skipped.
 template <int d>
-struct PgsPoint {
-  using VecD = Eigen::Matrix<double, d, 1>;
-  using TangentBasis = Eigen::Matrix<double, d, d - 1>;
-  using TangentVec = Eigen::Matrix<double, d - 1, 1>;
-  using TangentMat = Eigen::Matrix<double, d - 1, d - 1>;
-  VecD ra = VecD::Zero(), rb = VecD::Zero(), n = VecD::Zero();  // lever arms, normal out of b
-  VecD partnerVelocity = VecD::Zero();  // joint solve: the frozen partner's point velocity
-  Eigen::Matrix<double, d, d> K = Eigen::Matrix<double, d, d>::Zero();
-  VecD Kn = VecD::Zero();
-  double kn = 1, target = 0, normalImpulse = 0, mu = 0;
-  TangentBasis T = TangentBasis::Zero();
-  TangentMat tangentMass = TangentMat::Zero();
-  TangentVec tangentImpulse = TangentVec::Zero();
-
-  void prepare(const Eigen::Matrix<double, d, d>& impulseFactor) {
-    K = impulseFactor;
-    Kn = K * n;
-    kn = n.dot(Kn);
-    if constexpr (d == 3) {
-      const VecD t1 = (std::abs(n.x()) < 0.6 ? VecD::UnitX() : VecD::UnitY()).cross(n).normalized();
-      T.col(0) = t1;
-      T.col(1) = n.cross(t1);
-    } else {
-      T.col(0) = VecD(-n.y(), n.x());
-    }
-    tangentMass = (T.transpose() * K * T).inverse();
-  }
-  VecD impulse() const { return normalImpulse * n + T * tangentImpulse; }
-
-  // Given the relative velocity at the point, the impulse increment j of this sweep; returns
-  // the size of the velocity change (for the convergence test). Normal: accumulated impulse
-  // >= 0 reaching the target normal velocity. Friction: the sticking step in the tangent plane
-  // (the point velocity after the normal change is vrel + K n dl), limited to the Coulomb disk
-  // |f| <= mu lambda; when sliding the friction opposes the slip (maximal dissipation) rather
-  // than following the sticking impulse, which the rotational coupling in K skews (a sliding
-  // cube would yaw and drift sideways).
-  double step(const VecD& vrel, VecD& j) {
-    const double lambda = std::max(0.0, normalImpulse + (target - vrel.dot(n)) / kn);
-    const double dl = lambda - normalImpulse;
-    normalImpulse = lambda;
-    j = dl * n;
-    double change = std::abs(dl) * kn;
-    if (mu > 0) {
-      const TangentVec vt = T.transpose() * (vrel + Kn * dl);
-      TangentVec f = tangentImpulse - tangentMass * vt;
-      const double limit = mu * normalImpulse;
-      if (f.norm() > limit) f = vt.norm() > 0 ? TangentVec(-limit * vt.normalized()) : TangentVec(f * (limit / f.norm()));
-      const TangentVec df = f - tangentImpulse;
-      tangentImpulse = f;
-      j += T * df;
-      change = std::max(change, (T * df).norm() / tangentMass.norm());
-    }
-    return change;
-  }
-};
+bool mayTouch(const ContactBody<d>& a, const ContactBody<d>& b, double margin) {
+  const double reach = a.geometry->boundingRadius() + b.geometry->boundingRadius() + margin;
+  return !std::isfinite(reach) || (a.candidate.x - b.candidate.x).squaredNorm() <= reach * reach;
+}
 
 // The net impulse J of a solved set of points on the body they act on, its angular impulse
 // about that body's centre tau = sum r_a x j, and how many points carry an impulse.
 template <int d>
-int netImpulse(const std::vector<PgsPoint<d>>& points, Eigen::Matrix<double, d, 1>& J, con::AngVec<d>& tau) {
+int netImpulse(const std::vector<con::PgsPoint<d>>& points, Eigen::Matrix<double, d, 1>& J, con::AngVec<d>& tau) {
   J.setZero();
   tau.setZero();
   int active = 0;
@@ -129,7 +73,7 @@ int netImpulse(const std::vector<PgsPoint<d>>& points, Eigen::Matrix<double, d, 
     if (j.squaredNorm() == 0) continue;
     ++active;
     J += j;
-    tau += crossFast<d>(p.ra, j);
+    tau += con::cross<d>(p.ra, j);
   }
   return active;
 }
@@ -335,57 +279,57 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
   col::ContactQuery query;
   query.margin = margin;
   scratch.clear();
+  if (!mayTouch<d>(A, B, margin)) return 0;
   if (col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, query, scratch) == 0) return 0;
   if (collision) pair.processed = true;
   // Manifold points within the margin, with split-state lever arms and normals (candidate
   // positions, as GBF 2003 and Sec. 2.3.2 compute them; mapping points back through the body's
   // rotation to time n, as the level-set code does for surface vertices, is wrong for round
   // shapes: a rolling disk's deepest point is not a material point).
-  using Point = PgsPoint<d>;
+  using Point = con::PgsPoint<d>;
   thread_local std::vector<Point> points;
   points.clear();
   bool anyApproaching = false;
+  const bool finiteA = !A.infinite(), finiteB = !B.infinite();
+  con::PgsBodies<d> state;
+  state.va = A.v;
+  state.vb = B.v;
+  state.wa = A.inverseInertiaCandidate * A.L;
+  state.wb = B.inverseInertiaCandidate * B.L;
+  state.inverseMassA = A.inverseMass();
+  state.inverseMassB = B.inverseMass();
+  state.movesA = finiteA;  // bodies of infinite mass take no impulse
+  state.movesB = finiteB;
+  double speedScale = 0;
   for (const auto& c : scratch) {
     if (c.depth < -margin) continue;
-    Point p;
+    Point& p = points.emplace_back();  // in place: a prepared point is ~90 numbers
     p.ra = c.point - A.candidate.x;
     p.rb = c.point - B.candidate.x;
     p.n = c.normal;
-    const double vn = (A.v + spinFast<d>(A.inverseInertiaCandidate * A.L, p.ra) - B.v -
-                       spinFast<d>(B.inverseInertiaCandidate * B.L, p.rb)).dot(p.n);
+    const double vn = (state.va + spinFast<d>(state.wa, p.ra) - state.vb - spinFast<d>(state.wb, p.rb)).dot(p.n);
     const bool approaching = vn < -settings.approachTolerance;
     anyApproaching = anyApproaching || approaching;
     // Target normal velocity -e min(0, v_n); contact's e = -1 + eps removes the fraction eps
     // of the approach (notes 1.6). Points not approaching must not start to.
     p.target = approaching ? -impulse.restitution * vn : 0.0;
     p.mu = impulse.friction;
-    p.prepare(con::impulseFactor(con::ImpulseBody<d>{A.inverseMass(), A.splitInverseInertia(), p.ra}) +
-              con::impulseFactor(con::ImpulseBody<d>{B.inverseMass(), B.splitInverseInertia(), p.rb}));
-    points.push_back(p);
+    speedScale = std::max(speedScale, std::abs(p.target) + std::abs(vn));
   }
   if (!anyApproaching) return 0;
+  // K and the Jacobian rows only when something approaches (a solve follows).
+  const con::AngMat<d> Ia = finiteA ? A.inverseInertiaCandidate : con::AngMat<d>::Zero();
+  const con::AngMat<d> Ib = finiteB ? B.inverseInertiaCandidate : con::AngMat<d>::Zero();
+  for (Point& p : points) p.prepare(A.inverseMass() + B.inverseMass(), Ia, Ib, points.size() == 1);
 
-  // Working copies: the impulse of the whole pair is found first, then (second contact step,
-  // collisions) clamped as one against the state before it (Sec. 2.3.2) and applied.
-  const bool finiteA = !A.infinite(), finiteB = !B.infinite();
-  const double mA = A.inverseMass(), mB = B.inverseMass();
-  VecD vA = A.v, vB = B.v;
-  con::AngVec<d> wA = A.inverseInertiaCandidate * A.L, wB = B.inverseInertiaCandidate * B.L;
-  auto relativeVelocity = [&](const Point& p) -> VecD {
-    return vA + spinFast<d>(wA, p.ra) - vB - spinFast<d>(wB, p.rb);
-  };
-  auto apply = [&](const Point& p, const VecD& j) {  // bodies of infinite mass take no impulse
-    if (finiteA) vA += mA * j, wA += A.inverseInertiaCandidate * crossFast<d>(p.ra, j);
-    if (finiteB) vB -= mB * j, wB -= B.inverseInertiaCandidate * crossFast<d>(p.rb, j);
-  };
-  double speedScale = 0;
-  for (const Point& p : points) speedScale = std::max(speedScale, std::abs(p.target) + std::abs(relativeVelocity(p).dot(p.n)));
+  // Working copies (state): the impulse of the whole pair is found first, then (second contact
+  // step, collisions) clamped as one against the state before it (Sec. 2.3.2) and applied.
   const double tolerance = 1e-7 * speedScale + 1e-12;
   if (points.size() == 1) {
     // One point: the impulse of notes 1.5 (sticking, else sliding along K(n - mu t)).
     Point& p = points[0];
-    const VecD j = con::pointImpulse<d>(p.K, relativeVelocity(p), p.n, impulse);
-    apply(p, j);
+    const VecD vrel = state.va + spinFast<d>(state.wa, p.ra) - state.vb - spinFast<d>(state.wb, p.rb);
+    const VecD j = con::pointImpulse<d>(p.K, vrel, p.n, impulse);
     p.normalImpulse = j.dot(p.n);
     p.tangentImpulse = p.T.transpose() * (j - p.normalImpulse * p.n);
   } else {
@@ -393,15 +337,7 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
     // Gauss-Seidel on accumulated impulses (normal >= 0, friction inside the Coulomb disk), so
     // a box lying flat stops at all its corners at once instead of rocking between them as
     // one-point-at-a-time impulses do.
-    for (int sweep = 0; sweep < iterations; ++sweep) {
-      double change = 0;
-      VecD j;
-      for (Point& p : points) {
-        change = std::max(change, p.step(relativeVelocity(p), j));
-        apply(p, j);
-      }
-      if (change < tolerance) break;
-    }
+    con::pgsSolve<d>(points, state, iterations, tolerance);
   }
   // Net impulse on A and its angular impulse about A's centre.
   VecD J;
@@ -450,15 +386,18 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const std::vector<int>& 
   // them pair after pair instead leaves a residual slip that shows as a slow creep.
   ContactBody<d>& C = bodies[c];
   if (C.infinite()) return 0;
-  using Point = PgsPoint<d>;
+  using Point = con::PgsPoint<d>;
   thread_local std::vector<Point> points;
   points.clear();
   col::ContactQuery query;
   query.margin = margin;
   const double restitution = -1.0 + epsilon;
   const con::AngMat<d> Iinv = C.inverseInertiaCandidate;
-  const VecD v0 = C.v;
-  const con::AngVec<d> w0 = Iinv * C.L;
+  con::PgsBodies<d> state;  // C is body a; the partners are frozen (their velocity per point)
+  state.va = C.v;
+  state.wa = Iinv * C.L;
+  state.inverseMassA = C.inverseMass();
+  state.movesA = true;
   bool anyApproaching = false;
   VecD frameVelocity = VecD::Zero();
   bool frameSet = false;
@@ -467,42 +406,33 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const std::vector<int>& 
     const bool cIsA = pair.a == c;
     const ContactBody<d>& P = bodies[cIsA ? pair.b : pair.a];
     scratch.clear();
+    if (!mayTouch<d>(C, P, margin)) continue;
     if (col::findContacts(*C.geometry, C.candidate, *P.geometry, P.candidate, query, scratch) == 0) continue;
     const double mu = std::min(C.friction, P.friction);
     for (const auto& cp : scratch) {
       if (cp.depth < -margin) continue;
-      Point p;
+      Point& p = points.emplace_back();
       p.ra = cp.point - C.candidate.x;
       p.n = cp.normal;  // out of P towards C: C is "A" in findContacts above
       p.partnerVelocity = P.v + spinFast<d>(P.inverseInertiaCandidate * P.L, VecD(cp.point - P.candidate.x));
       if (!frameSet) frameVelocity = p.partnerVelocity, frameSet = true;
-      const double vn = (v0 + spinFast<d>(w0, p.ra) - p.partnerVelocity).dot(p.n);
+      const double vn = (state.va + spinFast<d>(state.wa, p.ra) - p.partnerVelocity).dot(p.n);
       const bool approaching = vn < -settings.approachTolerance;
       anyApproaching = anyApproaching || approaching;
       p.target = approaching ? -restitution * vn : 0.0;
       p.mu = mu;
-      p.prepare(con::impulseFactor(con::ImpulseBody<d>{C.inverseMass(), C.splitInverseInertia(), p.ra}));
-      points.push_back(p);
     }
     if (mode != ImpulseMode::Collision) pair.contacted = true;
   }
   if (!anyApproaching) return 0;
-  VecD v = v0;
-  con::AngVec<d> w = w0;
+  const con::AngMat<d> none = con::AngMat<d>::Zero();
   double speedScale = 0;
-  for (const Point& p : points) speedScale = std::max(speedScale, std::abs(p.target));
-  const double tolerance = 1e-7 * speedScale + 1e-12;
-  const double m = C.inverseMass();
-  for (int sweep = 0; sweep < iterations; ++sweep) {
-    double change = 0;
-    VecD j;
-    for (Point& p : points) {
-      change = std::max(change, p.step(VecD(v + spinFast<d>(w, p.ra) - p.partnerVelocity), j));
-      v += m * j;
-      w += Iinv * crossFast<d>(p.ra, j);
-    }
-    if (change < tolerance) break;
+  for (Point& p : points) {
+    p.prepare(C.inverseMass(), Iinv, none, false);
+    speedScale = std::max(speedScale, std::abs(p.target));
   }
+  const double tolerance = 1e-7 * speedScale + 1e-12;
+  con::pgsSolve<d>(points, state, iterations, tolerance);
   VecD J;
   con::AngVec<d> tau;
   const int active = netImpulse<d>(points, J, tau);

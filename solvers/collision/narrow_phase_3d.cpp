@@ -6,13 +6,16 @@
 // pair but sphere-mesh (the centre against the other shape's exact signed distance) and
 // capsule-capsule (closest points of the two segments plus the end caps). These support the
 // margin exactly.
-// FCL: the rest. Box-box gives FCL's clipped face manifold; the other pairs give FCL's one point,
+// Box-box: our separating-axis test and clipped face manifold (box_box.cpp, FCL's contract).
+// FCL: the rest. The other pairs give FCL's one point,
 // completed as in the thesis by the vertex-in-shape test both ways (the vertices of A inside B
 // with B's face normal and vice versa). Beyond FCL's contact, the margin is served by
-// fcl::distance (one point) and by the feature tests (exact). Shapes against a mesh go through
+// fcl::distance (one point; box pairs: their exact nearest points) and by the feature tests
+// (exact). Shapes against a mesh go through
 // narrow_phase_mesh.cpp (FCL per nearby triangle plus the feature points above each).
 #include <cmath>
 
+#include "solvers/collision/box_box_impl.h"
 #include "solvers/collision/collision_impl.h"
 #include "solvers/collision/contact_axis_impl.h"
 #include "solvers/collision/narrow_phase_fcl_impl.h"
@@ -45,6 +48,17 @@ Scratch& scratch() {
 }
 
 GeometryType typeOf(const PG& g) { return g.geometry().type; }
+
+// Box pairs: what descendToMinimumOverlap searches for locally is known exactly from the
+// separating-axis test (the least overlap over the 15 axes is the boxes' penetration depth), so
+// the contact moves there directly when that is shallower than its own axis.
+void moveToLeastOverlap(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb, const BoxBoxAxis& axis,
+                        CP& c) {
+  if (!(axis.leastOverlap < c.depth)) return;
+  CP moved;
+  if (contactOnAxis(a, pa, -1, b, pb, -1, c.point, axis.leastOverlapNormal, kInfinity, moved) && moved.depth < c.depth)
+    c = moved;
+}
 
 void capsulePair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb, double margin, double scale,
                  Scratch& s) {
@@ -83,14 +97,32 @@ void generalPair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
   s.main.clear();
   s.extra.clear();
   s.triangles.clear();
-  const bool fclWorked = fclContacts(a, pa, b, pb, s.main, s.triangles);
-  const bool clippedManifold = boxBox && !s.main.empty();  // FCL's box-box points: all kept
-  const bool fromFcl = !s.main.empty();                     // else from fcl::distance (exact axis)
+  bool fclWorked = true;
+  BoxBoxAxis sat;  // box pairs: the separating-axis test
+  if (boxBox) {
+    // Our own separating-axis test and face clipping (box_box.cpp) instead of FCL's dBoxBox.
+    sat = boxBoxAxis(a.geometry(), pa, b.geometry(), pb);
+    // Apart by more than the margin along some axis: farther apart than that everywhere, so
+    // neither the distance query nor the feature points could find anything.
+    if (sat.separation > margin) return;
+    boxBoxContacts(a.geometry(), pa, b.geometry(), pb, sat, s.main);
+    s.triangles.assign(s.main.size(), -1);
+  } else {
+    fclWorked = fclContacts(a, pa, b, pb, s.main, s.triangles);
+  }
+  const bool clippedManifold = boxBox && !s.main.empty();  // the clipped box-box points: all kept
+  const bool fromFcl = !s.main.empty();                     // else from the distance query (exact axis)
   if (fclWorked && s.main.empty()) {
     if (!(margin > 0)) return;
     CP c;
     int triangle = -1;
-    if (!fclMarginContact(a, pa, b, pb, margin, c, triangle)) return;
+    if (boxBox) {  // exact nearest points instead of fcl::distance (box_box.cpp)
+      Vec3 onA, onB;
+      if (!boxBoxNearestPoints(a.geometry(), pa, b.geometry(), pb, sat, margin, onA, onB)) return;
+      if (!contactOnAxis(a, pa, -1, b, pb, -1, 0.5 * (onA + onB), onA - onB, margin, c)) return;
+    } else if (!fclMarginContact(a, pa, b, pb, margin, c, triangle)) {
+      return;
+    }
     s.main.push_back(c);
     s.triangles.push_back(triangle);
   }
@@ -114,7 +146,10 @@ void generalPair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
       refineAxis(a, pa, b, pb, -1, s.axes, s.main[0]);
       // Still not represented by a feature point (an edge contact): search for the axis of least
       // overlap around it, which is what MPR approximates.
-      if (fromFcl && !isRepresented<3>(s.main[0], s.extra, tolerance)) descendToMinimumOverlap(a, pa, b, pb, s.main[0]);
+      if (fromFcl && !isRepresented<3>(s.main[0], s.extra, tolerance)) {
+        if (boxBox) moveToLeastOverlap(a, pa, b, pb, sat, s.main[0]);
+        else descendToMinimumOverlap(a, pa, b, pb, s.main[0]);
+      }
     }
     if (!s.main.empty()) {
       // A vertex that went more than half way through picks the far face: its normal opposes
@@ -183,6 +218,8 @@ int findContacts3(const PG& a, const Pose<3>& poseA, const PG& b, const Pose<3>&
 
 bool overlaps3(const PG& a, const Pose<3>& poseA, const PG& b, const Pose<3>& poseB) {
   if (a.unbounded() && b.unbounded()) return false;
+  if (typeOf(a) == GeometryType::Box && typeOf(b) == GeometryType::Box)
+    return boxBoxAxis(a.geometry(), poseA, b.geometry(), poseB).separation < 0;
   if (!contactsAreCheap(typeOf(a), typeOf(b))) return fclOverlap(a, poseA, b, poseB);
   thread_local std::vector<CP> deepest;
   deepest.clear();

@@ -240,8 +240,9 @@ void featureContacts(const PreparedGeometry<d>& f, const Pose<d>& poseF, const V
   const auto& bounds = s.impl().localBounds;
   for (const auto& p : scratch) {
     // Farther than margin + radius from S's box is farther from S: skip the exact query (big
-    // hulls have many vertices and many faces).
-    if (bounds.exteriorDistance(p.x) > margin + p.radius) continue;
+    // hulls have many vertices and many faces). Squared: no root for the many rejected points.
+    const double reach = margin + p.radius;
+    if (bounds.squaredExteriorDistance(p.x) > reach * reach) continue;
     const SurfaceDistance<d> sd = signedDistance<d>(s, p.x, margin + p.radius);
     const double depth = p.radius - sd.distance;
     if (!(depth >= -margin)) continue;
@@ -282,7 +283,7 @@ void mergeDuplicates(const std::vector<ContactPoint<d>>& points, double mergeDis
   // The shallower of two coincident contacts goes, the later one on ties.
   auto consider = [&](int i, int j) {
     if (s.removed[i] || s.removed[j]) return;
-    if ((points[i].point - points[j].point).norm() > mergeDistance) return;
+    if ((points[i].point - points[j].point).squaredNorm() > mergeDistance * mergeDistance) return;
     if (points[i].normal.dot(points[j].normal) < kSameNormalCosine) return;
     const bool dropI = points[j].depth > points[i].depth || (points[j].depth == points[i].depth && i > j);
     s.removed[dropI ? i : j] = 1;

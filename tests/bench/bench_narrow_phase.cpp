@@ -93,14 +93,15 @@ Pose<d> jittered(const Pose<d>& p, std::mt19937& rng) {
 
 template <int d>
 void benchPair(const char* name, const Geometry<d>& a, const Pose<d>& pa, const Geometry<d>& b, const Pose<d>& pb,
-               int queries) {
+               int queries, double margin = 0) {
   const PreparedGeometry<d> ga(a), gb(b);
   std::mt19937 rng(1);
   std::vector<Pose<d>> poses;
   for (int i = 0; i < 1024; ++i) poses.push_back(jittered<d>(pa, rng));
   std::vector<ContactPoint<d>> out;
   out.reserve(64);
-  const ContactQuery query;
+  ContactQuery query;
+  query.margin = margin;
   long points = 0;
   double best = 1e300;
   for (int rep = 0; rep < 3; ++rep) {
@@ -181,7 +182,11 @@ int main(int argc, char** argv) {
   benchPair<3>("box-box edge-edge", box3(0.5),
                at(V3(0, std::sqrt(2.0) - 0.01, 0), Eigen::AngleAxisd(kPi / 4, V3::UnitZ()).toRotationMatrix()), box3(0.5),
                at(V3::Zero(), Eigen::AngleAxisd(kPi / 4, V3::UnitX()).toRotationMatrix()), queries);
-  benchPair<3>("box-box resting, margin 0.01", box3(0.3), at(V3(0.1, 0.79, 0.05)), box3(0.5), at(V3::Zero()), queries);
+  benchPair<3>("box-box resting, margin 0.01", box3(0.3), at(V3(0.1, 0.79, 0.05)), box3(0.5), at(V3::Zero()), queries,
+               0.01);
+  // A pyramid's pair: a unit box half on another, 1e-4 deep, with the contact thickness 1e-4.
+  benchPair<3>("box-box pyramid, margin 1e-4", box3(0.5), at(V3(0.51, 0.9999, 0)), box3(0.5), at(V3::Zero()), queries,
+               1e-4);
   benchPair<3>("box-halfspace", box3(0.5), at(V3(0, 0.49, 0)), ground3(), at(V3::Zero()), queries);
   benchPair<3>("sphere-sphere", shape3(GeometryType::Sphere, 0.5, 0), at(V3(0.1, 0.99, 0)),
                shape3(GeometryType::Sphere, 0.5, 0), at(V3::Zero()), queries);
