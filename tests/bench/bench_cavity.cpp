@@ -3,7 +3,8 @@
 // the argument "1000") through the real pipeline; steady state = max|du|/dt < 1e-6 (the scene's
 // stop criterion).
 //
-// usage: bench_cavity [100|1000] [cells] [threads] [coupled|chorin]
+// usage: bench_cavity [100|1000] [cells] [threads] [coupled|chorin] [CFL: dt = CFL / cells, default 1]
+//                    [semi_lagrangian|eno3]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -24,12 +25,14 @@ int main(int argc, char** argv) {
   if (argc > 2) {
     const int n = std::atoi(argv[2]);
     char dt[32];
-    std::snprintf(dt, sizeof dt, "%.17g", 1.0 / n);  // CFL about 1, as in the scenes
+    const double cfl = argc > 5 ? std::atof(argv[5]) : 1.0;  // CFL about 1, as in the scenes
+    std::snprintf(dt, sizeof dt, "%.17g", cfl / n);
     overrides = {{"entities.fluid.mac_grid.cells", "[" + std::to_string(n) + "," + std::to_string(n) + "]"}, {"time.dt", dt}};
   }
   const int threads = argc > 3 ? std::atoi(argv[3]) : 2;
   const std::string projection = argc > 4 ? argv[4] : "coupled";
   overrides.push_back({"solvers.fluid.projection", projection});
+  if (argc > 6) overrides.push_back({"solvers.fluid.advection", argv[6]});
   Registry registry;
   registerBuiltins(registry);
   const SceneSpec scene = loadScene(file, overrides);
