@@ -175,15 +175,16 @@ TEST(KinematicObstacles, SpinningDiskCarriesItsRigidVelocityAndDragsTheFluidArou
   const solvers::MacLayout<2> layout(grid.cells, grid.dx, grid.origin);
   // 1. Every face with a solid cell on either side carries the normal component of w x r at its
   //    centre, exactly (the equal-velocity constraint at face centres).
+  const auto touchesSolid = [&](int axis, solvers::MacLayout<2>::Index index) {
+    const bool upper = layout.cellInside(index) && grid.solid[layout.cellIndex(index)];
+    index[axis] -= 1;
+    return upper || (layout.cellInside(index) && grid.solid[layout.cellIndex(index)]);
+  };
   int constrained = 0;
   double worstConstraint = 0;
   for (int f = 0; f < layout.totalFaces(); ++f) {
     const auto [axis, index] = layout.faceCoord(f);
-    auto lower = index;
-    lower[axis] -= 1;
-    const bool solidLower = layout.cellInside(lower) && grid.solid[layout.cellIndex(lower)];
-    const bool solidUpper = layout.cellInside(index) && grid.solid[layout.cellIndex(index)];
-    if (!solidLower && !solidUpper) continue;
+    if (!touchesSolid(axis, index)) continue;
     const Eigen::Vector2d x = layout.faceCenter(axis, index);
     const Eigen::Vector2d rigid(-x.y(), x.x());  // w x r with w = 1
     worstConstraint = std::max(worstConstraint, std::abs(grid.u[f] - rigid[axis]));
@@ -195,11 +196,7 @@ TEST(KinematicObstacles, SpinningDiskCarriesItsRigidVelocityAndDragsTheFluidArou
   double angular = 0;
   for (int f = 0; f < layout.totalFaces(); ++f) {
     const auto [axis, index] = layout.faceCoord(f);
-    auto lower = index;
-    lower[axis] -= 1;
-    if ((layout.cellInside(lower) && grid.solid[layout.cellIndex(lower)]) ||
-        (layout.cellInside(index) && grid.solid[layout.cellIndex(index)]))
-      continue;
+    if (touchesSolid(axis, index)) continue;
     const Eigen::Vector2d x = layout.faceCenter(axis, index);
     angular += axis == 0 ? -x.y() * grid.u[f] : x.x() * grid.u[f];
   }
