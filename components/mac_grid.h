@@ -68,6 +68,9 @@ struct MacGrid {
 
   // --- derived every step by rasterize_obstacles from the obstacles' bodies (not checkpointed) ---
   std::vector<ObstacleMotion<d>> obstacleMotions;
+  // Per face and direction, cells from the face centre to an obstacle surface (FluidDomain::
+  // wallDistance); empty when the obstacles' walls sit at the face centres ("obstacle_wall": "face").
+  std::vector<double> obstacleWallDistance;
 
   // Velocity of the obstacle nearest to x (the one whose bounding sphere x is deepest in); zero
   // without obstacles. Solid faces take its normal component (Sec. 5.4.1).

@@ -28,7 +28,7 @@ struct RigidRotationSettings {
 
 // How the fluid step of Ch. 5 is taken (scene "solvers": {"fluid": {...}}).
 struct FluidSolverSettings {
-  enum class Advection { SemiLagrangian, Eno3, None };  // None: unsteady Stokes flow (Sec. 5.7)
+  enum class Advection { SemiLagrangian, MacCormack, Eno3, None };  // None: unsteady Stokes flow (Sec. 5.7)
   enum class Projection { Coupled, Chorin };            // (5.31) vs pressure/viscosity splitting
   enum class Preconditioner { None, Jacobi, IC0, MIC0, Multigrid };
   Advection advection = Advection::SemiLagrangian;
@@ -36,6 +36,11 @@ struct FluidSolverSettings {
   Preconditioner preconditioner = Preconditioner::Multigrid;  // flat iteration counts (benchmarks)
   double tolerance = 1e-8;   // relative residual of the Krylov solve
   int maxIterations = 5000;
+  // Where the viscous operator puts an obstacle's no-slip wall for tangential velocities:
+  // true (scene "obstacle_wall": "surface"): at the obstacle's true surface, found along the
+  // pair's direction (docs/architecture.md); false ("face"): at the prescribed face centre, the
+  // thesis's first-order treatment (Sec. 5.4.1, 5.7), which sits up to dx/2 inside the solid.
+  bool obstacleWallAtSurface = true;
 };
 
 // Collisions, contact and interpenetration resolution (issue 3; scene "solvers": {"contact":

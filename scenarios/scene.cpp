@@ -366,8 +366,12 @@ void loadScenePlugins(const SceneSpec& scene, PluginLoader& loader, Registry& re
 namespace {
 void parseFluidSolverSettings(const Config& c, FluidSolverSettings& f) {
   using S = FluidSolverSettings;
-  const std::string advection = c.oneOf("advection", {"semi_lagrangian", "eno3", "none"}, "semi_lagrangian");
-  f.advection = advection == "eno3" ? S::Advection::Eno3 : advection == "none" ? S::Advection::None : S::Advection::SemiLagrangian;
+  const std::string advection = c.oneOf("advection", {"semi_lagrangian", "maccormack", "eno3", "none"}, "semi_lagrangian");
+  f.advection = advection == "eno3"         ? S::Advection::Eno3
+                : advection == "maccormack" ? S::Advection::MacCormack
+                : advection == "none"       ? S::Advection::None
+                                            : S::Advection::SemiLagrangian;
+  f.obstacleWallAtSurface = c.oneOf("obstacle_wall", {"surface", "face"}, "surface") == "surface";
   f.projection = c.oneOf("projection", {"coupled", "chorin"}, "coupled") == "chorin" ? S::Projection::Chorin : S::Projection::Coupled;
   const std::string pc = c.oneOf("preconditioner", {"none", "jacobi", "ic0", "mic0", "multigrid"}, "multigrid");
   f.preconditioner = pc == "none"     ? S::Preconditioner::None

@@ -40,10 +40,11 @@ void FluidAdvection<d>::run(World<d>& world, StepContext& ctx) {
     const auto domain = fluidDomainOf(grid);
     const solvers::FaceBoundary boundary = faceBoundaryOf(domain);
     const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(grid.u.data(), grid.u.size());
+    const auto scheme = world.settings().fluid.advection;
     const Eigen::VectorXd advected =
-        world.settings().fluid.advection == FluidSolverSettings::Advection::Eno3
-            ? solvers::advectFacesEnoRk3(domain.layout, u, ctx.dt, boundary)
-            : solvers::advectFacesSemiLagrangian(domain.layout, u, ctx.dt, boundary);
+        scheme == FluidSolverSettings::Advection::Eno3         ? solvers::advectFacesEnoRk3(domain.layout, u, ctx.dt, boundary)
+        : scheme == FluidSolverSettings::Advection::MacCormack ? solvers::advectFacesMacCormack(domain.layout, u, ctx.dt, boundary)
+                                                               : solvers::advectFacesSemiLagrangian(domain.layout, u, ctx.dt, boundary);
     Eigen::Map<Eigen::VectorXd>(grid.u.data(), grid.u.size()) = advected;
   }
 }

@@ -54,6 +54,7 @@ solvers::FluidDomain<d> fluidDomainOf(const MacGrid<d>& grid) {
     solvers::VelocityField<d> obstacleVelocity;
     if (grid.obstaclesMove()) obstacleVelocity = [&grid](const Vec& x) { return grid.obstacleVelocityAt(x); };
     solvers::markSolid(domain, grid.solid, obstacleVelocity);
+    domain.wallDistance = grid.obstacleWallDistance;
   }
   return domain;
 }

@@ -1,6 +1,9 @@
 #include "systems/fluid_obstacles.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 #include "components/fluid_obstacle.h"
 #include "solvers/mac_layout.h"
@@ -16,6 +19,37 @@ bool shapeContains(const Shape<d>& shape, const RigidBody<d>& body, const Eigen:
 }
 
 namespace {
+
+// Distance t in [0, tMax] along x + t e (|e| = 1) at which the ray enters the shape: 0 if x is
+// inside, +inf if it misses within tMax.
+template <int d>
+double rayEntry(const Shape<d>& shape, const RigidBody<d>& body, const Eigen::Matrix<double, d, 1>& x,
+                const Eigen::Matrix<double, d, 1>& e, double tMax) {
+  constexpr double kMiss = std::numeric_limits<double>::infinity();
+  const Eigen::Matrix<double, d, 1> p = body.rotation().transpose() * (x - body.x);
+  const Eigen::Matrix<double, d, 1> q = body.rotation().transpose() * e;
+  if (shape.type == ShapeType::Box) {  // slabs
+    double lo = 0, hi = tMax;
+    for (int i = 0; i < d; ++i) {
+      const double h = shape.halfExtents[i];
+      if (std::abs(q[i]) < 1e-15) {
+        if (std::abs(p[i]) > h) return kMiss;
+        continue;
+      }
+      double t0 = (-h - p[i]) / q[i], t1 = (h - p[i]) / q[i];
+      if (t0 > t1) std::swap(t0, t1);
+      lo = std::max(lo, t0), hi = std::min(hi, t1);
+      if (lo > hi) return kMiss;
+    }
+    return lo;
+  }
+  const double r = shape.radius, b = p.dot(q), c = p.squaredNorm() - r * r;
+  if (c <= 0) return 0;
+  const double disc = b * b - c;
+  if (disc < 0) return kMiss;
+  const double t = -b - std::sqrt(disc);
+  return t >= 0 && t <= tMax ? t : kMiss;
+}
 
 // The cell next to c along `axis` in direction dir (+-1); false outside a non-periodic domain.
 template <int d>
@@ -54,6 +88,41 @@ std::vector<std::uint8_t> obstacleMask(const World<d>& world, const MacGrid<d>& 
 }
 
 template <int d>
+std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d>& grid) {
+  using Index = typename solvers::MacLayout<d>::Index;
+  const solvers::MacLayout<d> layout = macLayoutOf(grid);
+  std::vector<std::pair<const Shape<d>*, const RigidBody<d>*>> obstacles;
+  forEachObstacle(world, [&](Entity, const Shape<d>& shape, const RigidBody<d>& body) { obstacles.emplace_back(&shape, &body); });
+  std::vector<double> distance(static_cast<std::size_t>(layout.totalFaces()) * 2 * d, 1.0);
+  if (grid.solid.empty()) return distance;
+  const auto solidCell = [&](const Index& c) { return grid.solid[layout.cellIndex(c)] != 0; };
+  for (int g = 0; g < layout.totalFaces(); ++g) {
+    const auto [a, f] = layout.faceCoord(g);
+    Index c0, c1 = f;
+    if (!layout.cellInside(c1) || !neighbour(layout, c1, a, -1, c0)) continue;  // a domain boundary face
+    if (solidCell(c0) || solidCell(c1)) continue;                              // not a free face
+    for (int b = 0; b < d; ++b) {
+      if (b == a) continue;
+      for (int dir = -1; dir <= 1; dir += 2) {
+        // The next face along dir e_b is an obstacle face if one of its cells is solid.
+        Index n0, n1;
+        const bool obstacleFace = (neighbour(layout, c0, b, dir, n0) && solidCell(n0)) ||
+                                  (neighbour(layout, c1, b, dir, n1) && solidCell(n1));
+        if (!obstacleFace) continue;
+        Eigen::Matrix<double, d, 1> e = Eigen::Matrix<double, d, 1>::Zero();
+        e[b] = dir;
+        const auto x = layout.faceCenter(a, f);
+        double t = std::numeric_limits<double>::infinity();
+        for (const auto& [shape, body] : obstacles) t = std::min(t, rayEntry(*shape, *body, x, e, layout.dx));
+        distance[static_cast<std::size_t>(g) * 2 * d + 2 * b + (dir > 0)] =
+            std::clamp(t / layout.dx, solvers::FluidDomain<d>::kMinWallDistance, 1.0);
+      }
+    }
+  }
+  return distance;
+}
+
+template <int d>
 Eigen::Matrix<double, d, 1> obstacleForce(const World<d>& world, Entity obstacle, const MacGrid<d>& grid,
                                           double viscosity) {
   using Vec = Eigen::Matrix<double, d, 1>;
@@ -84,10 +153,13 @@ Eigen::Matrix<double, d, 1> obstacleForce(const World<d>& world, Entity obstacle
       }
   }
 
-  // Wall shear: a free face of axis a (fluid on both sides) whose neighbours across axis b lie
-  // in the obstacle has the no-slip wall at distance dx/2; stress mu (u - u_wall) / (dx/2) drags the body
-  // along u. Weighted by the fraction of the face's span (half of each adjacent cell) covered.
+  // Wall shear, exactly as the viscous operator applies it (operators.h): every free face of axis a
+  // whose next face across axis b is one of this obstacle's faces has a shear row
+  // mu (u - u_wall) / (theta dx) on the face area, theta dx being the distance to the wall (the
+  // grid's wall distances; 1 cell when the wall sits at the face centre). The fluid loses that
+  // momentum to the body, so the sum is the body's share of the discrete momentum balance.
   if (viscosity > 0) {
+    const std::vector<double>& wallDistance = grid.obstacleWallDistance;
     for (int g = 0; g < layout.totalFaces(); ++g) {
       const auto [a, fi] = layout.faceCoord(g);
       Index c0, c1 = fi;
@@ -97,15 +169,15 @@ Eigen::Matrix<double, d, 1> obstacleForce(const World<d>& world, Entity obstacle
         if (b == a) continue;
         for (int dir = -1; dir <= 1; dir += 2) {
           Index n0, n1;
-          double covered = 0;
-          if (neighbour(layout, c0, b, dir, n0) && mine[layout.cellIndex(n0)]) covered += 0.5;
-          if (neighbour(layout, c1, b, dir, n1) && mine[layout.cellIndex(n1)]) covered += 0.5;
-          if (covered == 0) continue;
-          // Relative to the wall's own velocity at the wall point (dx/2 away along b).
+          const bool ours = (neighbour(layout, c0, b, dir, n0) && mine[layout.cellIndex(n0)]) ||
+                            (neighbour(layout, c1, b, dir, n1) && mine[layout.cellIndex(n1)]);
+          if (!ours) continue;
+          const double theta = wallDistance.empty() ? 1.0 : wallDistance[static_cast<std::size_t>(g) * 2 * d + 2 * b + (dir > 0)];
+          // The operator's known value: the obstacle face's prescribed velocity (its centre, one cell away).
           Eigen::Matrix<double, d, 1> wallPoint = layout.faceCenter(a, fi);
-          wallPoint[b] += dir * 0.5 * layout.dx;
+          wallPoint[b] += dir * layout.dx;
           const double wall = grid.obstacleVelocityAt(wallPoint)[a];
-          force[a] += viscosity * (grid.u[g] - wall) / (0.5 * layout.dx) * area * covered;
+          force[a] += viscosity * (grid.u[g] - wall) / (theta * layout.dx) * area;
         }
       }
     }
@@ -150,6 +222,8 @@ void RasterizeObstacles<d>::run(World<d>& world, StepContext&) {
     grid.obstacleMotions = motions;
     std::vector<std::uint8_t> mask = obstacleMask(world, grid);
     if (mask != grid.solid) grid.solid = std::move(mask);  // unchanged: keep the projection's cache
+    if (world.settings().fluid.obstacleWallAtSurface) grid.obstacleWallDistance = obstacleWallDistances(world, grid);
+    else grid.obstacleWallDistance.clear();
   }
 }
 
@@ -183,6 +257,8 @@ template bool shapeContains<2>(const Shape<2>&, const RigidBody<2>&, const Eigen
 template bool shapeContains<3>(const Shape<3>&, const RigidBody<3>&, const Eigen::Vector3d&);
 template std::vector<std::uint8_t> obstacleMask<2>(const World<2>&, const MacGrid<2>&);
 template std::vector<std::uint8_t> obstacleMask<3>(const World<3>&, const MacGrid<3>&);
+template std::vector<double> obstacleWallDistances<2>(const World<2>&, const MacGrid<2>&);
+template std::vector<double> obstacleWallDistances<3>(const World<3>&, const MacGrid<3>&);
 template Eigen::Vector2d obstacleForce<2>(const World<2>&, Entity, const MacGrid<2>&, double);
 template Eigen::Vector3d obstacleForce<3>(const World<3>&, Entity, const MacGrid<3>&, double);
 template class RasterizeObstacles<2>;

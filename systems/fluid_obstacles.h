@@ -4,11 +4,15 @@
 //  - rasterize_obstacles: grid.solid[c] = 1 for the cells whose centre lies inside any entity
 //    with shape + (static or kinematic) rigid_body + fluid_obstacle; writes the mask only when
 //    it changes (the projection caches its operators keyed on the mask and on the obstacles'
-//    motions), and grid.obstacleMotions (pose + rigid velocity) every step.
-//  - obstacle_forces: the fluid's force on each obstacle, a first-order stress integral over the
-//    staircase boundary (pressure of the fluid cell on every fluid-solid face, and the wall
-//    shear mu (u - u_wall) / (dx/2) of the free faces next to solid cells); diagnostics
-//    obstacle_<name>_force_x, _y (, _z).
+//    motions), and grid.obstacleMotions (pose + rigid velocity) every step. With the default
+//    "obstacle_wall": "surface" it also casts, from every free face next to an obstacle face, a
+//    ray along each tangential direction to the shape's surface (grid.obstacleWallDistance), so
+//    the viscous operator puts the no-slip wall where the body is rather than at the face centre
+//    inside it (operators.h); the normal constraints stay at the face centres as in the thesis.
+//  - obstacle_forces: the fluid's force on each obstacle: the pressure of the fluid cell on every
+//    fluid-solid face, plus the wall shear exactly as the viscous operator applies it,
+//    mu (u - u_wall) / (theta dx) on every free face whose tangential neighbour is an obstacle
+//    face; diagnostics obstacle_<name>_force_x, _y (, _z).
 #include "components/mac_grid.h"
 #include "components/rigid_body.h"
 #include "components/shape.h"
@@ -23,6 +27,12 @@ bool shapeContains(const Shape<d>& shape, const RigidBody<d>& body, const Eigen:
 // The obstacle mask of the grid: 1 for cells whose centre is inside some obstacle.
 template <int d>
 std::vector<std::uint8_t> obstacleMask(const World<d>& world, const MacGrid<d>& grid);
+
+// Per face and direction 2b + (dir > 0), the distance in cells from each free face's centre to
+// the nearest obstacle surface along dir e_b when the next face that way is an obstacle face
+// (clamped to [FluidDomain::kMinWallDistance, 1]); 1 elsewhere. Layout of FluidDomain::wallDistance.
+template <int d>
+std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d>& grid);
 
 // The force of the fluid on the obstacle (entity) from the grid's current velocity and pressure.
 template <int d>

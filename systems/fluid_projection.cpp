@@ -12,6 +12,7 @@ template <int d>
 struct FluidProjection<d>::Cache {
   std::vector<std::uint8_t> solid;  // geometry the operators were built for
   std::vector<ObstacleMotion<d>> motions;  // moving obstacles' velocities sit in the operators' RHS terms
+  std::vector<double> wallDistance;        // obstacle surfaces seen by the viscous rows
   double dt = -1, density = 0, viscosity = -1;
   solvers::PoissonPreconditionerKind kind = solvers::PoissonPreconditionerKind::None;
   std::unique_ptr<solvers::FluidOperators<d>> ops;
@@ -52,6 +53,7 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
     Cache& c = *cache_;
     const auto kind = preconditionerKind(settings.preconditioner);
     if (!c.ops || c.dt != ctx.dt || c.density != rho || c.viscosity != mu || c.solid != grid.solid || c.kind != kind ||
+        c.wallDistance != grid.obstacleWallDistance ||
         ((grid.obstaclesMove() || !c.motions.empty()) && c.motions != grid.obstacleMotions)) {
       c.ops = std::make_unique<solvers::FluidOperators<d>>(
           solvers::buildFluidOperators(fluidDomainOf(grid), solvers::FluidParameters{rho, mu, ctx.dt}));
@@ -60,6 +62,7 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
       c.density = rho;
       c.viscosity = mu;
       c.solid = grid.solid;
+      c.wallDistance = grid.obstacleWallDistance;
       c.motions = grid.obstaclesMove() ? grid.obstacleMotions : std::vector<ObstacleMotion<d>>{};
       c.kind = kind;
     }

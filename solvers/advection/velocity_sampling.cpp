@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -132,7 +133,7 @@ bool FaceVelocitySampler<d>::pointInSolid(const Vec& x) const {
 }
 
 template <int d>
-double FaceVelocitySampler<d>::component(int axis, const Vec& x) const {
+double FaceVelocitySampler<d>::component(int axis, const Vec& x, std::pair<double, double>* range) const {
   Index lo, hi;
   double t[d];
   for (int b = 0; b < d; ++b) {
@@ -161,6 +162,8 @@ double FaceVelocitySampler<d>::component(int axis, const Vec& x) const {
   }
   double sum = 0, weightSum = 0, solidSum = 0;
   bool dropped = false;
+  double fluidLo = std::numeric_limits<double>::infinity(), fluidHi = -fluidLo;
+  double solidLo = fluidLo, solidHi = -fluidLo;
   for (int corner = 0; corner < (1 << d); ++corner) {
     Index f;
     double w = 1;
@@ -174,11 +177,15 @@ double FaceVelocitySampler<d>::component(int axis, const Vec& x) const {
     if (faceInsideSolid(axis, f)) {  // rule 4
       dropped = true;
       solidSum += w * value;
+      solidLo = std::min(solidLo, value), solidHi = std::max(solidHi, value);
       continue;
     }
     sum += w * value;
     weightSum += w;
+    fluidLo = std::min(fluidLo, value), fluidHi = std::max(fluidHi, value);
   }
+  const bool fromFluid = !dropped || weightSum > 0;
+  if (range) *range = fromFluid ? std::make_pair(fluidLo, fluidHi) : std::make_pair(solidLo, solidHi);
   if (!dropped) return sum;
   return weightSum > 0 ? sum / weightSum : solidSum;
 }

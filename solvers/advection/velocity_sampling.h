@@ -34,6 +34,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace monolith::solvers {
@@ -80,7 +81,9 @@ class FaceVelocitySampler {
   Index cellOf(const Vec& x) const;
   bool pointInSolid(const Vec& x) const;
 
-  double component(int axis, const Vec& x) const;  // rules 1-4
+  // rules 1-4. If range is given it receives the smallest and largest of the face values that
+  // entered the sample (the bounds a limiter may clamp a higher-order correction to).
+  double component(int axis, const Vec& x, std::pair<double, double>* range = nullptr) const;
   Vec velocity(const Vec& x) const;                // all components at x
   // The point of segment [from, to] where it first enters a solid cell (its fluid side), or `to`
   // if it stays in fluid (rule 5). If `from` itself lies in a solid cell, returns `from`.

@@ -73,6 +73,14 @@ struct FluidDomain {
   std::vector<FaceKind> faces;        // layout.totalFaces()
   std::vector<double> faceVelocity;   // prescribed normal velocity of Prescribed faces, else 0
   BoxSpec<d> sides;
+  // Optional; empty: every obstacle wall sits at the prescribed face centre (the thesis's
+  // first-order staircase, Sec. 5.4.1). Else wallDistance[face * 2d + 2b + s] (s = 0 towards
+  // -e_b, 1 towards +e_b) is the distance, in cells, from the centre of a Free face to an
+  // obstacle's surface in that direction, in [kMinWallDistance, 1], 1 meaning "at the next face".
+  // The viscous operator reads it for tangential pairs (b != the face's axis) whose other end is
+  // a prescribed face (operators.h).
+  std::vector<double> wallDistance;
+  static constexpr double kMinWallDistance = 0.1;  // bounds the wall term's weight by 1/0.1
 
   // Classification of a face from its two cells and the sides (outside a Wall/Inflow side counts
   // as solid, outside an Outflow side as Dirichlet): solid on either side -> Prescribed, else a

@@ -150,7 +150,18 @@ void buildViscousRows(FluidOperators<d>& ops) {
         const PairEnd e1 = pairEnd<d>(domain, ops.dofs, a, b, f1);
         if (e0.kind == PairEnd::Drop || e1.kind == PairEnd::Drop) continue;
         if (e0.kind != PairEnd::Unknown && e1.kind != PairEnd::Unknown) continue;
-        const double c = (e0.ghost || e1.ghost) ? std::sqrt(2.0) * w : w;
+        double c = (e0.ghost || e1.ghost) ? std::sqrt(2.0) * w : w;
+        if (b != a && !domain.wallDistance.empty()) {
+          // A tangential pair ending on an obstacle face: the wall sits theta cells from the free
+          // face instead of one, so the row is w (U - u_f) / sqrt(theta) (theta = 1/2 is the
+          // mirrored ghost above); G_mu^T G_mu keeps its symmetric form.
+          const auto theta = [&](const PairEnd& unknown, int towardsUpper) {
+            return domain.wallDistance[static_cast<std::size_t>(ops.dofs.velocityToFace[unknown.velocity]) * 2 * d + 2 * b +
+                                       towardsUpper];
+          };
+          if (e0.kind == PairEnd::Unknown && e1.kind == PairEnd::Known && !e1.ghost) c = w / std::sqrt(theta(e0, 1));
+          if (e1.kind == PairEnd::Unknown && e0.kind == PairEnd::Known && !e0.ghost) c = w / std::sqrt(theta(e1, 0));
+        }
         ViscousRow row;
         double h = 0;
         if (e0.kind == PairEnd::Unknown) {
@@ -184,7 +195,8 @@ FluidOperators<d> buildFluidOperators(const FluidDomain<d>& domain, const FluidP
   const auto& layout = domain.layout;
   if (static_cast<int>(domain.cells.size()) != layout.cellCount() ||
       static_cast<int>(domain.faces.size()) != layout.totalFaces() ||
-      static_cast<int>(domain.faceVelocity.size()) != layout.totalFaces())
+      static_cast<int>(domain.faceVelocity.size()) != layout.totalFaces() ||
+      !(domain.wallDistance.empty() || domain.wallDistance.size() == static_cast<std::size_t>(layout.totalFaces()) * 2 * d))
     throw std::invalid_argument("buildFluidOperators: domain arrays do not match its layout");
   FluidOperators<d> ops;
   ops.domain = domain;
