@@ -221,6 +221,28 @@ TEST(SemiLagrangian, SolidBlockStaysBoundedAndFinite) {
   EXPECT_LT(umin, 0.5);  // the block really did slow the flow down behind it
 }
 
+TEST(MacCormack, SolidBlockStaysBoundedAndFinite) {
+  BlockScene scene;
+  Eigen::VectorXd u = scene.u;
+  const double dt = 2.0 * scene.layout.dx;  // CFL 2, as for semi-Lagrangian above
+  for (int step = 0; step < 20; ++step) u = advectFacesMacCormack(scene.layout, u, dt, scene.boundary);
+  double umin = 1e300, umax = -1e300, vmax = 0;
+  for (int g = 0; g < scene.layout.totalFaces(); ++g) {
+    ASSERT_TRUE(std::isfinite(u[g])) << g;
+    if (scene.boundary.prescribedFace[g]) {
+      EXPECT_EQ(u[g], scene.boundary.prescribedVelocity[g]);
+      continue;
+    }
+    if (scene.layout.faceCoord(g).first == 0) umin = std::min(umin, u[g]), umax = std::max(umax, u[g]);
+    else vmax = std::max(vmax, std::abs(u[g]));
+  }
+  // The limiter clamps each value into the range of the old values it was interpolated from, so
+  // the bounds of the plain scheme hold exactly.
+  EXPECT_GE(umin, -1e-12);
+  EXPECT_LE(umax, 1 + 1e-12);
+  EXPECT_LE(vmax, BlockScene::kVmax + 1e-12);
+}
+
 TEST(EnoRk3, SolidBlockStaysFiniteAndNearlyBounded) {
   BlockScene scene;
   // ENO reads prescribed values as ghosts inside the structure (eno.h), so give the block its
@@ -289,6 +311,20 @@ TEST(Convergence, EnoRk3Transverse2d) {
   // at the faces gives exactly 2.00 in the convective-term tests below).
   for (std::size_t i = 1; i < ns.size(); ++i) EXPECT_GT(order(e[i - 1], e[i]), 2.5);
   EXPECT_LT(e.back(), 1e-4);
+}
+
+TEST(Convergence, MacCormackTransverse2d) {
+  const std::vector<int> ns{32, 64, 128};
+  const auto e = transverseErrors2d(ns, [](const MacLayout<2>& l, const Eigen::VectorXd& y, double dt) {
+    return advectFacesMacCormack(l, y, dt);
+  });
+  printTable("MacCormack (limited), 2-D transverse sine, CFL 0.5, max error at T=0.5", ns, e);
+  // The back-and-forth correction cancels the interpolation's leading error: second order where
+  // the limiter is idle. It clips at the sine's extrema, which is where the max error sits, so
+  // the measured max-norm orders are 1.74, 1.73 (1.63 from 128 to 256). Plain semi-Lagrangian
+  // above is first order (0.97, error 3.8e-2 at 128), so > 1.5 and < 3e-3 fail if the correction is lost.
+  for (std::size_t i = 1; i < ns.size(); ++i) EXPECT_GT(order(e[i - 1], e[i]), 1.5);
+  EXPECT_LT(e.back(), 3e-3);
 }
 
 // 3-D: u = (1, 0.5, 0) constant, w(x, y, 0) = sin(2 pi x) cos(2 pi y), independent of z, so
@@ -495,14 +531,15 @@ TEST(Determinism, OneAndTwoThreadsBitwiseEqual) {
     tbb::task_arena arena(threads);
     std::vector<Eigen::VectorXd> out;
     arena.execute([&] {
-      Eigen::VectorXd sl = u0, eno = u0, phi = phi0, w = w0;
+      Eigen::VectorXd sl = u0, mc = u0, eno = u0, phi = phi0, w = w0;
       for (int s = 0; s < 5; ++s) {
         sl = advectFacesSemiLagrangian(scene.layout, sl, 1.5 * scene.layout.dx, scene.boundary);
+        mc = advectFacesMacCormack(scene.layout, mc, 1.5 * scene.layout.dx, scene.boundary);
         eno = advectFacesEnoRk3(scene.layout, eno, 0.4 * scene.layout.dx, scene.boundary);
         phi = advectScalarEnoRk3(scene.layout, phi, eno, 0.4 * scene.layout.dx, scene.boundary);
         w = advectFacesEnoRk3(layout3, advectFacesSemiLagrangian(layout3, w, 0.05), 0.02);
       }
-      out = {sl, eno, phi, w};
+      out = {sl, mc, eno, phi, w};
     });
     return out;
   };
