@@ -36,11 +36,11 @@ struct FluidSolverSettings {
   Preconditioner preconditioner = Preconditioner::Multigrid;  // flat iteration counts (benchmarks)
   double tolerance = 1e-8;   // relative residual of the Krylov solve
   int maxIterations = 5000;
-  // Where the viscous operator puts an obstacle's no-slip wall for tangential velocities:
-  // true (scene "obstacle_wall": "surface"): at the obstacle's true surface, found along the
-  // pair's direction (docs/architecture.md); false ("face"): at the prescribed face centre, the
-  // thesis's first-order treatment (Sec. 5.4.1, 5.7), which sits up to dx/2 inside the solid.
-  bool obstacleWallAtSurface = true;
+  // Where the viscous operator puts an obstacle's no-slip wall: false (scene "obstacle_wall":
+  // "face", default): at the obstacle face's centre, the thesis's first-order treatment (Sec.
+  // 5.4.1, 5.7), up to a cell inside the body; true ("surface"): at the body's true surface,
+  // found along each pair's direction (docs/architecture.md, measured in docs/benchmarks.md).
+  bool obstacleWallAtSurface = false;
 };
 
 // Collisions, contact and interpenetration resolution (issue 3; scene "solvers": {"contact":

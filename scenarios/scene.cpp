@@ -371,7 +371,7 @@ void parseFluidSolverSettings(const Config& c, FluidSolverSettings& f) {
                 : advection == "maccormack" ? S::Advection::MacCormack
                 : advection == "none"       ? S::Advection::None
                                             : S::Advection::SemiLagrangian;
-  f.obstacleWallAtSurface = c.oneOf("obstacle_wall", {"surface", "face"}, "surface") == "surface";
+  f.obstacleWallAtSurface = c.oneOf("obstacle_wall", {"face", "surface"}, "face") == "surface";
   f.projection = c.oneOf("projection", {"coupled", "chorin"}, "coupled") == "chorin" ? S::Projection::Chorin : S::Projection::Coupled;
   const std::string pc = c.oneOf("preconditioner", {"none", "jacobi", "ic0", "mic0", "multigrid"}, "multigrid");
   f.preconditioner = pc == "none"     ? S::Preconditioner::None

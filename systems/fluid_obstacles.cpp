@@ -102,12 +102,14 @@ std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d
     if (!layout.cellInside(c1) || !neighbour(layout, c1, a, -1, c0)) continue;  // a domain boundary face
     if (solidCell(c0) || solidCell(c1)) continue;                              // not a free face
     for (int b = 0; b < d; ++b) {
-      if (b == a) continue;
       for (int dir = -1; dir <= 1; dir += 2) {
-        // The next face along dir e_b is an obstacle face if one of its cells is solid.
+        // The next face along dir e_b is an obstacle face if one of its cells is solid (along the
+        // face's own axis: the cell beyond c1, or before c0).
         Index n0, n1;
-        const bool obstacleFace = (neighbour(layout, c0, b, dir, n0) && solidCell(n0)) ||
-                                  (neighbour(layout, c1, b, dir, n1) && solidCell(n1));
+        const bool obstacleFace = b == a ? (dir > 0 ? neighbour(layout, c1, a, 1, n1) && solidCell(n1)
+                                                    : neighbour(layout, c0, a, -1, n0) && solidCell(n0))
+                                         : (neighbour(layout, c0, b, dir, n0) && solidCell(n0)) ||
+                                               (neighbour(layout, c1, b, dir, n1) && solidCell(n1));
         if (!obstacleFace) continue;
         Eigen::Matrix<double, d, 1> e = Eigen::Matrix<double, d, 1>::Zero();
         e[b] = dir;
@@ -153,11 +155,13 @@ Eigen::Matrix<double, d, 1> obstacleForce(const World<d>& world, Entity obstacle
       }
   }
 
-  // Wall shear, exactly as the viscous operator applies it (operators.h): every free face of axis a
-  // whose next face across axis b is one of this obstacle's faces has a shear row
+  // Viscous stress, exactly as the viscous operator applies it (operators.h): every free face of
+  // axis a whose next face along axis b is one of this obstacle's faces has a row
   // mu (u - u_wall) / (theta dx) on the face area, theta dx being the distance to the wall (the
-  // grid's wall distances; 1 cell when the wall sits at the face centre). The fluid loses that
-  // momentum to the body, so the sum is the body's share of the discrete momentum balance.
+  // grid's wall distances; 1 cell when the wall sits at the obstacle face's centre; along the
+  // face's own axis the row is the normal stress of the cell between). The fluid loses that
+  // momentum to the body, so the sum is the body's share of the discrete momentum balance (on a
+  // staircase the normal rows do not vanish as du_n/dn = 0 would make them on a smooth wall).
   if (viscosity > 0) {
     const std::vector<double>& wallDistance = grid.obstacleWallDistance;
     for (int g = 0; g < layout.totalFaces(); ++g) {
@@ -166,11 +170,14 @@ Eigen::Matrix<double, d, 1> obstacleForce(const World<d>& world, Entity obstacle
       if (!layout.cellInside(c1) || !neighbour(layout, c1, a, -1, c0)) continue;  // a domain boundary face
       if (grid.solid[layout.cellIndex(c0)] || grid.solid[layout.cellIndex(c1)]) continue;
       for (int b = 0; b < d; ++b) {
-        if (b == a) continue;
         for (int dir = -1; dir <= 1; dir += 2) {
+          // Is the next face along dir e_b one of this obstacle's faces? Along the face's own axis
+          // that is the far face of c1 (or c0), whose cell beyond must be ours.
           Index n0, n1;
-          const bool ours = (neighbour(layout, c0, b, dir, n0) && mine[layout.cellIndex(n0)]) ||
-                            (neighbour(layout, c1, b, dir, n1) && mine[layout.cellIndex(n1)]);
+          const bool ours = b == a ? (dir > 0 ? neighbour(layout, c1, a, 1, n1) && mine[layout.cellIndex(n1)]
+                                              : neighbour(layout, c0, a, -1, n0) && mine[layout.cellIndex(n0)])
+                                   : (neighbour(layout, c0, b, dir, n0) && mine[layout.cellIndex(n0)]) ||
+                                         (neighbour(layout, c1, b, dir, n1) && mine[layout.cellIndex(n1)]);
           if (!ours) continue;
           const double theta = wallDistance.empty() ? 1.0 : wallDistance[static_cast<std::size_t>(g) * 2 * d + 2 * b + (dir > 0)];
           // The operator's known value: the obstacle face's prescribed velocity (its centre, one cell away).

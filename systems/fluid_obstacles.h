@@ -5,14 +5,15 @@
 //    with shape + (static or kinematic) rigid_body + fluid_obstacle; writes the mask only when
 //    it changes (the projection caches its operators keyed on the mask and on the obstacles'
 //    motions), and grid.obstacleMotions (pose + rigid velocity) every step. With the default
-//    "obstacle_wall": "surface" it also casts, from every free face next to an obstacle face, a
-//    ray along each tangential direction to the shape's surface (grid.obstacleWallDistance), so
-//    the viscous operator puts the no-slip wall where the body is rather than at the face centre
-//    inside it (operators.h); the normal constraints stay at the face centres as in the thesis.
+//    "obstacle_wall": "surface" it also casts, from every free face whose neighbour face along
+//    some axis is an obstacle face, a ray that way to the shape's surface
+//    (grid.obstacleWallDistance), so the viscous operator puts the no-slip wall where the body is
+//    rather than at the obstacle face's centre (operators.h); the normal constraints stay at the
+//    face centres as in the thesis.
 //  - obstacle_forces: the fluid's force on each obstacle: the pressure of the fluid cell on every
-//    fluid-solid face, plus the wall shear exactly as the viscous operator applies it,
-//    mu (u - u_wall) / (theta dx) on every free face whose tangential neighbour is an obstacle
-//    face; diagnostics obstacle_<name>_force_x, _y (, _z).
+//    fluid-solid face, plus the viscous stress exactly as the viscous operator applies it,
+//    mu (u - u_wall) / (theta dx) for every free face and axis whose neighbour face that way is
+//    an obstacle face (the body's share of the discrete momentum balance); diagnostics obstacle_<name>_force_x, _y (, _z).
 #include "components/mac_grid.h"
 #include "components/rigid_body.h"
 #include "components/shape.h"

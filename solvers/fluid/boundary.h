@@ -77,8 +77,7 @@ struct FluidDomain {
   // first-order staircase, Sec. 5.4.1). Else wallDistance[face * 2d + 2b + s] (s = 0 towards
   // -e_b, 1 towards +e_b) is the distance, in cells, from the centre of a Free face to an
   // obstacle's surface in that direction, in [kMinWallDistance, 1], 1 meaning "at the next face".
-  // The viscous operator reads it for tangential pairs (b != the face's axis) whose other end is
-  // a prescribed face (operators.h).
+  // The viscous operator reads it for pairs whose other end is a prescribed face (operators.h).
   std::vector<double> wallDistance;
   static constexpr double kMinWallDistance = 0.1;  // bounds the wall term's weight by 1/0.1
 

@@ -151,10 +151,11 @@ void buildViscousRows(FluidOperators<d>& ops) {
         if (e0.kind == PairEnd::Drop || e1.kind == PairEnd::Drop) continue;
         if (e0.kind != PairEnd::Unknown && e1.kind != PairEnd::Unknown) continue;
         double c = (e0.ghost || e1.ghost) ? std::sqrt(2.0) * w : w;
-        if (b != a && !domain.wallDistance.empty()) {
-          // A tangential pair ending on an obstacle face: the wall sits theta cells from the free
-          // face instead of one, so the row is w (U - u_f) / sqrt(theta) (theta = 1/2 is the
-          // mirrored ghost above); G_mu^T G_mu keeps its symmetric form.
+        if (!domain.wallDistance.empty()) {
+          // A pair ending on an obstacle face: the wall sits theta cells from the free face
+          // instead of one, so the row is w (U - u_f) / sqrt(theta) (theta = 1/2 is the mirrored
+          // ghost above); G_mu^T G_mu keeps its symmetric form. (Pairs ending on a domain wall's
+          // normal face have theta = 1: the wall is at that face.)
           const auto theta = [&](const PairEnd& unknown, int towardsUpper) {
             return domain.wallDistance[static_cast<std::size_t>(ops.dofs.velocityToFace[unknown.velocity]) * 2 * d + 2 * b +
                                        towardsUpper];

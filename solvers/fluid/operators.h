@@ -25,8 +25,8 @@
 // values are known; beyond an outflow face the normal velocity has zero normal derivative).
 // Pairs with a prescribed face inside the box (obstacle, wall normal face) are Dirichlet at the
 // face itself (first order at obstacles, as Sec. 5.7 says of its constraint locations), unless the
-// domain carries wallDistance: then a tangential pair ending on an obstacle face puts the wall at
-// the obstacle's true surface, theta cells away (row weight w / sqrt(theta); theta = 1/2 is the
+// domain carries wallDistance: then a pair ending on an obstacle face puts the wall at the
+// obstacle's true surface, theta cells away along the pair (row weight w / sqrt(theta); theta = 1/2 is the
 // mirrored domain-wall ghost above). This is Gibou et al.'s symmetric Dirichlet treatment (J.
 // Comput. Phys. 176, 2002): second order for the wall shear instead of the staircase's first.
 #include "solvers/fluid/boundary.h"
