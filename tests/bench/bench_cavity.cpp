@@ -49,17 +49,7 @@ int main(int argc, char** argv) {
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const MacGrid<2>& grid = sim.world().pool<MacGrid<2>>().components()[0];
-  double worstU = 0, worstV = 0, worstUAt = 0, worstVAt = 0;
-  for (const auto& p : test::kGhiaU) {
-    const double ref = re == 100 ? p.re100 : p.re1000;
-    const double error = std::abs(sampleVelocity(grid, Eigen::Vector2d(0.5, p.coordinate)).x() - ref);
-    if (error > worstU) worstU = error, worstUAt = p.coordinate;
-  }
-  for (const auto& p : test::kGhiaV) {
-    const double ref = re == 100 ? p.re100 : p.re1000;
-    const double error = std::abs(sampleVelocity(grid, Eigen::Vector2d(p.coordinate, 0.5)).y() - ref);
-    if (error > worstV) worstV = error, worstVAt = p.coordinate;
-  }
+  const auto [worstU, worstV, worstUAt, worstVAt] = test::ghiaDeviation(grid, re);
   std::printf("largest deviations: u at y = %.4f, v at x = %.4f\n", worstUAt, worstVAt);
   std::printf("| Re | cells | projection | threads | steady | t | steps | CG iterations/step | wall s | ms/step | max abs(u - Ghia) | max abs(v - Ghia) |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");

@@ -3,6 +3,10 @@
 // ../shared/REFERENCES.md): u on the vertical centre line x = 0.5, v on the horizontal centre
 // line y = 0.5, for Re = 100 and Re = 1000.
 #include <array>
+#include <cmath>
+
+#include "components/mac_grid.h"
+#include "scenarios/fluid_fields.h"
 
 namespace monolith::test {
 
@@ -27,5 +31,24 @@ inline constexpr std::array<GhiaPoint, 17> kGhiaV = {{
     {0.0938, 0.12317, 0.32627},   {0.0781, 0.10890, 0.30353},   {0.0703, 0.10091, 0.29012},
     {0.0625, 0.09233, 0.27485},   {0.0000, 0.00000, 0.00000},
 }};
+
+// Largest deviation of a unit-square cavity's centre-line velocities from the table, and where.
+struct GhiaDeviation {
+  double u = 0, v = 0;        // max |u - Ghia| on x = 0.5, max |v - Ghia| on y = 0.5
+  double uAt = 0, vAt = 0;    // the y (resp. x) coordinate of that point
+};
+
+inline GhiaDeviation ghiaDeviation(const MacGrid<2>& grid, int re) {
+  GhiaDeviation worst;
+  for (const auto& p : kGhiaU) {
+    const double error = std::abs(sampleVelocity(grid, Eigen::Vector2d(0.5, p.coordinate)).x() - (re == 100 ? p.re100 : p.re1000));
+    if (error > worst.u) worst.u = error, worst.uAt = p.coordinate;
+  }
+  for (const auto& p : kGhiaV) {
+    const double error = std::abs(sampleVelocity(grid, Eigen::Vector2d(p.coordinate, 0.5)).y() - (re == 100 ? p.re100 : p.re1000));
+    if (error > worst.v) worst.v = error, worst.vAt = p.coordinate;
+  }
+  return worst;
+}
 
 }  // namespace monolith::test
