@@ -56,11 +56,12 @@ TEST(CylinderLaminar, CoupledSolveAndChorinConvergeToEachOther) {
 TEST(DfgPeriodic, VorticesShedAtNearlyTheReferenceFrequencyAt10CellsPerDiameter) {
   // Schaefer & Turek 2D-2 (Re 100) on the coarsest grid of the benchmark, 220 x 41 (D = 10
   // cells), to t = 6 s; the lift is analysed over t >= 3 s (the shedding is periodic from about
-  // t = 2 s). Reference St = 0.300, c_D,max = 3.23, c_L,max = 1.00. Measured at this resolution
-  // with ENO3 advection: St = 0.257 (-14 %; the same over 3-12 s), c_D,max = 3.72 (+15 %),
-  // c_L,max = 0.39: the first-order staircase and 10 cells per diameter damp the shedding, which
-  // converges with refinement (docs/benchmarks.md). The bounds fail if the shedding stops or
-  // weakens (semi-Lagrangian advection: c_L,max = 0.10) or its frequency moves by > 20 %.
+  // t = 2 s). Reference St = 0.300, c_D,max = 3.23, c_L,max = 1.00. Measured over t = 6-12 s at
+  // this resolution with the scene's MacCormack advection: St = 0.279 (-7 %), c_D,max = 3.20
+  // (-1 %), c_L,max = 0.43 (ENO3: St -14 %, c_D,max +14 %, c_L,max 0.42): the first-order
+  // staircase and 10 cells per diameter damp the lift, which converges with refinement
+  // (docs/benchmarks.md). The bounds fail if the shedding stops or weakens (plain
+  // semi-Lagrangian advection: c_L,max = 0.10) or its frequency moves by > 20 %.
   const Registry registry = builtins();
   Simulation<2> sim(loadScene(kScenes + "dfg_2d2.json", {{"time.end", "6.0"}}), registry, 2);
   std::vector<double> t, cD, cL;
