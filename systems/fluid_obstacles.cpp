@@ -62,6 +62,32 @@ bool neighbour(const solvers::MacLayout<d>& layout, typename solvers::MacLayout<
   return true;
 }
 
+// Calls visit(g, a, f, b, dir) for every free face g = (a, f) (both cells inside the domain and
+// not solid) and direction dir e_b whose next face that way touches a cell with marked[c] != 0:
+// across the face's axis either cell of that face, along it the cell beyond (c1 + e_a or
+// c0 - e_a). These are the viscous pairs that end on an obstacle face (operators.h).
+template <int d, class Visit>
+void forEachPairIntoMarkedCells(const solvers::MacLayout<d>& layout, const std::vector<std::uint8_t>& solid,
+                                const std::vector<std::uint8_t>& marked, Visit&& visit) {
+  using Index = typename solvers::MacLayout<d>::Index;
+  const auto isMarked = [&](const Index& c) { return marked[layout.cellIndex(c)] != 0; };
+  for (int g = 0; g < layout.totalFaces(); ++g) {
+    const auto [a, f] = layout.faceCoord(g);
+    Index c0, c1 = f;
+    if (!layout.cellInside(c1) || !neighbour(layout, c1, a, -1, c0)) continue;  // a domain boundary face
+    if (solid[layout.cellIndex(c0)] || solid[layout.cellIndex(c1)]) continue;   // not a free face
+    for (int b = 0; b < d; ++b)
+      for (int dir = -1; dir <= 1; dir += 2) {
+        Index n0, n1;
+        const bool hit = b == a ? (dir > 0 ? neighbour(layout, c1, a, 1, n1) && isMarked(n1)
+                                           : neighbour(layout, c0, a, -1, n0) && isMarked(n0))
+                                : (neighbour(layout, c0, b, dir, n0) && isMarked(n0)) ||
+                                      (neighbour(layout, c1, b, dir, n1) && isMarked(n1));
+        if (hit) visit(g, a, f, b, dir);
+      }
+  }
+}
+
 // Every entity with a fluid_obstacle, shape and rigid_body, in pool order.
 template <int d, class F>
 void forEachObstacle(const World<d>& world, F&& f) {
@@ -95,32 +121,15 @@ std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d
   forEachObstacle(world, [&](Entity, const Shape<d>& shape, const RigidBody<d>& body) { obstacles.emplace_back(&shape, &body); });
   std::vector<double> distance(static_cast<std::size_t>(layout.totalFaces()) * 2 * d, 1.0);
   if (grid.solid.empty()) return distance;
-  const auto solidCell = [&](const Index& c) { return grid.solid[layout.cellIndex(c)] != 0; };
-  for (int g = 0; g < layout.totalFaces(); ++g) {
-    const auto [a, f] = layout.faceCoord(g);
-    Index c0, c1 = f;
-    if (!layout.cellInside(c1) || !neighbour(layout, c1, a, -1, c0)) continue;  // a domain boundary face
-    if (solidCell(c0) || solidCell(c1)) continue;                              // not a free face
-    for (int b = 0; b < d; ++b) {
-      for (int dir = -1; dir <= 1; dir += 2) {
-        // The next face along dir e_b is an obstacle face if one of its cells is solid (along the
-        // face's own axis: the cell beyond c1, or before c0).
-        Index n0, n1;
-        const bool obstacleFace = b == a ? (dir > 0 ? neighbour(layout, c1, a, 1, n1) && solidCell(n1)
-                                                    : neighbour(layout, c0, a, -1, n0) && solidCell(n0))
-                                         : (neighbour(layout, c0, b, dir, n0) && solidCell(n0)) ||
-                                               (neighbour(layout, c1, b, dir, n1) && solidCell(n1));
-        if (!obstacleFace) continue;
-        Eigen::Matrix<double, d, 1> e = Eigen::Matrix<double, d, 1>::Zero();
-        e[b] = dir;
-        const auto x = layout.faceCenter(a, f);
-        double t = std::numeric_limits<double>::infinity();
-        for (const auto& [shape, body] : obstacles) t = std::min(t, rayEntry(*shape, *body, x, e, layout.dx));
-        distance[static_cast<std::size_t>(g) * 2 * d + 2 * b + (dir > 0)] =
-            std::clamp(t / layout.dx, solvers::FluidDomain<d>::kMinWallDistance, 1.0);
-      }
-    }
-  }
+  forEachPairIntoMarkedCells(layout, grid.solid, grid.solid, [&](int g, int a, const Index& f, int b, int dir) {
+    Eigen::Matrix<double, d, 1> e = Eigen::Matrix<double, d, 1>::Zero();
+    e[b] = dir;
+    const auto x = layout.faceCenter(a, f);
+    double t = std::numeric_limits<double>::infinity();
+    for (const auto& [shape, body] : obstacles) t = std::min(t, rayEntry(*shape, *body, x, e, layout.dx));
+    distance[static_cast<std::size_t>(g) * 2 * d + 2 * b + (dir > 0)] =
+        std::clamp(t / layout.dx, solvers::FluidDomain<d>::kMinWallDistance, 1.0);
+  });
   return distance;
 }
 
@@ -164,30 +173,14 @@ Eigen::Matrix<double, d, 1> obstacleForce(const World<d>& world, Entity obstacle
   // staircase the normal rows do not vanish as du_n/dn = 0 would make them on a smooth wall).
   if (viscosity > 0) {
     const std::vector<double>& wallDistance = grid.obstacleWallDistance;
-    for (int g = 0; g < layout.totalFaces(); ++g) {
-      const auto [a, fi] = layout.faceCoord(g);
-      Index c0, c1 = fi;
-      if (!layout.cellInside(c1) || !neighbour(layout, c1, a, -1, c0)) continue;  // a domain boundary face
-      if (grid.solid[layout.cellIndex(c0)] || grid.solid[layout.cellIndex(c1)]) continue;
-      for (int b = 0; b < d; ++b) {
-        for (int dir = -1; dir <= 1; dir += 2) {
-          // Is the next face along dir e_b one of this obstacle's faces? Along the face's own axis
-          // that is the far face of c1 (or c0), whose cell beyond must be ours.
-          Index n0, n1;
-          const bool ours = b == a ? (dir > 0 ? neighbour(layout, c1, a, 1, n1) && mine[layout.cellIndex(n1)]
-                                              : neighbour(layout, c0, a, -1, n0) && mine[layout.cellIndex(n0)])
-                                   : (neighbour(layout, c0, b, dir, n0) && mine[layout.cellIndex(n0)]) ||
-                                         (neighbour(layout, c1, b, dir, n1) && mine[layout.cellIndex(n1)]);
-          if (!ours) continue;
-          const double theta = wallDistance.empty() ? 1.0 : wallDistance[static_cast<std::size_t>(g) * 2 * d + 2 * b + (dir > 0)];
-          // The operator's known value: the obstacle face's prescribed velocity (its centre, one cell away).
-          Eigen::Matrix<double, d, 1> wallPoint = layout.faceCenter(a, fi);
-          wallPoint[b] += dir * layout.dx;
-          const double wall = grid.obstacleVelocityAt(wallPoint)[a];
-          force[a] += viscosity * (grid.u[g] - wall) / (theta * layout.dx) * area;
-        }
-      }
-    }
+    forEachPairIntoMarkedCells(layout, grid.solid, mine, [&](int g, int a, const Index& fi, int b, int dir) {
+      const double theta = wallDistance.empty() ? 1.0 : wallDistance[static_cast<std::size_t>(g) * 2 * d + 2 * b + (dir > 0)];
+      // The operator's known value: the obstacle face's prescribed velocity (its centre, one cell away).
+      Eigen::Matrix<double, d, 1> wallPoint = layout.faceCenter(a, fi);
+      wallPoint[b] += dir * layout.dx;
+      const double wall = grid.obstacleVelocityAt(wallPoint)[a];
+      force[a] += viscosity * (grid.u[g] - wall) / (theta * layout.dx) * area;
+    });
   }
   return force;
 }
