@@ -71,6 +71,9 @@ struct MacGrid {
   // Per face and direction, cells from the face centre to an obstacle surface (FluidDomain::
   // wallDistance); empty when the obstacles' walls sit at the face centres ("obstacle_wall": "face").
   std::vector<double> obstacleWallDistance;
+  // Per face, the part of its area outside every obstacle (FluidDomain::openFraction); empty for
+  // the staircase ("obstacle_cells": "staircase"), where `solid` alone describes the obstacles.
+  std::vector<double> openFraction;
 
   // Velocity of the obstacle nearest to x (the one whose bounding sphere x is deepest in); zero
   // without obstacles. Solid faces take its normal component (Sec. 5.4.1).

@@ -41,6 +41,10 @@ struct FluidSolverSettings {
   // 5.4.1, 5.7), up to a cell inside the body; true ("surface"): at the body's true surface,
   // found along each pair's direction (docs/architecture.md, measured in docs/benchmarks.md).
   bool obstacleWallAtSurface = false;
+  // How obstacles meet the pressure: false (scene "obstacle_cells": "staircase", default): cells
+  // with the centre inside are solid, their faces carry the body's velocity (Sec. 5.4.1); true
+  // ("cut"): faces cut by the body keep their open part as fluid (solvers::cutFaces).
+  bool cutCells = false;
 };
 
 // Collisions, contact and interpenetration resolution (issue 3; scene "solvers": {"contact":

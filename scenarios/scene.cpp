@@ -372,6 +372,7 @@ void parseFluidSolverSettings(const Config& c, FluidSolverSettings& f) {
                 : advection == "none"       ? S::Advection::None
                                             : S::Advection::SemiLagrangian;
   f.obstacleWallAtSurface = c.oneOf("obstacle_wall", {"face", "surface"}, "face") == "surface";
+  f.cutCells = c.oneOf("obstacle_cells", {"staircase", "cut"}, "staircase") == "cut";
   f.projection = c.oneOf("projection", {"coupled", "chorin"}, "coupled") == "chorin" ? S::Projection::Chorin : S::Projection::Coupled;
   const std::string pc = c.oneOf("preconditioner", {"none", "jacobi", "ic0", "mic0", "multigrid"}, "multigrid");
   f.preconditioner = pc == "none"     ? S::Preconditioner::None

@@ -50,10 +50,11 @@ solvers::FluidDomain<d> fluidDomainOf(const MacGrid<d>& grid) {
   solvers::FluidDomain<d> domain = solvers::boxDomain(layout, box);
   bool anySolid = false;
   for (auto s : grid.solid) anySolid = anySolid || s;
-  if (anySolid) {
+  if (anySolid || !grid.openFraction.empty()) {
     solvers::VelocityField<d> obstacleVelocity;
     if (grid.obstaclesMove()) obstacleVelocity = [&grid](const Vec& x) { return grid.obstacleVelocityAt(x); };
     solvers::markSolid(domain, grid.solid, obstacleVelocity);
+    if (!grid.openFraction.empty()) solvers::cutFaces(domain, grid.openFraction, obstacleVelocity);
     domain.wallDistance = grid.obstacleWallDistance;
   }
   return domain;

@@ -20,16 +20,16 @@ bool shapeContains(const Shape<d>& shape, const RigidBody<d>& body, const Eigen:
 
 namespace {
 
-// Distance t in [0, tMax] along x + t e (|e| = 1) at which the ray enters the shape: 0 if x is
-// inside, +inf if it misses within tMax.
+// The part [t0, t1] of the segment x + t e, t in [0, tMax] (|e| = 1), inside the shape; t0 > t1
+// when the segment misses it.
 template <int d>
-double rayEntry(const Shape<d>& shape, const RigidBody<d>& body, const Eigen::Matrix<double, d, 1>& x,
-                const Eigen::Matrix<double, d, 1>& e, double tMax) {
-  constexpr double kMiss = std::numeric_limits<double>::infinity();
+std::pair<double, double> segmentInside(const Shape<d>& shape, const RigidBody<d>& body, const Eigen::Matrix<double, d, 1>& x,
+                                        const Eigen::Matrix<double, d, 1>& e, double tMax) {
+  constexpr std::pair<double, double> kMiss{1, 0};
   const Eigen::Matrix<double, d, 1> p = body.rotation().transpose() * (x - body.x);
   const Eigen::Matrix<double, d, 1> q = body.rotation().transpose() * e;
+  double lo = 0, hi = tMax;
   if (shape.type == ShapeType::Box) {  // slabs
-    double lo = 0, hi = tMax;
     for (int i = 0; i < d; ++i) {
       const double h = shape.halfExtents[i];
       if (std::abs(q[i]) < 1e-15) {
@@ -41,14 +41,23 @@ double rayEntry(const Shape<d>& shape, const RigidBody<d>& body, const Eigen::Ma
       lo = std::max(lo, t0), hi = std::min(hi, t1);
       if (lo > hi) return kMiss;
     }
-    return lo;
+    return {lo, hi};
   }
   const double r = shape.radius, b = p.dot(q), c = p.squaredNorm() - r * r;
-  if (c <= 0) return 0;
   const double disc = b * b - c;
   if (disc < 0) return kMiss;
-  const double t = -b - std::sqrt(disc);
-  return t >= 0 && t <= tMax ? t : kMiss;
+  const double root = std::sqrt(disc);
+  lo = std::max(lo, -b - root), hi = std::min(hi, -b + root);
+  return lo <= hi ? std::make_pair(lo, hi) : kMiss;
+}
+
+// Distance t in [0, tMax] along x + t e (|e| = 1) at which the ray enters the shape: 0 if x is
+// inside, +inf if it misses within tMax.
+template <int d>
+double rayEntry(const Shape<d>& shape, const RigidBody<d>& body, const Eigen::Matrix<double, d, 1>& x,
+                const Eigen::Matrix<double, d, 1>& e, double tMax) {
+  const auto [t0, t1] = segmentInside(shape, body, x, e, tMax);
+  return t0 <= t1 ? t0 : std::numeric_limits<double>::infinity();
 }
 
 // The cell next to c along `axis` in direction dir (+-1); false outside a non-periodic domain.
@@ -62,30 +71,110 @@ bool neighbour(const solvers::MacLayout<d>& layout, typename solvers::MacLayout<
   return true;
 }
 
-// Calls visit(g, a, f, b, dir) for every free face g = (a, f) (both cells inside the domain and
-// not solid) and direction dir e_b whose next face that way touches a cell with marked[c] != 0:
-// across the face's axis either cell of that face, along it the cell beyond (c1 + e_a or
-// c0 - e_a). These are the viscous pairs that end on an obstacle face (operators.h).
-template <int d, class Visit>
-void forEachPairIntoMarkedCells(const solvers::MacLayout<d>& layout, const std::vector<std::uint8_t>& solid,
-                                const std::vector<std::uint8_t>& marked, Visit&& visit) {
+// Calls visit(g, a, f, b, dir) for every interior face g = (a, f) with isFree(g) and direction
+// dir e_b whose next face of the same axis that way is marked (markedFace[face] != 0). These are
+// the viscous pairs that end on an obstacle face (operators.h).
+template <int d, class IsFree, class Visit>
+void forEachPairIntoMarkedFaces(const solvers::MacLayout<d>& layout, IsFree&& isFree,
+                                const std::vector<std::uint8_t>& markedFace, Visit&& visit) {
   using Index = typename solvers::MacLayout<d>::Index;
-  const auto isMarked = [&](const Index& c) { return marked[layout.cellIndex(c)] != 0; };
   for (int g = 0; g < layout.totalFaces(); ++g) {
     const auto [a, f] = layout.faceCoord(g);
-    Index c0, c1 = f;
-    if (!layout.cellInside(c1) || !neighbour(layout, c1, a, -1, c0)) continue;  // a domain boundary face
-    if (solid[layout.cellIndex(c0)] || solid[layout.cellIndex(c1)]) continue;   // not a free face
+    Index c0;
+    if (!layout.cellInside(f) || !neighbour(layout, f, a, -1, c0)) continue;  // a domain boundary face
+    if (!isFree(g)) continue;
+    const Index dims = layout.faceDims(a);
     for (int b = 0; b < d; ++b)
       for (int dir = -1; dir <= 1; dir += 2) {
-        Index n0, n1;
-        const bool hit = b == a ? (dir > 0 ? neighbour(layout, c1, a, 1, n1) && isMarked(n1)
-                                           : neighbour(layout, c0, a, -1, n0) && isMarked(n0))
-                                : (neighbour(layout, c0, b, dir, n0) && isMarked(n0)) ||
-                                      (neighbour(layout, c1, b, dir, n1) && isMarked(n1));
-        if (hit) visit(g, a, f, b, dir);
+        Index partner = f;
+        partner[b] += dir;
+        if (partner[b] < 0 || partner[b] >= dims[b]) {
+          if (!layout.periodic[b]) continue;
+          partner[b] = (partner[b] + layout.cells[b]) % layout.cells[b];
+        }
+        if (markedFace[layout.faceIndex(a, partner)]) visit(g, a, f, b, dir);
       }
   }
+}
+
+// Faces touching a cell with mask[c] != 0.
+template <int d>
+std::vector<std::uint8_t> facesOfMarkedCells(const solvers::MacLayout<d>& layout, const std::vector<std::uint8_t>& mask) {
+  std::vector<std::uint8_t> marked(layout.totalFaces(), 0);
+  for (int c = 0; c < layout.cellCount(); ++c) {
+    if (!mask[c]) continue;
+    const auto ci = layout.cellCoord(c);
+    for (int a = 0; a < d; ++a)
+      for (int side = 0; side < 2; ++side) {
+        auto f = ci;
+        f[a] += side;
+        marked[layout.faceIndex(a, f)] = 1;
+      }
+  }
+  return marked;
+}
+
+// A free face of the grid: both cells inside the domain and not solid, and (cut faces) some part
+// of it open.
+template <int d>
+bool gridFaceFree(const solvers::MacLayout<d>& layout, const MacGrid<d>& grid, int g) {
+  const auto [a, f] = layout.faceCoord(g);
+  typename solvers::MacLayout<d>::Index c0;
+  if (!layout.cellInside(f) || !neighbour(layout, f, a, -1, c0)) return false;
+  if (grid.solid[layout.cellIndex(c0)] || grid.solid[layout.cellIndex(f)]) return false;
+  return grid.openFraction.empty() || grid.openFraction[g] > 0;
+}
+
+template <int d>
+using ObstacleList = std::vector<std::pair<const Shape<d>*, const RigidBody<d>*>>;
+
+// Part of every face outside all the given obstacles (solvers::cutFaces). A face is measured along
+// exact segment-shape intersections: in 2-D the face is one segment; in 3-D the midpoint rule over
+// kCutLines segments. Fractions below kMinOpenFraction count as covered (a sliver of a face would
+// only slow the solves down), those within 1e-12 of 1 as open.
+constexpr int kCutLines = 8;
+constexpr double kMinOpenFraction = 0.01;
+
+template <int d>
+std::vector<double> openFractions(const solvers::MacLayout<d>& layout, const ObstacleList<d>& obstacles) {
+  using Vec = Eigen::Matrix<double, d, 1>;
+  std::vector<double> open(layout.totalFaces(), 1.0);
+  const double h = layout.dx;
+  std::vector<std::pair<double, double>> pieces;
+  for (int g = 0; g < layout.totalFaces(); ++g) {
+    const auto [a, f] = layout.faceCoord(g);
+    const Vec x = layout.faceCenter(a, f);
+    bool near = false;
+    for (const auto& [shape, body] : obstacles) {
+      const double reach = shape->type == ShapeType::Box ? shape->halfExtents.norm() : shape->radius;
+      near |= (x - body->x).norm() <= reach + h;
+    }
+    if (!near) continue;
+    const int t1 = (a + 1) % d, t2 = (a + 2) % d;  // t2 == a in 2-D: one line
+    const int lines = d == 2 ? 1 : kCutLines;
+    Vec e = Vec::Zero();
+    e[t1] = 1;
+    double covered = 0;
+    for (int k = 0; k < lines; ++k) {
+      Vec start = x;
+      start[t1] -= 0.5 * h;
+      if (d == 3) start[t2] += ((k + 0.5) / lines - 0.5) * h;
+      pieces.clear();
+      for (const auto& [shape, body] : obstacles) {
+        const auto piece = segmentInside(*shape, *body, start, e, h);
+        if (piece.first <= piece.second) pieces.push_back(piece);
+      }
+      std::sort(pieces.begin(), pieces.end());
+      double end = 0;  // union of the pieces along the line
+      for (const auto& [lo, hi] : pieces) {
+        covered += std::max(0.0, hi - std::max(lo, end));
+        end = std::max(end, hi);
+      }
+    }
+    const double theta = 1.0 - covered / (lines * h);
+    open[g] = theta < kMinOpenFraction ? 0.0 : theta > 1 - 1e-12 ? 1.0 : theta;
+  }
+  return open;
 }
 
 // Every entity with a fluid_obstacle, shape and rigid_body, in pool order.
@@ -114,14 +203,47 @@ std::vector<std::uint8_t> obstacleMask(const World<d>& world, const MacGrid<d>& 
 }
 
 template <int d>
+std::vector<double> obstacleOpenFractions(const World<d>& world, const MacGrid<d>& grid) {
+  ObstacleList<d> obstacles;
+  forEachObstacle(world, [&](Entity, const Shape<d>& shape, const RigidBody<d>& body) { obstacles.emplace_back(&shape, &body); });
+  return openFractions(macLayoutOf(grid), obstacles);
+}
+
+template <int d>
+std::vector<std::uint8_t> coveredCells(const solvers::MacLayout<d>& layout, const std::vector<double>& openFraction) {
+  std::vector<std::uint8_t> mask(layout.cellCount(), 0);
+  for (int c = 0; c < layout.cellCount(); ++c) {
+    const auto ci = layout.cellCoord(c);
+    bool covered = true;
+    for (int a = 0; a < d && covered; ++a)
+      for (int side = 0; side < 2; ++side) {
+        auto f = ci;
+        f[a] += side;
+        covered = covered && openFraction[layout.faceIndex(a, f)] == 0;
+      }
+    mask[c] = covered;
+  }
+  return mask;
+}
+
+// The obstacle faces the viscous rows end on: faces of solid cells, and cut faces covered whole.
+template <int d>
+std::vector<std::uint8_t> obstacleFaces(const solvers::MacLayout<d>& layout, const MacGrid<d>& grid) {
+  std::vector<std::uint8_t> marked = facesOfMarkedCells(layout, grid.solid);
+  for (std::size_t g = 0; g < grid.openFraction.size(); ++g) marked[g] |= grid.openFraction[g] == 0;
+  return marked;
+}
+
+template <int d>
 std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d>& grid) {
   using Index = typename solvers::MacLayout<d>::Index;
   const solvers::MacLayout<d> layout = macLayoutOf(grid);
-  std::vector<std::pair<const Shape<d>*, const RigidBody<d>*>> obstacles;
+  ObstacleList<d> obstacles;
   forEachObstacle(world, [&](Entity, const Shape<d>& shape, const RigidBody<d>& body) { obstacles.emplace_back(&shape, &body); });
   std::vector<double> distance(static_cast<std::size_t>(layout.totalFaces()) * 2 * d, 1.0);
   if (grid.solid.empty()) return distance;
-  forEachPairIntoMarkedCells(layout, grid.solid, grid.solid, [&](int g, int a, const Index& f, int b, int dir) {
+  const auto isFree = [&](int g) { return gridFaceFree(layout, grid, g); };
+  forEachPairIntoMarkedFaces(layout, isFree, obstacleFaces(layout, grid), [&](int g, int a, const Index& f, int b, int dir) {
     Eigen::Matrix<double, d, 1> e = Eigen::Matrix<double, d, 1>::Zero();
     e[b] = dir;
     const auto x = layout.faceCenter(a, f);
@@ -144,23 +266,37 @@ Eigen::Matrix<double, d, 1> obstacleForce(const World<d>& world, Entity obstacle
   if (!shape || !body || grid.solid.empty()) return force;
   const solvers::MacLayout<d> layout = macLayoutOf(grid);
   const int n = layout.cellCount();
-  // Cells of this obstacle: solid and with the centre inside its shape.
-  std::vector<std::uint8_t> mine(n, 0);
-  for (int c = 0; c < n; ++c)
-    mine[c] = grid.solid[c] && shapeContains(*shape, *body, layout.cellCenter(layout.cellCoord(c)));
+  // Part of each face covered by this obstacle: staircase, every face of its solid cells (those
+  // with the centre inside its shape); cut faces, the covered part of the face.
+  std::vector<double> covered;
+  std::vector<std::uint8_t> mine;  // faces this obstacle covers whole: the viscous rows' walls
+  if (grid.openFraction.empty()) {
+    std::vector<std::uint8_t> cells(n, 0);
+    for (int c = 0; c < n; ++c)
+      cells[c] = grid.solid[c] && shapeContains(*shape, *body, layout.cellCenter(layout.cellCoord(c)));
+    mine = facesOfMarkedCells(layout, cells);
+    covered.assign(mine.begin(), mine.end());
+  } else {
+    covered = openFractions(layout, ObstacleList<d>{{shape, body}});
+    mine.resize(covered.size());
+    for (std::size_t g = 0; g < covered.size(); ++g) {
+      covered[g] = 1.0 - covered[g];
+      mine[g] = covered[g] == 1;
+    }
+  }
   const double area = layout.faceArea();
 
-  // Pressure: p of the fluid cell times the face area, along the normal from fluid into solid.
-  for (int s = 0; s < n; ++s) {
-    if (!mine[s]) continue;
-    const Index cs = layout.cellCoord(s);
+  // Pressure: p of each fluid cell on the covered part of its faces, along the normal from the
+  // fluid into the obstacle: the discrete momentum exchange of the constraint's obstacle terms.
+  for (int c = 0; c < n; ++c) {
+    if (grid.solid[c] || grid.p[c] == 0) continue;
+    const Index ci = layout.cellCoord(c);
     for (int a = 0; a < d; ++a)
-      for (int dir = -1; dir <= 1; dir += 2) {
-        Index cn;
-        if (!neighbour(layout, cs, a, dir, cn)) continue;
-        const int f = layout.cellIndex(cn);
-        if (grid.solid[f]) continue;
-        force[a] -= dir * grid.p[f] * area;
+      for (int side = 0; side < 2; ++side) {
+        Index fi = ci;
+        fi[a] += side;
+        const double part = covered[layout.faceIndex(a, fi)];
+        if (part > 0) force[a] += (side == 1 ? 1.0 : -1.0) * grid.p[c] * part * area;
       }
   }
 
@@ -173,7 +309,8 @@ Eigen::Matrix<double, d, 1> obstacleForce(const World<d>& world, Entity obstacle
   // staircase the normal rows do not vanish as du_n/dn = 0 would make them on a smooth wall).
   if (viscosity > 0) {
     const std::vector<double>& wallDistance = grid.obstacleWallDistance;
-    forEachPairIntoMarkedCells(layout, grid.solid, mine, [&](int g, int a, const Index& fi, int b, int dir) {
+    const auto isFree = [&](int g) { return gridFaceFree(layout, grid, g); };
+    forEachPairIntoMarkedFaces(layout, isFree, mine, [&](int g, int a, const Index& fi, int b, int dir) {
       const double theta = wallDistance.empty() ? 1.0 : wallDistance[static_cast<std::size_t>(g) * 2 * d + 2 * b + (dir > 0)];
       // The operator's known value: the obstacle face's prescribed velocity (its centre, one cell away).
       Eigen::Matrix<double, d, 1> wallPoint = layout.faceCenter(a, fi);
@@ -220,7 +357,16 @@ void RasterizeObstacles<d>::run(World<d>& world, StepContext&) {
   const std::vector<ObstacleMotion<d>> motions = obstacleMotions(world);
   for (MacGrid<d>& grid : pool.components()) {
     grid.obstacleMotions = motions;
-    std::vector<std::uint8_t> mask = obstacleMask(world, grid);
+    const solvers::MacLayout<d> layout = macLayoutOf(grid);
+    std::vector<std::uint8_t> mask;
+    if (world.settings().fluid.cutCells) {
+      std::vector<double> open = obstacleOpenFractions(world, grid);
+      mask = coveredCells(layout, open);
+      if (open != grid.openFraction) grid.openFraction = std::move(open);
+    } else {
+      mask = obstacleMask(world, grid);
+      grid.openFraction.clear();
+    }
     if (mask != grid.solid) grid.solid = std::move(mask);  // unchanged: keep the projection's cache
     if (world.settings().fluid.obstacleWallAtSurface) grid.obstacleWallDistance = obstacleWallDistances(world, grid);
     else grid.obstacleWallDistance.clear();
@@ -257,6 +403,8 @@ template bool shapeContains<2>(const Shape<2>&, const RigidBody<2>&, const Eigen
 template bool shapeContains<3>(const Shape<3>&, const RigidBody<3>&, const Eigen::Vector3d&);
 template std::vector<std::uint8_t> obstacleMask<2>(const World<2>&, const MacGrid<2>&);
 template std::vector<std::uint8_t> obstacleMask<3>(const World<3>&, const MacGrid<3>&);
+template std::vector<double> obstacleOpenFractions<2>(const World<2>&, const MacGrid<2>&);
+template std::vector<double> obstacleOpenFractions<3>(const World<3>&, const MacGrid<3>&);
 template std::vector<double> obstacleWallDistances<2>(const World<2>&, const MacGrid<2>&);
 template std::vector<double> obstacleWallDistances<3>(const World<3>&, const MacGrid<3>&);
 template Eigen::Vector2d obstacleForce<2>(const World<2>&, Entity, const MacGrid<2>&, double);

@@ -10,8 +10,11 @@
 //    (grid.obstacleWallDistance), so the viscous operator puts the no-slip wall where the body is
 //    rather than at the obstacle face's centre (operators.h); the normal constraints stay at the
 //    face centres as in the thesis.
+//    With "obstacle_cells": "cut" it instead measures the open part of every face near an obstacle
+//    (grid.openFraction, solvers::cutFaces) and marks solid only the cells whose faces are all
+//    covered: the pressure then sees the body's true surface (second order, Ng, Min & Gibou 2009).
 //  - obstacle_forces: the fluid's force on each obstacle: the pressure of the fluid cell on every
-//    fluid-solid face, plus the viscous stress exactly as the viscous operator applies it,
+//    fluid-solid face (on the covered part of every cut face), plus the viscous stress exactly as the viscous operator applies it,
 //    mu (u - u_wall) / (theta dx) for every free face and axis whose neighbour face that way is
 //    an obstacle face (the body's share of the discrete momentum balance); diagnostics obstacle_<name>_force_x, _y (, _z).
 #include "components/mac_grid.h"
@@ -28,6 +31,11 @@ bool shapeContains(const Shape<d>& shape, const RigidBody<d>& body, const Eigen:
 // The obstacle mask of the grid: 1 for cells whose centre is inside some obstacle.
 template <int d>
 std::vector<std::uint8_t> obstacleMask(const World<d>& world, const MacGrid<d>& grid);
+
+// Per face, the part of its area outside every obstacle ("obstacle_cells": "cut"; below 1 % counts
+// as covered).
+template <int d>
+std::vector<double> obstacleOpenFractions(const World<d>& world, const MacGrid<d>& grid);
 
 // Per face and direction 2b + (dir > 0), the distance in cells from each free face's centre to
 // the nearest obstacle surface along dir e_b when the next face that way is an obstacle face

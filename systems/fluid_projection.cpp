@@ -13,6 +13,7 @@ struct FluidProjection<d>::Cache {
   std::vector<std::uint8_t> solid;  // geometry the operators were built for
   std::vector<ObstacleMotion<d>> motions;  // moving obstacles' velocities sit in the operators' RHS terms
   std::vector<double> wallDistance;        // obstacle surfaces seen by the viscous rows
+  std::vector<double> openFraction;        // cut faces
   double dt = -1, density = 0, viscosity = -1;
   solvers::PoissonPreconditionerKind kind = solvers::PoissonPreconditionerKind::None;
   std::unique_ptr<solvers::FluidOperators<d>> ops;
@@ -53,7 +54,7 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
     Cache& c = *cache_;
     const auto kind = preconditionerKind(settings.preconditioner);
     if (!c.ops || c.dt != ctx.dt || c.density != rho || c.viscosity != mu || c.solid != grid.solid || c.kind != kind ||
-        c.wallDistance != grid.obstacleWallDistance ||
+        c.wallDistance != grid.obstacleWallDistance || c.openFraction != grid.openFraction ||
         ((grid.obstaclesMove() || !c.motions.empty()) && c.motions != grid.obstacleMotions)) {
       c.ops = std::make_unique<solvers::FluidOperators<d>>(
           solvers::buildFluidOperators(fluidDomainOf(grid), solvers::FluidParameters{rho, mu, ctx.dt}));
@@ -63,6 +64,7 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
       c.viscosity = mu;
       c.solid = grid.solid;
       c.wallDistance = grid.obstacleWallDistance;
+      c.openFraction = grid.openFraction;
       c.motions = grid.obstaclesMove() ? grid.obstacleMotions : std::vector<ObstacleMotion<d>>{};
       c.kind = kind;
     }
@@ -83,10 +85,8 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
 
     // Diagnostics of t^{n+1}.
     const auto& layout = c.ops->domain.layout;
-    const Eigen::VectorXd divergence = solvers::volumeDivergence(layout, u);
-    double maxDivergence = 0;
-    for (int p = 0; p < c.ops->pressureCount(); ++p)
-      maxDivergence = std::max(maxDivergence, std::abs(divergence[c.ops->dofs.pressureToCell[p]]));
+    const Eigen::VectorXd divergence = solvers::constraintDivergence(*c.ops, u);  // cut faces weighted
+    const double maxDivergence = divergence.size() > 0 ? divergence.cwiseAbs().maxCoeff() : 0.0;
     double kinetic = 0, change = 0;
     Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
     const double faceMass = rho * layout.cellVolume();  // a face carries the mass of one cell

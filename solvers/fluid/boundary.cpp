@@ -140,6 +140,30 @@ void markSolid(FluidDomain<d>& domain, const std::vector<uint8_t>& solidMask, co
 }
 
 template <int d>
+void cutFaces(FluidDomain<d>& domain, const std::vector<double>& openFraction, const VelocityField<d>& obstacleVelocity) {
+  const auto& layout = domain.layout;
+  if (static_cast<int>(openFraction.size()) != layout.totalFaces())
+    throw std::invalid_argument("cutFaces: expected one open fraction per face");
+  for (double theta : openFraction)
+    if (!(theta >= 0 && theta <= 1)) throw std::invalid_argument("cutFaces: open fractions must lie in [0, 1]");
+  domain.openFraction.assign(layout.totalFaces(), 1.0);
+  for (int face = 0; face < layout.totalFaces(); ++face) {
+    if (domain.faces[face] != FaceKind::Free || openFraction[face] == 1) continue;
+    const auto [axis, f] = layout.faceCoord(face);
+    domain.faceVelocity[face] = obstacleVelocity ? obstacleVelocity(layout.faceCenter(axis, f))[axis] : 0.0;
+    if (openFraction[face] == 0) domain.faces[face] = FaceKind::Prescribed;
+    else domain.openFraction[face] = openFraction[face];
+  }
+  // A fluid cell whose faces are all covered holds no fluid a pressure could act on.
+  for (int c = 0; c < layout.cellCount(); ++c) {
+    if (domain.cells[c] != CellKind::Fluid) continue;
+    bool anyFree = false;
+    forFacesOfCell<d>(layout, c, [&](int, int face) { anyFree |= domain.faces[face] == FaceKind::Free; });
+    if (!anyFree) domain.cells[c] = CellKind::Solid;
+  }
+}
+
+template <int d>
 void markDirichlet(FluidDomain<d>& domain, const std::vector<uint8_t>& mask) {
   const auto& layout = domain.layout;
   if (static_cast<int>(mask.size()) != layout.cellCount())
@@ -167,6 +191,8 @@ template FluidDomain<2> boxDomain<2>(const MacLayout<2>&, const BoxSpec<2>&);
 template FluidDomain<3> boxDomain<3>(const MacLayout<3>&, const BoxSpec<3>&);
 template void markSolid<2>(FluidDomain<2>&, const std::vector<uint8_t>&, const VelocityField<2>&);
 template void markSolid<3>(FluidDomain<3>&, const std::vector<uint8_t>&, const VelocityField<3>&);
+template void cutFaces<2>(FluidDomain<2>&, const std::vector<double>&, const VelocityField<2>&);
+template void cutFaces<3>(FluidDomain<3>&, const std::vector<double>&, const VelocityField<3>&);
 template void markDirichlet<2>(FluidDomain<2>&, const std::vector<uint8_t>&);
 template void markDirichlet<3>(FluidDomain<3>&, const std::vector<uint8_t>&);
 

@@ -80,6 +80,11 @@ struct FluidDomain {
   // The viscous operator reads it for pairs whose other end is a prescribed face (operators.h).
   std::vector<double> wallDistance;
   static constexpr double kMinWallDistance = 0.1;  // bounds the wall term's weight by 1/0.1
+  // Optional cut faces (see cutFaces); empty: every face is wholly open or wholly covered (the
+  // staircase). Else openFraction[face] in (0, 1] for Free faces: the part of the face's area
+  // outside every obstacle. The rest of such a face moves with the obstacle: faceVelocity holds
+  // that normal velocity.
+  std::vector<double> openFraction;
 
   // Classification of a face from its two cells and the sides (outside a Wall/Inflow side counts
   // as solid, outside an Outflow side as Dirichlet): solid on either side -> Prescribed, else a
@@ -102,6 +107,18 @@ FluidDomain<d> boxDomain(const MacLayout<d>& layout, const BoxSpec<d>& sides);
 template <int d>
 void markSolid(FluidDomain<d>& domain, const std::vector<uint8_t>& solidMask,
                const VelocityField<d>& obstacleVelocity = {});
+
+// Cut faces (Ng, Min & Gibou, J. Comput. Phys. 228, 2009; the thesis's code does the same for
+// faces cut by its front, notes 5.2 "in-fluid length fraction"): openFraction[face] in [0, 1] is the
+// part of each face outside the obstacles. A Free face with fraction 0 becomes Prescribed with the
+// obstacle's normal velocity at its centre; one with fraction in (0, 1) stays Free, and its covered
+// part carries the obstacle's normal velocity (faceVelocity) into the divergence. A Fluid cell left
+// without any Free face becomes Solid. The operators then weight each free face's area and mass by
+// its fraction (operators.h). Throws std::invalid_argument on a size mismatch or a fraction outside
+// [0, 1].
+template <int d>
+void cutFaces(FluidDomain<d>& domain, const std::vector<double>& openFraction,
+              const VelocityField<d>& obstacleVelocity = {});
 
 // Marks cells with mask[c] != 0 as Dirichlet (p = 0) and reclassifies the faces around them.
 template <int d>

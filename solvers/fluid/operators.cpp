@@ -197,7 +197,8 @@ FluidOperators<d> buildFluidOperators(const FluidDomain<d>& domain, const FluidP
   if (static_cast<int>(domain.cells.size()) != layout.cellCount() ||
       static_cast<int>(domain.faces.size()) != layout.totalFaces() ||
       static_cast<int>(domain.faceVelocity.size()) != layout.totalFaces() ||
-      !(domain.wallDistance.empty() || domain.wallDistance.size() == static_cast<std::size_t>(layout.totalFaces()) * 2 * d))
+      !(domain.wallDistance.empty() || domain.wallDistance.size() == static_cast<std::size_t>(layout.totalFaces()) * 2 * d) ||
+      !(domain.openFraction.empty() || static_cast<int>(domain.openFraction.size()) == layout.totalFaces()))
     throw std::invalid_argument("buildFluidOperators: domain arrays do not match its layout");
   FluidOperators<d> ops;
   ops.domain = domain;
@@ -208,17 +209,26 @@ FluidOperators<d> buildFluidOperators(const FluidDomain<d>& domain, const FluidP
   ops.betaInv = 1.0 / (params.density * ops.volume);
   ops.viscousWeight = std::sqrt(params.dt * params.viscosity / ops.volume) * ops.area;
   const int np = ops.pressureCount(), nu = ops.velocityCount();
+  ops.openFraction.setOnes(nu);
+  if (!domain.openFraction.empty())
+    for (int v = 0; v < nu; ++v) {
+      const double theta = domain.openFraction[ops.dofs.velocityToFace[v]];
+      if (!(theta > 0 && theta <= 1)) throw std::invalid_argument("buildFluidOperators: a free face's open fraction must lie in (0, 1]");
+      ops.openFraction[v] = theta;
+      ops.cut |= theta != 1;
+    }
 
   // G: per free face the unknown cells on either side (Dirichlet / ghost: p = 0, no entry).
   ops.gradientCells.resize(nu);
   std::vector<Eigen::Triplet<double>> triplets;
   for (int v = 0; v < nu; ++v) {
     const int face = ops.dofs.velocityToFace[v];
+    const double area = ops.area * ops.openFraction[v];
     for (int which = 0; which < 2; ++which) {
       int cell = -1;
       const int p = domain.faceCell(face, which, cell) ? ops.dofs.cellToPressure[cell] : -1;
       ops.gradientCells[v][which] = p;
-      if (p >= 0) triplets.emplace_back(v, p, which == 0 ? -ops.area : ops.area);
+      if (p >= 0) triplets.emplace_back(v, p, which == 0 ? -area : area);
     }
   }
   ops.G.resize(nu, np);
@@ -234,9 +244,11 @@ FluidOperators<d> buildFluidOperators(const FluidDomain<d>& domain, const FluidP
         auto f = c;
         f[a] += side;
         const int face = layout.faceIndex(a, f);
-        ops.divergenceFaces[p][2 * a + side] = ops.dofs.faceToVelocity[face];
-        if (domain.faces[face] == FaceKind::Prescribed)
-          ops.prescribedDivergence[p] += (side == 1 ? ops.area : -ops.area) * domain.faceVelocity[face];
+        const int v = ops.dofs.faceToVelocity[face];
+        ops.divergenceFaces[p][2 * a + side] = v;
+        // The covered part of a face (all of a prescribed one) moves with what covers it.
+        const double covered = domain.faces[face] == FaceKind::Prescribed ? 1.0 : v >= 0 ? 1.0 - ops.openFraction[v] : 0.0;
+        if (covered > 0) ops.prescribedDivergence[p] += (side == 1 ? ops.area : -ops.area) * covered * domain.faceVelocity[face];
       }
   }
 
@@ -255,11 +267,12 @@ FluidOperators<d> buildFluidOperators(const FluidDomain<d>& domain, const FluidP
 template <int d>
 void applyGradient(const FluidOperators<d>& ops, const Eigen::Ref<const Eigen::VectorXd>& p, Eigen::Ref<Eigen::VectorXd> out) {
   const double A = ops.area;
+  const double* theta = ops.cut ? ops.openFraction.data() : nullptr;
   parallel::forRows(ops.velocityCount(), [&](int v) {
     const auto& cells = ops.gradientCells[v];
     const double lo = cells[0] >= 0 ? p[cells[0]] : 0.0;
     const double hi = cells[1] >= 0 ? p[cells[1]] : 0.0;
-    out[v] = A * (hi - lo);
+    out[v] = (theta ? A * theta[v] : A) * (hi - lo);
   });
 }
 
@@ -267,6 +280,19 @@ template <int d>
 void applyGradientTranspose(const FluidOperators<d>& ops, const Eigen::Ref<const Eigen::VectorXd>& u,
                             Eigen::Ref<Eigen::VectorXd> out) {
   const double A = ops.area;
+  if (ops.cut) {
+    const double* theta = ops.openFraction.data();
+    parallel::forRows(ops.pressureCount(), [&](int p) {
+      const auto& faces = ops.divergenceFaces[p];
+      double s = 0;
+      for (int a = 0; a < d; ++a) {
+        if (faces[2 * a] >= 0) s += theta[faces[2 * a]] * u[faces[2 * a]];
+        if (faces[2 * a + 1] >= 0) s -= theta[faces[2 * a + 1]] * u[faces[2 * a + 1]];
+      }
+      out[p] = A * s;
+    });
+    return;
+  }
   parallel::forRows(ops.pressureCount(), [&](int p) {
     const auto& faces = ops.divergenceFaces[p];
     double s = 0;
@@ -329,6 +355,18 @@ void writeVelocities(const FluidOperators<d>& ops, const Eigen::VectorXd& free, 
 }
 
 template <int d>
+Eigen::VectorXd faceBetaInverse(const FluidOperators<d>& ops) {
+  return ops.betaInv * ops.openFraction.cwiseInverse();
+}
+
+template <int d>
+Eigen::VectorXd constraintDivergence(const FluidOperators<d>& ops, const Eigen::VectorXd& faceVelocities) {
+  Eigen::VectorXd div(ops.pressureCount());
+  applyGradientTranspose(ops, freeVelocities(ops, faceVelocities), div);
+  return ops.prescribedDivergence - div;
+}
+
+template <int d>
 Eigen::VectorXd volumeDivergence(const MacLayout<d>& layout, const Eigen::VectorXd& u) {
   Eigen::VectorXd div(layout.cellCount());
   const double A = layout.faceArea();
@@ -349,7 +387,7 @@ Eigen::VectorXd volumeDivergence(const MacLayout<d>& layout, const Eigen::Vector
 template <int d>
 SparseMatrixR assemblePoisson(const FluidOperators<d>& ops) {
   SparseMatrixR GT = ops.G.transpose();
-  SparseMatrixR P = ops.betaInv * (GT * ops.G);
+  SparseMatrixR P = ops.cut ? SparseMatrixR(GT * faceBetaInverse(ops).asDiagonal() * ops.G) : SparseMatrixR(ops.betaInv * (GT * ops.G));
   P.prune(0.0);
   return P;
 }
@@ -366,7 +404,7 @@ SparseMatrixR assembleCoupled(const FluidOperators<d>& ops) {
     for (SparseMatrixR::InnerIterator it(ops.Gmu, k); it; ++it) t.emplace_back(np + it.row(), it.col(), it.value());
   K.setFromTriplets(t.begin(), t.end());
   SparseMatrixR KT = K.transpose();
-  SparseMatrixR A = ops.betaInv * (K * KT);
+  SparseMatrixR A = ops.cut ? SparseMatrixR(K * faceBetaInverse(ops).asDiagonal() * KT) : SparseMatrixR(ops.betaInv * (K * KT));
   SparseMatrixR P(np + nr, np + nr);
   std::vector<Eigen::Triplet<double>> id;
   for (int r = 0; r < nr; ++r) id.emplace_back(np + r, np + r, 1.0);
@@ -390,6 +428,8 @@ SparseMatrixR assembleCoupled(const FluidOperators<d>& ops) {
                                                  Eigen::Ref<Eigen::VectorXd>);                                  \
   template Eigen::VectorXd freeVelocities<D>(const FluidOperators<D>&, const Eigen::VectorXd&);                 \
   template void writeVelocities<D>(const FluidOperators<D>&, const Eigen::VectorXd&, Eigen::VectorXd&);          \
+  template Eigen::VectorXd faceBetaInverse<D>(const FluidOperators<D>&);                                         \
+  template Eigen::VectorXd constraintDivergence<D>(const FluidOperators<D>&, const Eigen::VectorXd&);            \
   template Eigen::VectorXd volumeDivergence<D>(const MacLayout<D>&, const Eigen::VectorXd&);                    \
   template SparseMatrixR assemblePoisson<D>(const FluidOperators<D>&);                                          \
   template SparseMatrixR assembleCoupled<D>(const FluidOperators<D>&);

@@ -10,6 +10,13 @@
 //    w (u(f + e_b) - u(f)) with w = sqrt(dt mu / V_cell) A, so that beta^-1 G_mu^T G_mu is
 //    -dt nu times the 5-/7-point Laplacian of each velocity component.
 //
+// Cut faces (domain.openFraction, boundary.h): a free face with open fraction theta has area
+// theta A in G and D and mass theta rho V_cell in beta, so the velocity update beta^-1 G p is the
+// plain pressure difference while the divergence counts only the open part of the face; its covered
+// part moves with the obstacle and enters g. This is the variational cut-cell discretization of Ng,
+// Min & Gibou (2009), which keeps (5.31) symmetric positive definite; G_mu is unchanged (its rows
+// act on the face's reduced mass, so viscous coupling is stronger on small cut faces).
+//
 // Known values enter as affine terms: the discrete divergence of a full velocity field is
 // D u = -G^T u_free + g (g = prescribed-face fluxes, `prescribedDivergence`), and the viscous row
 // values are G_mu u_free + h (`viscousKnown`).
@@ -73,7 +80,9 @@ struct FluidOperators {
   FluidParameters params;
   FluidDofs dofs;
   double area = 0, volume = 0;
-  double betaInv = 0;        // 1 / (rho V_cell)
+  double betaInv = 0;        // 1 / (rho V_cell): a whole face; a cut face has betaInv / theta
+  bool cut = false;          // some free face is cut (openFraction != 1)
+  Eigen::VectorXd openFraction;  // theta per velocity unknown (all 1 without cut faces)
   double viscousWeight = 0;  // w = sqrt(dt mu / V_cell) A
 
   // Stencil tables for the matrix-free applies.
@@ -119,6 +128,15 @@ template <int d>
 Eigen::VectorXd freeVelocities(const FluidOperators<d>& ops, const Eigen::VectorXd& faceVelocities);
 template <int d>
 void writeVelocities(const FluidOperators<d>& ops, const Eigen::VectorXd& free, Eigen::VectorXd& faceVelocities);
+
+// beta^-1 per velocity unknown (1 / (rho V_cell theta)).
+template <int d>
+Eigen::VectorXd faceBetaInverse(const FluidOperators<d>& ops);
+
+// The constraint the projection drives to zero, per pressure unknown: (D u)_c = -G^T u_free + g,
+// cut faces weighted by their open fractions and their covered parts moving with the obstacle.
+template <int d>
+Eigen::VectorXd constraintDivergence(const FluidOperators<d>& ops, const Eigen::VectorXd& faceVelocities);
 
 // Volume-weighted divergence (D u)_c = sum over the cell's faces of +-A u, over every face of every
 // cell (prescribed ones included, periodic wrap applied): the quantity projection drives to zero.

@@ -33,10 +33,11 @@ template <int d>
 CgReport implicitViscosity(const FluidOperators<d>& ops, Eigen::VectorXd& faceVelocities, const CgSettings& settings) {
   if (ops.viscousCount() == 0) return {};
   const Eigen::VectorXd uStar = freeVelocities(ops, faceVelocities);
-  // rhs = u* - beta^-1 G_mu^T h: the known ends of the viscous rows (walls, obstacles, inflow).
+  // rhs = Theta u* - beta_1^-1 G_mu^T h: the known ends of the viscous rows (walls, obstacles,
+  // inflow); Theta = I without cut faces (spd_systems.h).
   Eigen::VectorXd rhs(ops.velocityCount());
   applyViscousGradientTranspose(ops, ops.viscousKnown, rhs);
-  rhs = uStar - ops.betaInv * rhs;
+  rhs = ops.openFraction.cwiseProduct(uStar) - ops.betaInv * rhs;
   ViscousOperator<d> system(ops);
   Eigen::VectorXd u = uStar;
   const CgReport report =
@@ -61,7 +62,8 @@ ProjectionReport pressureProjection(const FluidOperators<d>& ops, Eigen::VectorX
                                    report.pressureImpulse, settings.solve);
   Eigen::VectorXd grad(ops.velocityCount());
   applyGradient(ops, report.pressureImpulse, grad);
-  u -= ops.betaInv * grad;
+  if (ops.cut) u -= faceBetaInverse(ops).cwiseProduct(grad);
+  else u -= ops.betaInv * grad;
   writeVelocities(ops, u, faceVelocities);
   report.pressure = pressurePerCell(ops, report.pressureImpulse);
   return report;
@@ -115,7 +117,8 @@ ProjectionReport coupledProjection(const FluidOperators<d>& ops, Eigen::VectorXd
     applyViscousGradientTranspose(ops, z.tail(nr), visc);
     faces += visc;
   }
-  const Eigen::VectorXd u = uStar - ops.betaInv * faces;
+  const Eigen::VectorXd u = ops.cut ? Eigen::VectorXd(uStar - faceBetaInverse(ops).cwiseProduct(faces))
+                                    : Eigen::VectorXd(uStar - ops.betaInv * faces);
   writeVelocities(ops, u, faceVelocities);
   report.pressureImpulse = z.head(np);
   report.pressure = pressurePerCell(ops, report.pressureImpulse);

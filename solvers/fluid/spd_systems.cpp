@@ -14,6 +14,14 @@ PoissonOperator<d>::PoissonOperator(const FluidOperators<d>& ops)
       neighbours_[c][e] = v >= 0 ? ops.gradientCells[v][e % 2 == 0 ? 0 : 1] : -1;
       freeFaces_[c] += v >= 0;
     }
+  if (ops.cut) {
+    weights_.resize(ops.pressureCount());
+    for (int c = 0; c < ops.pressureCount(); ++c)
+      for (int e = 0; e < 2 * d; ++e) {
+        const int v = ops.divergenceFaces[c][e];
+        weights_[c][e] = v >= 0 ? ops.openFraction[v] : 0.0;
+      }
+  }
 }
 
 template <int d>
@@ -25,6 +33,17 @@ void PoissonOperator<d>::apply(const Eigen::VectorXd& p, Eigen::VectorXd& out) c
   out.resize(ops.pressureCount());
   const double* pp = p.data();
   double* po = out.data();
+  if (ops.cut) {  // A^2 beta^-1 = k theta on a cut face
+    parallel::forRows(ops.pressureCount(), [&](int c) {
+      double s = 0;
+      for (int e = 0; e < 2 * d; ++e) {
+        const int other = neighbours_[c][e];
+        s += weights_[c][e] * (pp[c] - (other >= 0 ? pp[other] : 0.0));
+      }
+      po[c] = k * s;
+    });
+    return;
+  }
   parallel::forRows(ops.pressureCount(), [&](int c) {
     double s = freeFaces_[c] * pp[c];
     for (int other : neighbours_[c])
@@ -38,7 +57,15 @@ Eigen::VectorXd PoissonOperator<d>::diagonal() const {
   const FluidOperators<d>& ops = *ops_;
   const double k = ops.area * ops.area * ops.betaInv;
   Eigen::VectorXd diag(ops.pressureCount());
-  for (int c = 0; c < ops.pressureCount(); ++c) diag[c] = k * freeFaces_[c];
+  for (int c = 0; c < ops.pressureCount(); ++c) {
+    if (!ops.cut) {
+      diag[c] = k * freeFaces_[c];
+      continue;
+    }
+    double w = 0;
+    for (double x : weights_[c]) w += x;
+    diag[c] = k * w;
+  }
   return diag;
 }
 
@@ -59,17 +86,20 @@ void CoupledOperator<d>::apply(const Eigen::VectorXd& z, Eigen::VectorXd& out) c
   const auto p = z.head(np);
   const auto uhat = z.segment(np, nr);
   const double A = ops.area, binv = ops.betaInv;
+  const double* theta = ops.cut ? ops.openFraction.data() : nullptr;
   parallel::forRows(ops.velocityCount(), [&](int v) {
+    // beta^-1 (G p_hat + G_mu^T u_hat); on a cut face beta^-1 G p_hat is still binv A dp.
     const auto& cells = ops.gradientCells[v];
-    double s = A * ((cells[1] >= 0 ? p[cells[1]] : 0.0) - (cells[0] >= 0 ? p[cells[0]] : 0.0));
+    const double pressure = A * ((cells[1] >= 0 ? p[cells[1]] : 0.0) - (cells[0] >= 0 ? p[cells[0]] : 0.0));
+    double viscous = 0;
     if (nr > 0) {
       const auto& rows = ops.faceViscousRows[v];
       for (int b = 0; b < d; ++b) {
-        if (rows[2 * b] >= 0) s += ops.viscousRows[rows[2 * b]].c1 * uhat[rows[2 * b]];
-        if (rows[2 * b + 1] >= 0) s += ops.viscousRows[rows[2 * b + 1]].c0 * uhat[rows[2 * b + 1]];
+        if (rows[2 * b] >= 0) viscous += ops.viscousRows[rows[2 * b]].c1 * uhat[rows[2 * b]];
+        if (rows[2 * b + 1] >= 0) viscous += ops.viscousRows[rows[2 * b + 1]].c0 * uhat[rows[2 * b + 1]];
       }
     }
-    faces_[v] = binv * s;
+    faces_[v] = theta ? binv * (pressure + viscous / theta[v]) : binv * (pressure + viscous);
   });
   out.resize(np + nr);
   applyGradientTranspose(ops, faces_, out.head(np));
@@ -90,7 +120,9 @@ Eigen::VectorXd CoupledOperator<d>::viscousDiagonal() const {
   Eigen::VectorXd diag(ops.viscousCount());
   for (int r = 0; r < ops.viscousCount(); ++r) {
     const ViscousRow& row = ops.viscousRows[r];
-    diag[r] = 1.0 + ops.betaInv * (row.c0 * row.c0 + row.c1 * row.c1);
+    const double w0 = row.u0 >= 0 ? row.c0 * row.c0 / ops.openFraction[row.u0] : 0.0;
+    const double w1 = row.u1 >= 0 ? row.c1 * row.c1 / ops.openFraction[row.u1] : 0.0;
+    diag[r] = 1.0 + ops.betaInv * (w0 + w1);
   }
   return diag;
 }
@@ -111,13 +143,14 @@ void ViscousOperator<d>::apply(const Eigen::VectorXd& u, Eigen::VectorXd& out) c
   applyViscousGradient(ops, u, rows_);
   applyViscousGradientTranspose(ops, rows_, out);
   const double binv = ops.betaInv;
-  parallel::forRows(ops.velocityCount(), [&](int v) { out[v] = u[v] + binv * out[v]; });
+  const double* theta = ops.openFraction.data();
+  parallel::forRows(ops.velocityCount(), [&](int v) { out[v] = theta[v] * u[v] + binv * out[v]; });
 }
 
 template <int d>
 Eigen::VectorXd ViscousOperator<d>::diagonal() const {
   const FluidOperators<d>& ops = *ops_;
-  Eigen::VectorXd diag = Eigen::VectorXd::Ones(ops.velocityCount());
+  Eigen::VectorXd diag = ops.openFraction;
   for (const ViscousRow& row : ops.viscousRows) {
     if (row.u0 >= 0) diag[row.u0] += ops.betaInv * row.c0 * row.c0;
     if (row.u1 >= 0) diag[row.u1] += ops.betaInv * row.c1 * row.c1;

@@ -5,8 +5,13 @@
 //  * CoupledOperator:  A = K beta^-1 K^T + diag(0, I) with K = [G^T; G_mu], i.e. eq. (5.31)
 //                      [[G^T b G, G^T b G_mu^T], [G_mu b G, I + G_mu b G_mu^T]], b = beta^-1,
 //                      on z = (p_hat, u_hat) stacked as [pressure unknowns, viscous rows]
-//  * ViscousOperator:  I + beta^-1 G_mu^T G_mu  (= I + dt nu L per component: the implicit
-//                      viscosity step of the Chorin splitting, divided through by beta)
+//  * ViscousOperator:  Theta + beta_1^-1 G_mu^T G_mu  (= I + dt nu L per component: the implicit
+//                      viscosity step of the Chorin splitting, divided through by the mass
+//                      beta_1 = rho V_cell of a whole face; Theta = diag(open fractions) is I
+//                      without cut faces and keeps the system symmetric with them)
+//
+// With cut faces (operators.h) beta^-1 is per face; the Poisson stencil then weights each free
+// face by its open fraction.
 //
 // Each apply is a sequence of row-parallel stencil loops (deterministic). The objects keep a
 // workspace, so one instance must not be applied from two threads at once.
@@ -30,6 +35,7 @@ class PoissonOperator {
   // each free face (-1: Dirichlet p = 0 or no free face) and the number of free faces.
   std::vector<std::array<int, 2 * d>> neighbours_;
   std::vector<int> freeFaces_;
+  std::vector<std::array<double, 2 * d>> weights_;  // cut faces only: open fraction per face, 0 if none
 };
 
 template <int d>

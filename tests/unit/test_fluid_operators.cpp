@@ -297,3 +297,122 @@ TEST(FluidOperators, SlipWallsAndOutflowDropShearRows) {
 }
 
 }  // namespace
+
+// --- cut faces (cutFaces, operators.h): area theta A in G and D, mass theta rho V in beta ---
+
+// The mixed domains with some free faces cut: fractions from a fixed pseudo-random sequence in
+// [0.05, 1), one face covered whole (fraction 0 -> prescribed); the covered parts move with the
+// field `covered`.
+template <int d>
+FluidDomain<d> withCutFaces(FluidDomain<d> domain, std::vector<double>& fractions) {
+  const int n = domain.layout.totalFaces();
+  fractions.assign(n, 1.0);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> uniform(0.05, 1.0);
+  int cut = 0;
+  for (int f = 0; f < n; ++f) {
+    if (domain.faces[f] != FaceKind::Free || f % 3 != 0) continue;
+    fractions[f] = cut == 5 ? 0.0 : uniform(rng);
+    ++cut;
+  }
+  cutFaces<d>(domain, fractions, [](const Eigen::Matrix<double, d, 1>& x) {
+    Eigen::Matrix<double, d, 1> v = Eigen::Matrix<double, d, 1>::Constant(0.3);
+    v[0] += x[d - 1];
+    return v;
+  });
+  return domain;
+}
+
+template <int d>
+void expectCutOperatorsConsistent(const FluidDomain<d>& plain) {
+  std::vector<double> fractions;
+  const FluidDomain<d> domain = withCutFaces(plain, fractions);
+  const FluidOperators<d> ops = buildFluidOperators(domain, FluidParameters{0.9, 0.3, 0.1});
+  ASSERT_TRUE(ops.cut);
+  const double minTheta = ops.openFraction.minCoeff();
+  ASSERT_GE(minTheta, 0.05);
+
+  // The covered face became prescribed with the field's velocity.
+  int covered = 0;
+  for (int f = 0; f < domain.layout.totalFaces(); ++f) covered += fractions[f] == 0 && domain.faces[f] == FaceKind::Prescribed;
+  EXPECT_EQ(covered, 1);
+
+  // D u = sum over the cell's faces of +-A (theta u + (1 - theta) U), written out here.
+  VectorXd faces = randomVector(domain.layout.totalFaces(), 5);
+  writeVelocities(ops, freeVelocities(ops, faces), faces);
+  const VectorXd div = constraintDivergence(ops, faces);
+  for (int p = 0; p < ops.pressureCount(); ++p) {
+    const auto c = domain.layout.cellCoord(ops.dofs.pressureToCell[p]);
+    double expected = 0;
+    for (int a = 0; a < d; ++a)
+      for (int side = 0; side < 2; ++side) {
+        auto f = c;
+        f[a] += side;
+        const int g = domain.layout.faceIndex(a, f);
+        const double theta = domain.faces[g] == FaceKind::Free ? domain.openFraction[g] : 0.0;
+        const double value = domain.faces[g] == FaceKind::Free ? theta * faces[g] + (1 - theta) * domain.faceVelocity[g]
+                                                               : domain.faceVelocity[g];
+        expected += (side == 1 ? 1 : -1) * ops.area * value;
+      }
+    EXPECT_NEAR(div[p], expected, 1e-13 * 2 * d * ops.area * 3);
+  }
+
+  // Matrix-free applies equal the assembled operators; the velocity update beta^-1 G p is the
+  // plain pressure difference on cut faces too.
+  const VectorXd p = randomVector(ops.pressureCount(), 1), u = randomVector(ops.velocityCount(), 2);
+  VectorXd grad(ops.velocityCount()), outP(ops.pressureCount());
+  applyGradient(ops, p, grad);
+  EXPECT_LE((grad - ops.G * p).cwiseAbs().maxCoeff(), 1e-14 * ops.area);
+  const VectorXd update = faceBetaInverse(ops).cwiseProduct(grad);
+  for (int v = 0; v < ops.velocityCount(); ++v) {
+    const auto& cells = ops.gradientCells[v];
+    const double dp = (cells[1] >= 0 ? p[cells[1]] : 0.0) - (cells[0] >= 0 ? p[cells[0]] : 0.0);
+    EXPECT_NEAR(update[v], ops.betaInv * ops.area * dp, 1e-13 * ops.betaInv * ops.area);
+  }
+  const SparseMatrixR P = assemblePoisson(ops);
+  PoissonOperator<d> poisson(ops);
+  poisson.apply(p, outP);
+  const double scale = ops.area * ops.area * ops.betaInv;
+  EXPECT_LE((outP - P * p).cwiseAbs().maxCoeff(), 1e-13 * scale);
+  EXPECT_LE((poisson.diagonal() - VectorXd(P.diagonal())).cwiseAbs().maxCoeff(), 1e-13 * scale);
+  const SparseMatrixR A = assembleCoupled(ops);
+  CoupledOperator<d> coupled(ops);
+  const VectorXd z = randomVector(coupled.size(), 4);
+  VectorXd Az(coupled.size());
+  coupled.apply(z, Az);
+  const double scaleA = std::max(scale, 1.0 + ops.betaInv * ops.viscousWeight * ops.viscousWeight / minTheta);
+  EXPECT_LE((Az - A * z).cwiseAbs().maxCoeff(), 1e-13 * scaleA);
+  EXPECT_LE((coupled.viscousDiagonal() - VectorXd(A.diagonal().tail(ops.viscousCount()))).cwiseAbs().maxCoeff(), 1e-13 * scaleA);
+  EXPECT_LE(Eigen::MatrixXd(A - SparseMatrixR(A.transpose())).cwiseAbs().maxCoeff(), 1e-13 * scaleA);
+
+  // Both systems stay symmetric positive: (5.31) and the Chorin viscosity system Theta + b G_mu^T G_mu.
+  ViscousOperator<d> viscous(ops);
+  for (unsigned seed = 0; seed < 3; ++seed) {
+    const VectorXd x = randomVector(coupled.size(), 10 + seed), y = randomVector(coupled.size(), 20 + seed);
+    VectorXd Ax(coupled.size()), Ay(coupled.size());
+    coupled.apply(x, Ax);
+    coupled.apply(y, Ay);
+    EXPECT_LE(std::abs(x.dot(Ay) - y.dot(Ax)), 1e-12 * (x.cwiseAbs().dot(Ay.cwiseAbs()) + y.cwiseAbs().dot(Ax.cwiseAbs())));
+    EXPECT_GT(x.dot(Ax), 0.0);
+    const VectorXd a = randomVector(ops.velocityCount(), 30 + seed), b = randomVector(ops.velocityCount(), 40 + seed);
+    VectorXd Va(ops.velocityCount()), Vb(ops.velocityCount());
+    viscous.apply(a, Va);
+    viscous.apply(b, Vb);
+    EXPECT_LE(std::abs(a.dot(Vb) - b.dot(Va)), 1e-12 * (a.cwiseAbs().dot(Vb.cwiseAbs()) + b.cwiseAbs().dot(Va.cwiseAbs())));
+    EXPECT_GT(a.dot(Va), 0.0);
+  }
+}
+
+TEST(FluidOperators, CutFacesKeepTheOperatorsConsistentAndSpd2D) { expectCutOperatorsConsistent(mixedDomain2()); }
+TEST(FluidOperators, CutFacesKeepTheOperatorsConsistentAndSpd3D) { expectCutOperatorsConsistent(mixedDomain3()); }
+
+TEST(FluidOperators, CutFacesRejectBadFractions) {
+  FluidDomain<2> domain = mixedDomain2();
+  std::vector<double> fractions(domain.layout.totalFaces(), 1.0);
+  fractions[3] = 1.5;
+  EXPECT_THROW(cutFaces<2>(domain, fractions), std::invalid_argument);
+  fractions[3] = std::nan("");
+  EXPECT_THROW(cutFaces<2>(domain, fractions), std::invalid_argument);
+  fractions.pop_back();
+  EXPECT_THROW(cutFaces<2>(domain, fractions), std::invalid_argument);
+}
