@@ -256,14 +256,13 @@ std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d
 }
 
 template <int d>
-Eigen::Matrix<double, d, 1> obstacleForce(const World<d>& world, Entity obstacle, const MacGrid<d>& grid,
-                                          double viscosity) {
-  using Vec = Eigen::Matrix<double, d, 1>;
+ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const MacGrid<d>& grid, double viscosity) {
   using Index = typename solvers::MacLayout<d>::Index;
-  Vec force = Vec::Zero();
+  ObstacleForce<d> result;
+  auto& force = result.pressure;
   const Shape<d>* shape = world.template get<Shape<d>>(obstacle);
   const RigidBody<d>* body = world.template get<RigidBody<d>>(obstacle);
-  if (!shape || !body || grid.solid.empty()) return force;
+  if (!shape || !body || grid.solid.empty()) return result;
   const solvers::MacLayout<d> layout = macLayoutOf(grid);
   const int n = layout.cellCount();
   // Part of each face covered by this obstacle: staircase, every face of its solid cells (those
@@ -316,10 +315,10 @@ Eigen::Matrix<double, d, 1> obstacleForce(const World<d>& world, Entity obstacle
       Eigen::Matrix<double, d, 1> wallPoint = layout.faceCenter(a, fi);
       wallPoint[b] += dir * layout.dx;
       const double wall = grid.obstacleVelocityAt(wallPoint)[a];
-      force[a] += viscosity * (grid.u[g] - wall) / (theta * layout.dx) * area;
+      result.viscous[a] += viscosity * (grid.u[g] - wall) / (theta * layout.dx) * area;
     });
   }
-  return force;
+  return result;
 }
 
 template <int d>
@@ -392,10 +391,13 @@ void ObstacleForces<d>::run(World<d>& world, StepContext& ctx) {
   const double mu = material ? material->viscosity : 0.0;
   const char* axes[] = {"x", "y", "z"};
   forEachObstacle(world, [&](Entity e, const Shape<d>&, const RigidBody<d>&) {
-    const Eigen::Matrix<double, d, 1> f = obstacleForce(world, e, grid, mu);
+    const ObstacleForce<d> f = obstacleForce(world, e, grid, mu);
     const std::string& name = world.name(e);
-    const std::string prefix = "obstacle_" + (name.empty() ? std::to_string(e.index) : name) + "_force_";
-    for (int a = 0; a < d; ++a) ctx.diagnostics.set(prefix + axes[a], f[a]);
+    const std::string prefix = "obstacle_" + (name.empty() ? std::to_string(e.index) : name);
+    for (int a = 0; a < d; ++a) {
+      ctx.diagnostics.set(prefix + "_force_" + axes[a], f.total()[a]);
+      ctx.diagnostics.set(prefix + "_pressure_force_" + axes[a], f.pressure[a]);
+    }
   });
 }
 
@@ -407,8 +409,8 @@ template std::vector<double> obstacleOpenFractions<2>(const World<2>&, const Mac
 template std::vector<double> obstacleOpenFractions<3>(const World<3>&, const MacGrid<3>&);
 template std::vector<double> obstacleWallDistances<2>(const World<2>&, const MacGrid<2>&);
 template std::vector<double> obstacleWallDistances<3>(const World<3>&, const MacGrid<3>&);
-template Eigen::Vector2d obstacleForce<2>(const World<2>&, Entity, const MacGrid<2>&, double);
-template Eigen::Vector3d obstacleForce<3>(const World<3>&, Entity, const MacGrid<3>&, double);
+template ObstacleForce<2> obstacleForce<2>(const World<2>&, Entity, const MacGrid<2>&, double);
+template ObstacleForce<3> obstacleForce<3>(const World<3>&, Entity, const MacGrid<3>&, double);
 template class RasterizeObstacles<2>;
 template class RasterizeObstacles<3>;
 template class ObstacleForces<2>;

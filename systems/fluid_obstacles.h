@@ -16,7 +16,8 @@
 //  - obstacle_forces: the fluid's force on each obstacle: the pressure of the fluid cell on every
 //    fluid-solid face (on the covered part of every cut face), plus the viscous stress exactly as the viscous operator applies it,
 //    mu (u - u_wall) / (theta dx) for every free face and axis whose neighbour face that way is
-//    an obstacle face (the body's share of the discrete momentum balance); diagnostics obstacle_<name>_force_x, _y (, _z).
+//    an obstacle face (the body's share of the discrete momentum balance); diagnostics obstacle_<name>_force_x, _y (, _z), and its pressure part
+//    obstacle_<name>_pressure_force_x, ...
 #include "components/mac_grid.h"
 #include "components/rigid_body.h"
 #include "components/shape.h"
@@ -43,10 +44,16 @@ std::vector<double> obstacleOpenFractions(const World<d>& world, const MacGrid<d
 template <int d>
 std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d>& grid);
 
-// The force of the fluid on the obstacle (entity) from the grid's current velocity and pressure.
+// The force of the fluid on the obstacle (entity) from the grid's current velocity and pressure,
+// split into its pressure and viscous parts.
 template <int d>
-Eigen::Matrix<double, d, 1> obstacleForce(const World<d>& world, Entity obstacle, const MacGrid<d>& grid,
-                                          double viscosity);
+struct ObstacleForce {
+  Eigen::Matrix<double, d, 1> pressure = Eigen::Matrix<double, d, 1>::Zero();
+  Eigen::Matrix<double, d, 1> viscous = Eigen::Matrix<double, d, 1>::Zero();
+  Eigen::Matrix<double, d, 1> total() const { return pressure + viscous; }
+};
+template <int d>
+ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const MacGrid<d>& grid, double viscosity);
 
 template <int d>
 class RasterizeObstacles final : public System<d> {

@@ -9,7 +9,8 @@
 // the second half of the run (the shedding has settled by then).
 //
 // usage: bench_dfg [2d2] [max cells across the channel: 41|82|164] [threads] [end time, default the scene's]
-//                  [first cells across, default 41]
+//                  [first cells across, default 41] [key=value scene overrides, e.g.
+//                  solvers.fluid.obstacle_cells=cut solvers.fluid.obstacle_wall=surface]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -54,6 +55,8 @@ struct Row {
   bool steady = false;
 };
 
+std::vector<Override> extraOverrides;  // key=value arguments
+
 Row run(const Registry& registry, int ny, int threads, const std::string& end) {
   const std::string file = std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/dfg_2d1.json";
   const int nx = ny * 220 / 41;  // square cells: 2.2 / nx = 0.41 / ny
@@ -63,6 +66,7 @@ Row run(const Registry& registry, int ny, int threads, const std::string& end) {
   std::snprintf(dt, sizeof dt, "%.17g", 0.025 * 41 / ny);  // the scene's CFL about 0.95 at every resolution
   overrides.push_back({"time.dt", dt});
   if (!end.empty()) overrides.push_back({"time.end", end});
+  overrides.insert(overrides.end(), extraOverrides.begin(), extraOverrides.end());
   const SceneSpec scene = loadScene(file, overrides);
   Simulation<2> sim(scene, registry, threads);
   Row r;
@@ -101,6 +105,7 @@ void runPeriodic(const Registry& registry, int ny, int threads, const std::strin
   std::snprintf(dt, sizeof dt, "%.17g", 0.004 * 41 / ny);  // CFL about 0.9 at every resolution
   overrides.push_back({"time.dt", dt});
   if (!end.empty()) overrides.push_back({"time.end", end});
+  overrides.insert(overrides.end(), extraOverrides.begin(), extraOverrides.end());
   const SceneSpec scene = loadScene(file, overrides);
   Simulation<2> sim(scene, registry, threads);
   std::vector<double> t, cD, cL;
@@ -124,6 +129,14 @@ void runPeriodic(const Registry& registry, int ny, int threads, const std::strin
 }  // namespace
 
 int main(int argc, char** argv) {
+  int kept = 1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const auto eq = arg.find('=');
+    if (eq == std::string::npos) argv[kept++] = argv[i];
+    else extraOverrides.push_back({arg.substr(0, eq), arg.substr(eq + 1)});
+  }
+  argc = kept;
   const bool periodic = argc > 1 && std::string(argv[1]) == "2d2";
   if (periodic) --argc, ++argv;
   const int maxNy = argc > 1 ? std::atoi(argv[1]) : 164;
