@@ -169,8 +169,10 @@ void expectApplyMatchesAssembly(const FluidDomain<d>& domain) {
   const VectorXd z = randomVector(coupled.size(), 4);
   VectorXd Az(coupled.size());
   coupled.apply(z, Az);
-  const double scaleA = std::max(scale, 1.0 + ops.betaInv * ops.viscousWeight * ops.viscousWeight);
+  // A cut face's viscous terms carry beta^-1 / theta.
+  const double scaleA = std::max(scale, 1.0 + ops.betaInv * ops.viscousWeight * ops.viscousWeight / ops.openFraction.minCoeff());
   EXPECT_LE((Az - A * z).cwiseAbs().maxCoeff(), 1e-13 * scaleA);
+  EXPECT_LE((coupled.viscousDiagonal() - VectorXd(A.diagonal().tail(ops.viscousCount()))).cwiseAbs().maxCoeff(), 1e-13 * scaleA);
 }
 
 TEST(FluidOperators, ApplyMatchesAssembly2D) { expectApplyMatchesAssembly(mixedDomain2()); }
@@ -359,31 +361,17 @@ void expectCutOperatorsConsistent(const FluidDomain<d>& plain) {
 
   // Matrix-free applies equal the assembled operators; the velocity update beta^-1 G p is the
   // plain pressure difference on cut faces too.
-  const VectorXd p = randomVector(ops.pressureCount(), 1), u = randomVector(ops.velocityCount(), 2);
-  VectorXd grad(ops.velocityCount()), outP(ops.pressureCount());
+  expectApplyMatchesAssembly(domain);
+  const VectorXd p = randomVector(ops.pressureCount(), 1);
+  VectorXd grad(ops.velocityCount());
   applyGradient(ops, p, grad);
-  EXPECT_LE((grad - ops.G * p).cwiseAbs().maxCoeff(), 1e-14 * ops.area);
   const VectorXd update = faceBetaInverse(ops).cwiseProduct(grad);
   for (int v = 0; v < ops.velocityCount(); ++v) {
     const auto& cells = ops.gradientCells[v];
     const double dp = (cells[1] >= 0 ? p[cells[1]] : 0.0) - (cells[0] >= 0 ? p[cells[0]] : 0.0);
     EXPECT_NEAR(update[v], ops.betaInv * ops.area * dp, 1e-13 * ops.betaInv * ops.area);
   }
-  const SparseMatrixR P = assemblePoisson(ops);
-  PoissonOperator<d> poisson(ops);
-  poisson.apply(p, outP);
-  const double scale = ops.area * ops.area * ops.betaInv;
-  EXPECT_LE((outP - P * p).cwiseAbs().maxCoeff(), 1e-13 * scale);
-  EXPECT_LE((poisson.diagonal() - VectorXd(P.diagonal())).cwiseAbs().maxCoeff(), 1e-13 * scale);
-  const SparseMatrixR A = assembleCoupled(ops);
   CoupledOperator<d> coupled(ops);
-  const VectorXd z = randomVector(coupled.size(), 4);
-  VectorXd Az(coupled.size());
-  coupled.apply(z, Az);
-  const double scaleA = std::max(scale, 1.0 + ops.betaInv * ops.viscousWeight * ops.viscousWeight / minTheta);
-  EXPECT_LE((Az - A * z).cwiseAbs().maxCoeff(), 1e-13 * scaleA);
-  EXPECT_LE((coupled.viscousDiagonal() - VectorXd(A.diagonal().tail(ops.viscousCount()))).cwiseAbs().maxCoeff(), 1e-13 * scaleA);
-  EXPECT_LE(Eigen::MatrixXd(A - SparseMatrixR(A.transpose())).cwiseAbs().maxCoeff(), 1e-13 * scaleA);
 
   // Both systems stay symmetric positive: (5.31) and the Chorin viscosity system Theta + b G_mu^T G_mu.
   ViscousOperator<d> viscous(ops);
