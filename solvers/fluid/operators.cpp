@@ -217,6 +217,7 @@ FluidOperators<d> buildFluidOperators(const FluidDomain<d>& domain, const FluidP
       ops.openFraction[v] = theta;
       ops.cut |= theta != 1;
     }
+  ops.faceBetaInv = ops.betaInv * ops.openFraction.cwiseInverse();
 
   // G: per free face the unknown cells on either side (Dirichlet / ghost: p = 0, no entry).
   ops.gradientCells.resize(nu);
@@ -355,11 +356,6 @@ void writeVelocities(const FluidOperators<d>& ops, const Eigen::VectorXd& free, 
 }
 
 template <int d>
-Eigen::VectorXd faceBetaInverse(const FluidOperators<d>& ops) {
-  return ops.betaInv * ops.openFraction.cwiseInverse();
-}
-
-template <int d>
 Eigen::VectorXd constraintDivergence(const FluidOperators<d>& ops, const Eigen::VectorXd& faceVelocities) {
   Eigen::VectorXd div(ops.pressureCount());
   applyGradientTranspose(ops, freeVelocities(ops, faceVelocities), div);
@@ -428,7 +424,6 @@ SparseMatrixR assembleCoupled(const FluidOperators<d>& ops) {
                                                  Eigen::Ref<Eigen::VectorXd>);                                  \
   template Eigen::VectorXd freeVelocities<D>(const FluidOperators<D>&, const Eigen::VectorXd&);                 \
   template void writeVelocities<D>(const FluidOperators<D>&, const Eigen::VectorXd&, Eigen::VectorXd&);          \
-  template Eigen::VectorXd faceBetaInverse<D>(const FluidOperators<D>&);                                         \
   template Eigen::VectorXd constraintDivergence<D>(const FluidOperators<D>&, const Eigen::VectorXd&);            \
   template Eigen::VectorXd volumeDivergence<D>(const MacLayout<D>&, const Eigen::VectorXd&);                    \
   template SparseMatrixR assemblePoisson<D>(const FluidOperators<D>&);                                          \

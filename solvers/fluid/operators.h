@@ -83,6 +83,7 @@ struct FluidOperators {
   double betaInv = 0;        // 1 / (rho V_cell): a whole face; a cut face has betaInv / theta
   bool cut = false;          // some free face is cut (openFraction != 1)
   Eigen::VectorXd openFraction;  // theta per velocity unknown (all 1 without cut faces)
+  Eigen::VectorXd faceBetaInv;   // betaInv / theta per velocity unknown (built once, used per solve)
   double viscousWeight = 0;  // w = sqrt(dt mu / V_cell) A
 
   // Stencil tables for the matrix-free applies.
@@ -131,7 +132,9 @@ void writeVelocities(const FluidOperators<d>& ops, const Eigen::VectorXd& free, 
 
 // beta^-1 per velocity unknown (1 / (rho V_cell theta)).
 template <int d>
-Eigen::VectorXd faceBetaInverse(const FluidOperators<d>& ops);
+const Eigen::VectorXd& faceBetaInverse(const FluidOperators<d>& ops) {
+  return ops.faceBetaInv;
+}
 
 // The constraint the projection drives to zero, per pressure unknown: (D u)_c = -G^T u_free + g,
 // cut faces weighted by their open fractions and their covered parts moving with the obstacle.
