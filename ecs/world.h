@@ -28,7 +28,7 @@ struct RigidRotationSettings {
 
 // How the fluid step of Ch. 5 is taken (scene "solvers": {"fluid": {...}}).
 struct FluidSolverSettings {
-  enum class Advection { SemiLagrangian, MacCormack, Eno3, None };  // None: unsteady Stokes flow (Sec. 5.7)
+  enum class Advection { SemiLagrangian, MacCormack, Eno3, Weno5, None };  // None: unsteady Stokes flow (Sec. 5.7)
   enum class Projection { Coupled, Chorin };            // (5.31) vs pressure/viscosity splitting
   enum class Preconditioner { None, Jacobi, IC0, MIC0, Multigrid };
   Advection advection = Advection::SemiLagrangian;

@@ -161,7 +161,7 @@ void registerDimension(Registry& r) {
                   "Steps II-V contact (Sec. 4.4-4.7, App. B): collisions, contact, shock_propagation, "
                   "resolve_interpenetration, velocity_contact",
                   [] { return makeRigidContactSystems<d>(); }, ""});
-  r.addSystem<d>({"advect_fluid", "fluid advection u* = u - dt (u.grad)u (semi-Lagrangian or ENO3/RK3)",
+  r.addSystem<d>({"advect_fluid", "fluid advection u* = u - dt (u.grad)u (semi-Lagrangian, MacCormack, ENO3 or WENO5 with RK3)",
                   [] { return single<FluidAdvection<d>>(); }, ""});
   r.addSystem<d>({"fluid_gravity", "gravity on the fluid's free faces", [] { return single<FluidGravity<d>>(); }, ""});
   r.addSystem<d>({"project_fluid", "coupled SPD pressure-viscosity solve (5.31) or Chorin splitting",

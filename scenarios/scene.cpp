@@ -366,8 +366,9 @@ void loadScenePlugins(const SceneSpec& scene, PluginLoader& loader, Registry& re
 namespace {
 void parseFluidSolverSettings(const Config& c, FluidSolverSettings& f) {
   using S = FluidSolverSettings;
-  const std::string advection = c.oneOf("advection", {"semi_lagrangian", "maccormack", "eno3", "none"}, "semi_lagrangian");
+  const std::string advection = c.oneOf("advection", {"semi_lagrangian", "maccormack", "eno3", "weno5", "none"}, "semi_lagrangian");
   f.advection = advection == "eno3"         ? S::Advection::Eno3
+                : advection == "weno5"      ? S::Advection::Weno5
                 : advection == "maccormack" ? S::Advection::MacCormack
                 : advection == "none"       ? S::Advection::None
                                             : S::Advection::SemiLagrangian;

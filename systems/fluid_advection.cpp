@@ -42,7 +42,9 @@ void FluidAdvection<d>::run(World<d>& world, StepContext& ctx) {
     const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(grid.u.data(), grid.u.size());
     const auto scheme = world.settings().fluid.advection;
     const Eigen::VectorXd advected =
-        scheme == FluidSolverSettings::Advection::Eno3         ? solvers::advectFacesEnoRk3(domain.layout, u, ctx.dt, boundary)
+        scheme == FluidSolverSettings::Advection::Eno3 ? solvers::advectFacesEnoRk3(domain.layout, u, ctx.dt, boundary)
+        : scheme == FluidSolverSettings::Advection::Weno5
+            ? solvers::advectFacesEnoRk3(domain.layout, u, ctx.dt, boundary, solvers::HjStencil::Weno5)
         : scheme == FluidSolverSettings::Advection::MacCormack ? solvers::advectFacesMacCormack(domain.layout, u, ctx.dt, boundary)
                                                                : solvers::advectFacesSemiLagrangian(domain.layout, u, ctx.dt, boundary);
     Eigen::Map<Eigen::VectorXd>(grid.u.data(), grid.u.size()) = advected;

@@ -1,6 +1,7 @@
 #pragma once
 // Fluid advection (thesis Sec. 5.4, step 6; Sec. 5.2): u* = u^n - dt (u^n . grad) u^n by the
-// scene's scheme, semi-Lagrangian (with clipping at solids) or 3rd-order ENO with TVD RK3.
+// scene's scheme, semi-Lagrangian (with clipping at solids), MacCormack, or 3rd-order ENO /
+// 5th-order WENO with TVD RK3.
 // Skipped for unsteady Stokes flow ("advection": "none"). Limits the step by the CFL condition.
 #include "components/mac_grid.h"
 #include "ecs/system.h"

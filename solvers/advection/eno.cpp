@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -28,7 +29,34 @@ double eno3Derivative(const std::array<double, 7>& v, double dx, bool backward) 
   return derivative;
 }
 
+double weno5Derivative(const std::array<double, 7>& v, double dx, bool backward) {
+  // The five one-sided differences a1..a5, ordered from the far upwind side (Osher & Fedkiw
+  // eqs. 3.25-3.35; for D^+ the same formulas apply to the mirrored differences).
+  double a[5];
+  for (int j = 0; j < 5; ++j) a[j] = backward ? (v[j + 1] - v[j]) / dx : (v[6 - j] - v[5 - j]) / dx;
+  // The three third-order candidates (the ENO3 stencils) ...
+  const double p1 = a[0] / 3 - 7 * a[1] / 6 + 11 * a[2] / 6;
+  const double p2 = -a[1] / 6 + 5 * a[2] / 6 + a[3] / 3;
+  const double p3 = a[2] / 3 + 5 * a[3] / 6 - a[4] / 6;
+  // ... their smoothness indicators ...
+  const auto sq = [](double x) { return x * x; };
+  const double s1 = 13.0 / 12 * sq(a[0] - 2 * a[1] + a[2]) + 0.25 * sq(a[0] - 4 * a[1] + 3 * a[2]);
+  const double s2 = 13.0 / 12 * sq(a[1] - 2 * a[2] + a[3]) + 0.25 * sq(a[1] - a[3]);
+  const double s3 = 13.0 / 12 * sq(a[2] - 2 * a[3] + a[4]) + 0.25 * sq(3 * a[2] - 4 * a[3] + a[4]);
+  // ... and the nonlinear weights around the optimal 0.1, 0.6, 0.3; eps scales with the data so
+  // that the weights do not depend on the units (Fedkiw et al.'s choice, with a floor for a = 0).
+  double largest = 0;
+  for (double x : a) largest = std::max(largest, x * x);
+  const double eps = 1e-6 * largest + 1e-99;
+  const double w1 = 0.1 / sq(s1 + eps), w2 = 0.6 / sq(s2 + eps), w3 = 0.3 / sq(s3 + eps);
+  return (w1 * p1 + w2 * p2 + w3 * p3) / (w1 + w2 + w3);
+}
+
 namespace {
+
+double hjDerivative(HjStencil stencil, const std::array<double, 7>& v, double dx, bool backward) {
+  return stencil == HjStencil::Weno5 ? weno5Derivative(v, dx, backward) : eno3Derivative(v, dx, backward);
+}
 
 template <int d>
 using IndexT = typename MacLayout<d>::Index;
@@ -149,7 +177,8 @@ Eigen::VectorXd tvdRk3(Eigen::VectorXd y0, double dt, Conv conv, Fix fix) {
 }  // namespace
 
 template <int d>
-Eigen::VectorXd enoConvectiveTerm(const MacLayout<d>& layout, const Eigen::VectorXd& u, const FaceBoundary& boundary) {
+Eigen::VectorXd enoConvectiveTerm(const MacLayout<d>& layout, const Eigen::VectorXd& u, const FaceBoundary& boundary,
+                                  HjStencil stencil) {
   const FaceVelocitySampler<d> sampler(layout, u, boundary);
   Eigen::VectorXd out(u.size());
   forEach(static_cast<int>(u.size()), [&](int g) {
@@ -165,7 +194,7 @@ Eigen::VectorXd enoConvectiveTerm(const MacLayout<d>& layout, const Eigen::Vecto
       if (w[b] == 0) continue;
       const auto v = gather7<d>(f, b, dims, layout.periodic, [&](const IndexT<d>& n) { return layout.faceIndex(axis, n); },
                                 [&](int face) { return sampler.faceValue(face); });
-      term += w[b] * eno3Derivative(v, layout.dx, w[b] > 0);
+      term += w[b] * hjDerivative(stencil, v, layout.dx, w[b] > 0);
     }
     out[g] = term;
   });
@@ -174,7 +203,7 @@ Eigen::VectorXd enoConvectiveTerm(const MacLayout<d>& layout, const Eigen::Vecto
 
 template <int d>
 Eigen::VectorXd advectFacesEnoRk3(const MacLayout<d>& layout, const Eigen::VectorXd& u, double dt,
-                                  const FaceBoundary& boundary) {
+                                  const FaceBoundary& boundary, HjStencil stencil) {
   checkDt(dt);
   validateBoundary(layout, boundary);
   if (u.size() != layout.totalFaces()) throw std::invalid_argument("advectFacesEnoRk3: field needs one value per face");
@@ -184,12 +213,12 @@ Eigen::VectorXd advectFacesEnoRk3(const MacLayout<d>& layout, const Eigen::Vecto
     for (Eigen::Index g = 0; g < y.size(); ++g)
       if (boundary.prescribedFace[g]) y[g] = boundary.prescribedVelocity[g];
   };
-  return tvdRk3(u, dt, [&](const Eigen::VectorXd& y) { return enoConvectiveTerm(layout, y, boundary); }, fix);
+  return tvdRk3(u, dt, [&](const Eigen::VectorXd& y) { return enoConvectiveTerm(layout, y, boundary, stencil); }, fix);
 }
 
 template <int d>
 Eigen::VectorXd enoScalarConvectiveTerm(const MacLayout<d>& layout, const Eigen::VectorXd& phi, const Eigen::VectorXd& u,
-                                        const FaceBoundary& boundary) {
+                                        const FaceBoundary& boundary, HjStencil stencil) {
   if (phi.size() != layout.cellCount()) throw std::invalid_argument("enoScalarConvectiveTerm: phi needs one value per cell");
   const FaceVelocitySampler<d> sampler(layout, u, boundary);
   Eigen::VectorXd out(phi.size());
@@ -205,7 +234,7 @@ Eigen::VectorXd enoScalarConvectiveTerm(const MacLayout<d>& layout, const Eigen:
       if (w[b] == 0) continue;
       const auto v = gather7<d>(c, b, layout.cells, layout.periodic, [&](const IndexT<d>& n) { return layout.cellIndex(n); },
                                 [&](int i) { return phi[i]; });
-      term += w[b] * eno3Derivative(v, layout.dx, w[b] > 0);
+      term += w[b] * hjDerivative(stencil, v, layout.dx, w[b] > 0);
     }
     out[cell] = term;
   });
@@ -214,7 +243,7 @@ Eigen::VectorXd enoScalarConvectiveTerm(const MacLayout<d>& layout, const Eigen:
 
 template <int d>
 Eigen::VectorXd advectScalarEnoRk3(const MacLayout<d>& layout, const Eigen::VectorXd& phi, const Eigen::VectorXd& u,
-                                   double dt, const FaceBoundary& boundary) {
+                                   double dt, const FaceBoundary& boundary, HjStencil stencil) {
   checkDt(dt);
   if (phi.size() != layout.cellCount()) throw std::invalid_argument("advectScalarEnoRk3: phi needs one value per cell");
   validateBoundary(layout, boundary);
@@ -224,17 +253,18 @@ Eigen::VectorXd advectScalarEnoRk3(const MacLayout<d>& layout, const Eigen::Vect
     for (std::size_t c = 0; c < boundary.solidCell.size(); ++c)
       if (boundary.solidCell[c]) y[static_cast<Eigen::Index>(c)] = phi[static_cast<Eigen::Index>(c)];
   };
-  return tvdRk3(phi, dt, [&](const Eigen::VectorXd& y) { return enoScalarConvectiveTerm(layout, y, u, boundary); }, fix);
+  return tvdRk3(phi, dt, [&](const Eigen::VectorXd& y) { return enoScalarConvectiveTerm(layout, y, u, boundary, stencil); }, fix);
 }
 
 #define MONOLITH_ENO_INSTANTIATE(D)                                                                                   \
-  template Eigen::VectorXd enoConvectiveTerm<D>(const MacLayout<D>&, const Eigen::VectorXd&, const FaceBoundary&);    \
+  template Eigen::VectorXd enoConvectiveTerm<D>(const MacLayout<D>&, const Eigen::VectorXd&, const FaceBoundary&,     \
+                                                HjStencil);                                                           \
   template Eigen::VectorXd advectFacesEnoRk3<D>(const MacLayout<D>&, const Eigen::VectorXd&, double,                  \
-                                                const FaceBoundary&);                                                 \
+                                                const FaceBoundary&, HjStencil);                                      \
   template Eigen::VectorXd enoScalarConvectiveTerm<D>(const MacLayout<D>&, const Eigen::VectorXd&,                    \
-                                                      const Eigen::VectorXd&, const FaceBoundary&);                   \
+                                                      const Eigen::VectorXd&, const FaceBoundary&, HjStencil);        \
   template Eigen::VectorXd advectScalarEnoRk3<D>(const MacLayout<D>&, const Eigen::VectorXd&, const Eigen::VectorXd&, \
-                                                 double, const FaceBoundary&);
+                                                 double, const FaceBoundary&, HjStencil);
 MONOLITH_ENO_INSTANTIATE(2)
 MONOLITH_ENO_INSTANTIATE(3)
 #undef MONOLITH_ENO_INSTANTIATE

@@ -42,30 +42,46 @@
 
 namespace monolith::solvers {
 
+// The one-sided derivative rule of the Hamilton-Jacobi schemes below.
+//  * Eno3: third-order ENO (the thesis' scheme). Its stencil choice is a discontinuous function
+//    of the data, so a steady flow can settle into a limit cycle of stencil switches (measured
+//    on DFG 2D-1: a period-4 cycle of 1e-3 beside the disk, docs/benchmarks.md).
+//  * Weno5: fifth-order weighted ENO (Jiang & Peng 2000; Osher & Fedkiw Sec. 3.4) on the same
+//    six points: a convex combination of the three ENO3 candidates whose weights are smooth in
+//    the data, fifth order where the solution is smooth and ENO-like at kinks; its steady
+//    states exist and are reached.
+enum class HjStencil { Eno3, Weno5 };
+
 // ENO3 one-sided derivative at v[3] from the seven values v[0..6] at spacing dx: backward
 // (D^-, upwind for positive velocity; uses v[0..5]) or forward (D^+; uses v[1..6]).
 // Exact for cubic polynomials.
 double eno3Derivative(const std::array<double, 7>& v, double dx, bool backward);
 
+// WENO5 one-sided derivative at v[3], same arguments and stencils (D^- uses v[0..5], D^+ v[1..6]).
+// Exact for cubics (every candidate is); fifth order on smooth data.
+double weno5Derivative(const std::array<double, 7>& v, double dx, bool backward);
+
 // (u . grad) u at every face (component of the face's axis); 0 on prescribed faces.
 template <int d>
 Eigen::VectorXd enoConvectiveTerm(const MacLayout<d>& layout, const Eigen::VectorXd& u,
-                                  const FaceBoundary& boundary = {});
+                                  const FaceBoundary& boundary = {}, HjStencil stencil = HjStencil::Eno3);
 
 // One TVD-RK3 step of u_t + (u . grad) u = 0 (no pressure). dt >= 0 and finite.
 template <int d>
 Eigen::VectorXd advectFacesEnoRk3(const MacLayout<d>& layout, const Eigen::VectorXd& u, double dt,
-                                  const FaceBoundary& boundary = {});
+                                  const FaceBoundary& boundary = {}, HjStencil stencil = HjStencil::Eno3);
 
 // (u . grad) phi for a cell-centred scalar phi (one value per cell, layout.cellIndex order) in
 // the face-velocity field u. Solid cells get 0 (their values are only read, as ghost values).
 template <int d>
 Eigen::VectorXd enoScalarConvectiveTerm(const MacLayout<d>& layout, const Eigen::VectorXd& phi,
-                                        const Eigen::VectorXd& u, const FaceBoundary& boundary = {});
+                                        const Eigen::VectorXd& u, const FaceBoundary& boundary = {},
+                                        HjStencil stencil = HjStencil::Eno3);
 
 // One TVD-RK3 step of phi_t + (u . grad) phi = 0 with u frozen over the step.
 template <int d>
 Eigen::VectorXd advectScalarEnoRk3(const MacLayout<d>& layout, const Eigen::VectorXd& phi,
-                                   const Eigen::VectorXd& u, double dt, const FaceBoundary& boundary = {});
+                                   const Eigen::VectorXd& u, double dt, const FaceBoundary& boundary = {},
+                                   HjStencil stencil = HjStencil::Eno3);
 
 }  // namespace monolith::solvers
