@@ -1,8 +1,9 @@
 // Schaefer-Turek DFG 2D-1 (steady Re 20 flow past a cylinder, REFERENCES.md): drag and lift
 // coefficients and the pressure difference across the cylinder against the reference values,
-// for the first-order staircase obstacle (fluid_obstacle) at several resolutions. Runs
-// scenarios/scenes/dfg_2d1.json through the real pipeline to steady state
-// (max|du|/dt < 1e-6, the scene's stop criterion).
+// at several resolutions, with the scene's settings (cut faces, wall at the surface, WENO5; the
+// thesis's staircase: add solvers.fluid.obstacle_cells=staircase solvers.fluid.obstacle_wall=face
+// solvers.fluid.advection=semi_lagrangian). Runs scenarios/scenes/dfg_2d1.json through the real
+// pipeline to steady state (max|du|/dt < 1e-6, the scene's stop criterion).
 //
 // With the first argument "2d2" it runs the periodic benchmark 2D-2 (dfg_2d2.json, Re 100)
 // instead: maximum c_D and c_L and the Strouhal number St = D f / Ubar of the lift, measured over
