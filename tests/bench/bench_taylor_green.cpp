@@ -1,5 +1,5 @@
 // Taylor-Green vortex at t = 1 (dt = dx / 2): L-infinity velocity error and wall time for both
-// advection schemes and both projections, 32^2 to 128^2, with the observed order.
+// advection schemes (and WENO5) and both projections, 32^2 to 128^2, with the observed order.
 //
 // usage: bench_taylor_green [threads]
 #include <chrono>
@@ -14,7 +14,7 @@ int main(int argc, char** argv) {
   monolith::Registry registry;
   monolith::registerBuiltins(registry);
   std::printf("| advection | projection | cells | steps | L-inf error | observed order | wall s |\n|---|---|---|---|---|---|---|\n");
-  for (const char* advection : {"semi_lagrangian", "eno3"})
+  for (const char* advection : {"semi_lagrangian", "eno3", "weno5"})
     for (const char* projection : {"coupled", "chorin"}) {
       double previous = 0;
       for (int n : {32, 64, 128}) {
