@@ -74,6 +74,10 @@ struct MacGrid {
   // Per face, the part of its area outside every obstacle (FluidDomain::openFraction); empty for
   // the staircase ("obstacle_cells": "staircase"), where `solid` alone describes the obstacles.
   std::vector<double> openFraction;
+  // What the fields above were last rasterized from (grid, settings, every obstacle's shape and
+  // pose): while it is unchanged (static obstacles) rasterize_obstacles reuses them. Not
+  // checkpointed: empty after a restart, so the first step rasterizes afresh.
+  std::vector<double> rasterizedFrom;
 
   // Velocity of the obstacle nearest to x (the one whose bounding sphere x is deepest in); zero
   // without obstacles. Solid faces take its normal component (Sec. 5.4.1).

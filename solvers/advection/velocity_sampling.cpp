@@ -92,6 +92,16 @@ FaceVelocitySampler<d>::FaceVelocitySampler(const MacLayout<d>& layout, const Ei
   if (u.size() != layout.totalFaces())
     throw std::invalid_argument("FaceVelocitySampler: field needs one value per face");
   validateBoundary(layout, boundary);
+  if (!hasSolids()) return;
+  insideSolid_.assign(layout.totalFaces(), 0);
+  for (int g = 0; g < layout.totalFaces(); ++g) {
+    const auto [axis, f] = layout.faceCoord(g);
+    int cells[2];
+    const int count = faceNeighbourCells(layout, axis, f, cells);
+    bool inside = count > 0;
+    for (int k = 0; k < count; ++k) inside = inside && boundary.solidCell[cells[k]];
+    insideSolid_[g] = inside;
+  }
 }
 
 template <int d>
@@ -103,12 +113,7 @@ FaceVelocitySampler<d>::FaceVelocitySampler(const MacLayout<d>& layout, const Ei
 
 template <int d>
 bool FaceVelocitySampler<d>::faceInsideSolid(int axis, const Index& f) const {
-  if (!hasSolids()) return false;
-  int cells[2];
-  const int count = faceNeighbourCells(layout_, axis, f, cells);
-  for (int k = 0; k < count; ++k)
-    if (!boundary_->solidCell[cells[k]]) return false;
-  return count > 0;
+  return hasSolids() && insideSolid_[layout_.faceIndex(axis, f)];
 }
 
 template <int d>
@@ -173,8 +178,9 @@ double FaceVelocitySampler<d>::component(int axis, const Vec& x, std::pair<doubl
       w *= upper ? t[b] : 1 - t[b];
     }
     if (w == 0) continue;  // also keeps exact face-centre samples free of neighbour values
-    const double value = faceValue(layout_.faceIndex(axis, f));
-    if (faceInsideSolid(axis, f)) {  // rule 4
+    const int face = layout_.faceIndex(axis, f);
+    const double value = faceValue(face);
+    if (!insideSolid_.empty() && insideSolid_[face]) {  // rule 4
       dropped = true;
       solidSum += w * value;
       solidLo = std::min(solidLo, value), solidHi = std::max(solidHi, value);

@@ -93,6 +93,9 @@ class FaceVelocitySampler {
   MacLayout<d> layout_;
   const Eigen::VectorXd* u_;
   const FaceBoundary* boundary_;
+  // Rule 4's test per face, tabulated once per sampler (empty without structures): it is asked
+  // for every corner of every sample, and the neighbour-cell lookup was the advection's hot spot.
+  std::vector<std::uint8_t> insideSolid_;
 };
 
 }  // namespace monolith::solvers

@@ -6,6 +6,7 @@
 //    1- and 2-thread states are bitwise equal.
 //
 // usage: bench_rigid_contact [pyramid|pour|all, default all] [seconds] [pyramid scene, e.g. pyramid_20]
+//                            [key=value scene overrides for the pyramids, e.g. solvers.contact.contact_iterations=4]
 //   seconds: simulated time per run; pour default 1.0, pyramids default the scenes' 10 s (a
 //   shorter run is for quick comparisons while profiling; report the 10 s numbers).
 #include <chrono>
@@ -25,7 +26,7 @@ namespace {
 
 const std::string kScenes = std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/";
 
-void pyramids(const Registry& registry, double seconds, const std::string& only) {
+void pyramids(const Registry& registry, double seconds, const std::string& only, const std::vector<Override>& extra) {
   std::printf("| scene | boxes | dt | steps | us/step (1 thread) | max drift | final KE | max penetration / size |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
   for (const char* name : {"pyramid_10", "pyramid_20"}) {
@@ -35,8 +36,10 @@ void pyramids(const Registry& registry, double seconds, const std::string& only)
       std::snprintf(dtText, sizeof dtText, "%.17g", dt);
       char end[64];
       std::snprintf(end, sizeof end, "%.17g", seconds);
-      const SceneSpec scene = seconds > 0 ? loadScene(kScenes + name + ".json", {{"time.dt", dtText}, {"time.end", end}})
-                                          : loadScene(kScenes + name + ".json", {{"time.dt", dtText}});
+      std::vector<Override> overrides = extra;
+      overrides.push_back({"time.dt", dtText});
+      if (seconds > 0) overrides.push_back({"time.end", end});
+      const SceneSpec scene = loadScene(kScenes + name + ".json", overrides);
       Simulation<3> sim(scene, registry, 1);
       auto& bodies = sim.world().pool<RigidBody<3>>().components();
       std::vector<Eigen::Vector3d> start;
@@ -107,7 +110,17 @@ int main(int argc, char** argv) {
   const double seconds = argc > 2 ? std::atof(argv[2]) : 0.0;  // 0: the default of each group
   Registry registry;
   registerBuiltins(registry);
-  if (what == "pyramid" || what == "all") pyramids(registry, seconds, argc > 3 ? argv[3] : "");
+  std::vector<Override> extra;
+  for (int i = 4; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const auto eq = arg.find('=');
+    if (eq == std::string::npos) {
+      std::fprintf(stderr, "expected key=value, got %s\n", argv[i]);
+      return 2;
+    }
+    extra.push_back({arg.substr(0, eq), arg.substr(eq + 1)});
+  }
+  if (what == "pyramid" || what == "all") pyramids(registry, seconds, argc > 3 ? argv[3] : "", extra);
   if (what == "pour" || what == "all") pour(registry, seconds > 0 ? seconds : 1.0);
   return 0;
 }
