@@ -302,12 +302,7 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
     mine = facesOfMarkedCells(layout, cells);
     covered.assign(mine.begin(), mine.end());
   } else {
-    // A lone obstacle covers what the grid's fractions leave open, if they are still its own
-    // (rasterized from its present pose); else they are computed for it alone.
-    int obstacles = 0;
-    forEachObstacle(world, [&](Entity, const Shape<d>&, const RigidBody<d>&) { ++obstacles; });
-    if (obstacles == 1 && rasterizationKey(world, grid) == grid.rasterizedFrom) covered = grid.openFraction;
-    else covered = openFractions(layout, ObstacleList<d>{{shape, body}});
+    covered = openFractions(layout, ObstacleList<d>{{shape, body}});
     mine.resize(covered.size());
     for (std::size_t g = 0; g < covered.size(); ++g) {
       covered[g] = 1.0 - covered[g];

@@ -113,7 +113,7 @@ FaceVelocitySampler<d>::FaceVelocitySampler(const MacLayout<d>& layout, const Ei
 
 template <int d>
 bool FaceVelocitySampler<d>::faceInsideSolid(int axis, const Index& f) const {
-  return hasSolids() && insideSolid_[layout_.faceIndex(axis, f)];
+  return insideSolid(layout_.faceIndex(axis, f));
 }
 
 template <int d>
@@ -180,7 +180,7 @@ double FaceVelocitySampler<d>::component(int axis, const Vec& x, std::pair<doubl
     if (w == 0) continue;  // also keeps exact face-centre samples free of neighbour values
     const int face = layout_.faceIndex(axis, f);
     const double value = faceValue(face);
-    if (!insideSolid_.empty() && insideSolid_[face]) {  // rule 4
+    if (insideSolid(face)) {  // rule 4
       dropped = true;
       solidSum += w * value;
       solidLo = std::min(solidLo, value), solidHi = std::max(solidHi, value);

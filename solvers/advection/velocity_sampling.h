@@ -96,6 +96,7 @@ class FaceVelocitySampler {
   // Rule 4's test per face, tabulated once per sampler (empty without structures): it is asked
   // for every corner of every sample, and the neighbour-cell lookup was the advection's hot spot.
   std::vector<std::uint8_t> insideSolid_;
+  bool insideSolid(int face) const { return !insideSolid_.empty() && insideSolid_[face]; }
 };
 
 }  // namespace monolith::solvers
