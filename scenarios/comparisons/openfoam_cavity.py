@@ -22,12 +22,10 @@ import argparse
 import os
 import re
 import shutil
-import subprocess
 import sys
 import tempfile
-import time
 
-HEADER = "FoamFile {{ version 2.0; format ascii; class {cls}; object {obj}; }}\n"
+from openfoam_case import HEADER, require_openfoam, run, solve, write
 
 # Ghia, Ghia & Shin (1982) centre-line values, as in tests/support/ghia.h (coordinate, Re 100, Re 1000).
 GHIA_U = [(1.0000, 1.00000, 1.00000), (0.9766, 0.84123, 0.65928), (0.9688, 0.78871, 0.57492),
@@ -42,12 +40,6 @@ GHIA_V = [(1.0000, 0.00000, 0.00000), (0.9688, -0.05906, -0.21388), (0.9609, -0.
           (0.2344, 0.17527, 0.32235), (0.2266, 0.17507, 0.33075), (0.1563, 0.16077, 0.37095),
           (0.0938, 0.12317, 0.32627), (0.0781, 0.10890, 0.30353), (0.0703, 0.10091, 0.29012),
           (0.0625, 0.09233, 0.27485), (0.0000, 0.00000, 0.00000)]
-
-
-def write(path, text):
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    with open(path, "w") as f:
-        f.write(text)
 
 
 def write_case(case, n, nu, solver, dt, steps, procs, loose, gamg):
@@ -135,26 +127,6 @@ boundaryField
 """)
 
 
-def run(case, args, log):
-    with open(os.path.join(case, log), "w") as out:
-        subprocess.run(args, cwd=case, stdout=out, stderr=subprocess.STDOUT, check=True)
-
-
-def solve(case, app, procs):
-    """Runs the solver (decomposed over `procs` MPI ranks if > 1); returns its wall seconds."""
-    if procs > 1:
-        run(case, ["decomposePar", "-force"], "log.decomposePar")
-        start = time.perf_counter()
-        run(case, ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", str(procs), app, "-parallel"], "log." + app)
-        seconds = time.perf_counter() - start
-        run(case, ["reconstructPar", "-latestTime"], "log.reconstructPar")
-    else:
-        start = time.perf_counter()
-        run(case, [app], "log." + app)
-        seconds = time.perf_counter() - start
-    return seconds
-
-
 def latest_time(case):
     times = [d for d in os.listdir(case) if re.fullmatch(r"[0-9.e+-]+", d) and d != "0"]
     return max(times, key=float)
@@ -218,10 +190,7 @@ def main():
                         help="icoFoam's pressure with GAMG instead of the tutorial's DIC-preconditioned CG")
     parser.add_argument("--keep", help="case directory to keep (default: a temporary one, removed)")
     args = parser.parse_args()
-    if shutil.which("blockMesh") is None:
-        sys.exit("openfoam_cavity.py: OpenFOAM is not installed (Debian 12: apt-get install openfoam)")
-    # Debian's package finds its etc/ (global controlDict) through WM_PROJECT_DIR.
-    os.environ.setdefault("WM_PROJECT_DIR", "/usr/share/openfoam")
+    require_openfoam("openfoam_cavity.py")
     n, nu = args.cells, 1.0 / args.re
     case = args.keep or tempfile.mkdtemp(prefix="of_cavity_")
     if args.keep and os.path.exists(case):

@@ -25,21 +25,12 @@ import math
 import os
 import re
 import shutil
-import subprocess
-import sys
 import tempfile
-import time
 
-HEADER = "FoamFile {{ version 2.0; format ascii; class {cls}; object {obj}; }}\n"
+from openfoam_case import HEADER, require_openfoam, run, solve, write
 H, R, CX, CY, PEAK, NU, SPAN = 0.41, 0.05, 0.2, 0.2, 1.5, 0.001, 0.01
 PROBES = [(0.6, 0.2), (1.0, 0.2)]  # wake points: the shedding's strength away from the disk
 REF_CD, REF_CL, REF_ST = 3.23, 1.00, 0.300  # REFERENCES.md: c_D,max ~ 3.23, c_L,max ~ 1.00, St in [0.295, 0.305]
-
-
-def write(path, text):
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    with open(path, "w") as f:
-        f.write(text)
 
 
 def block_mesh(level):
@@ -235,11 +226,6 @@ boundaryField
 """)
 
 
-def run(case, args, log):
-    with open(os.path.join(case, log), "w") as out:
-        subprocess.run(args, cwd=case, stdout=out, stderr=subprocess.STDOUT, check=True)
-
-
 def coefficients(case):
     """(t, c_D, c_L) rows from forceCoeffs' output."""
     found = []
@@ -305,9 +291,7 @@ def main():
                         help="body-fitted O-grid (default) or Monolith's uniform grid with the disk's cells removed")
     parser.add_argument("--keep", help="case directory to keep (default: a temporary one, removed)")
     args = parser.parse_args()
-    if shutil.which("blockMesh") is None:
-        sys.exit("openfoam_dfg2d2.py: OpenFOAM is not installed (Debian 12: apt-get install openfoam)")
-    os.environ.setdefault("WM_PROJECT_DIR", "/usr/share/openfoam")  # Debian's etc/ (global controlDict)
+    require_openfoam("openfoam_dfg2d2.py")
     case = args.keep or tempfile.mkdtemp(prefix="of_dfg_")
     if args.keep and os.path.exists(case):
         shutil.rmtree(case)
@@ -319,14 +303,7 @@ def main():
     run(case, ["checkMesh"], "log.checkMesh")
     cells = int(re.search(r"cells:\s+(\d+)", open(os.path.join(case, "log.checkMesh")).read()).group(1))
     write_fields(case)
-    if args.procs > 1:
-        run(case, ["decomposePar", "-force"], "log.decomposePar")
-        command = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", str(args.procs), "icoFoam", "-parallel"]
-    else:
-        command = ["icoFoam"]
-    begin = time.perf_counter()
-    run(case, command, "log.icoFoam")
-    seconds = time.perf_counter() - begin
+    seconds = solve(case, "icoFoam", args.procs)
     cd_max, cl_max, st, periods = analyse(coefficients(case), args.start)
     steps = int(round(args.end / (0.002 / args.level)))
     print("| code | level | cells | dt | steps | processes | wall s | ms/step | c_D,max | err | c_L,max | err | St | err (vs 0.300) | periods |")
