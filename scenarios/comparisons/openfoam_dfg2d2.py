@@ -29,7 +29,9 @@ import tempfile
 
 from openfoam_case import HEADER, require_openfoam, run, solve, write
 H, R, CX, CY, PEAK, NU, SPAN = 0.41, 0.05, 0.2, 0.2, 1.5, 0.001, 0.01
-PROBES = [(0.6, 0.2), (1.0, 0.2)]  # wake points: the shedding's strength away from the disk
+# Wake points on the centre line: the recirculation just behind the disk (x = 0.26 ... 0.4) and the
+# shedding's strength further away (0.6, 1.0).
+PROBES = [(0.26, 0.2), (0.3, 0.2), (0.35, 0.2), (0.4, 0.2), (0.6, 0.2), (1.0, 0.2)]
 REF_CD, REF_CL, REF_ST = 3.23, 1.00, 0.300  # REFERENCES.md: c_D,max ~ 3.23, c_L,max ~ 1.00, St in [0.295, 0.305]
 
 
@@ -247,8 +249,8 @@ def coefficients(case):
     return rows
 
 
-def wake_amplitudes(case, start):
-    """Half the peak-to-peak v at each wake probe over t >= start."""
+def wake_statistics(case, start):
+    """Mean u and half the peak-to-peak v at each wake probe over t >= start."""
     path = os.path.join(case, "postProcessing", "probes", "0", "U")
     samples = [[] for _ in PROBES]
     with open(path) as f:
@@ -260,8 +262,8 @@ def wake_amplitudes(case, start):
                 continue
             vectors = re.findall(r"\(([-0-9.eE+]+) ([-0-9.eE+]+) [-0-9.eE+]+\)", line)
             for k, v in enumerate(vectors):
-                samples[k].append(float(v[1]))
-    return [(max(v) - min(v)) / 2 for v in samples]
+                samples[k].append((float(v[0]), float(v[1])))
+    return [(sum(u for u, _ in s) / len(s), (max(v for _, v in s) - min(v for _, v in s)) / 2) for s in samples]
 
 
 def analyse(rows, start):
@@ -311,9 +313,9 @@ def main():
     print(f"| OpenFOAM v1912 icoFoam, {'O-grid' if args.mesh == 'ogrid' else 'staircase'} | {args.level} | {cells} | {0.002 / args.level:g} | {steps} | {args.procs} | "
           f"{seconds:.1f} | {1000 * seconds / steps:.2f} | {cd_max:.4f} | {100 * (cd_max / REF_CD - 1):+.1f} % | "
           f"{cl_max:.4f} | {100 * (cl_max / REF_CL - 1):+.1f} % | {st:.4f} | {100 * (st / REF_ST - 1):+.1f} % | {periods} |")
-    amplitudes = wake_amplitudes(case, args.start)
-    print("wake v amplitude (half peak-to-peak, t >= %g): " % args.start +
-          ", ".join(f"({x}, {y}): {a:.4f}" for (x, y), a in zip(PROBES, amplitudes)))
+    print(f"wake probes over t >= {args.start:g}: (x, y): mean u, v amplitude (half peak-to-peak)")
+    for (x, y), (mean_u, amplitude) in zip(PROBES, wake_statistics(case, args.start)):
+        print(f"  ({x}, {y}): {mean_u:.4f}, {amplitude:.4f}")
     if not args.keep:
         shutil.rmtree(case)
 
