@@ -158,7 +158,8 @@ def inlet_profile(case):
 def write_case(case, level, end, procs, staircase):
     dt = 0.002 / level
     write(f"{case}/system/blockMeshDict", block_mesh_uniform(level) if staircase else block_mesh(level))
-    write(f"{case}/system/topoSetDict", topo_set())
+    if staircase:
+        write(f"{case}/system/topoSetDict", topo_set())
     write(f"{case}/system/controlDict", HEADER.format(cls="dictionary", obj="controlDict") + f"""
 application icoFoam; startFrom startTime; startTime 0; stopAt endTime; endTime {end!r}; deltaT {dt!r};
 writeControl runTime; writeInterval {end!r}; purgeWrite 0; writeFormat ascii; writePrecision 10;
