@@ -41,6 +41,12 @@ struct FluidSolverSettings {
   // 5.4.1, 5.7), up to a cell inside the body; true ("surface"): at the body's true surface,
   // found along each pair's direction (docs/architecture.md, measured in docs/benchmarks.md).
   bool obstacleWallAtSurface = false;
+  // Where the advection's samples see that wall: false ("advection_wall": "face", default): behind
+  // the first fluid faces they read the obstacle faces' own velocity or, inside the body, extend
+  // the fluid's (velocity_sampling.h rules 3-4, the thesis's clipping of Sec. 5.2); true
+  // ("surface", needs obstacleWallAtSurface): ghost values continue the velocity linearly through
+  // the wall at the true surface (solvers/advection/wall_ghosts.h).
+  bool advectionWallAtSurface = false;
   // How obstacles meet the pressure: false (scene "obstacle_cells": "staircase", default): cells
   // with the centre inside are solid, their faces carry the body's velocity (Sec. 5.4.1); true
   // ("cut"): faces cut by the body keep their open part as fluid (solvers::cutFaces).

@@ -373,6 +373,10 @@ void parseFluidSolverSettings(const Config& c, FluidSolverSettings& f) {
                 : advection == "none"       ? S::Advection::None
                                             : S::Advection::SemiLagrangian;
   f.obstacleWallAtSurface = c.oneOf("obstacle_wall", {"face", "surface"}, "face") == "surface";
+  f.advectionWallAtSurface = c.oneOf("advection_wall", {"face", "surface"}, "face") == "surface";
+  if (f.advectionWallAtSurface && !f.obstacleWallAtSurface)
+    c.failAt("advection_wall", "\"face\" unless \"obstacle_wall\" is \"surface\" (the ghost values need its wall distances)",
+             "\"surface\"");
   f.cutCells = c.oneOf("obstacle_cells", {"staircase", "cut"}, "staircase") == "cut";
   f.projection = c.oneOf("projection", {"coupled", "chorin"}, "coupled") == "chorin" ? S::Projection::Chorin : S::Projection::Coupled;
   const std::string pc = c.oneOf("preconditioner", {"none", "jacobi", "ic0", "mic0", "multigrid"}, "multigrid");

@@ -5,14 +5,16 @@
 #include "solvers/advection/cfl.h"
 #include "solvers/advection/eno.h"
 #include "solvers/advection/semi_lagrangian.h"
+#include "solvers/advection/wall_ghosts.h"
 #include "systems/fluid_domain.h"
 
 namespace monolith {
 
 namespace {
-// Prescribed faces (walls, inflow, obstacles) and solid cells as the advection schemes see them.
+// Prescribed faces (walls, inflow, obstacles), solid cells and (ghostsAtSurface) the ghost rules of
+// the obstacle walls as the advection schemes see them.
 template <int d>
-solvers::FaceBoundary faceBoundaryOf(const solvers::FluidDomain<d>& domain) {
+solvers::FaceBoundary faceBoundaryOf(const solvers::FluidDomain<d>& domain, bool ghostsAtSurface) {
   solvers::FaceBoundary b;
   const int faces = domain.layout.totalFaces();
   b.prescribedFace.assign(faces, 0);
@@ -29,6 +31,7 @@ solvers::FaceBoundary faceBoundaryOf(const solvers::FluidDomain<d>& domain) {
     anySolid = anySolid || solid[c];
   }
   if (anySolid) b.solidCell = std::move(solid);
+  if (ghostsAtSurface) b.ghosts = solvers::obstacleWallGhosts(domain);  // the wall where the viscous operator has it
   return b;
 }
 }  // namespace
@@ -38,7 +41,7 @@ void FluidAdvection<d>::run(World<d>& world, StepContext& ctx) {
   auto& pool = world.template pool<MacGrid<d>>();
   for (auto& grid : pool.components()) {
     const auto domain = fluidDomainOf(grid);
-    const solvers::FaceBoundary boundary = faceBoundaryOf(domain);
+    const solvers::FaceBoundary boundary = faceBoundaryOf(domain, world.settings().fluid.advectionWallAtSurface);
     const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(grid.u.data(), grid.u.size());
     const auto scheme = world.settings().fluid.advection;
     const Eigen::VectorXd advected =

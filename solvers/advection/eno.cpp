@@ -193,7 +193,7 @@ Eigen::VectorXd enoConvectiveTerm(const MacLayout<d>& layout, const Eigen::Vecto
     for (int b = 0; b < d; ++b) {
       if (w[b] == 0) continue;
       const auto v = gather7<d>(f, b, dims, layout.periodic, [&](const IndexT<d>& n) { return layout.faceIndex(axis, n); },
-                                [&](int face) { return sampler.faceValue(face); });
+                                [&](int face) { return sampler.sampleValue(face); });
       term += w[b] * hjDerivative(stencil, v, layout.dx, w[b] > 0);
     }
     out[g] = term;

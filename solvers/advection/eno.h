@@ -22,7 +22,9 @@
 //     convective term only at O(dx) in the first cells (first order at walls, as the thesis'
 //     Sec. 5.4 wall treatment);
 //   * prescribed faces (walls, coupling faces, faces inside structures) are read as their
-//     prescribed velocity, i.e. the structure velocity is the ghost extension into obstacles;
+//     prescribed velocity, i.e. the structure velocity is the ghost extension into obstacles,
+//     or, where the boundary has ghost rules (wall at the obstacle's surface), as the linear
+//     extension through that wall (velocity_sampling.h, rule 3b);
 //     ENO's smoothest-stencil choice then prefers stencils away from the velocity kink.
 // Prescribed faces get a zero convective term and keep their prescribed value.
 //

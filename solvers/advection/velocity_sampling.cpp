@@ -56,6 +56,15 @@ void validateBoundary(const MacLayout<d>& layout, const FaceBoundary& boundary) 
       if (boundary.prescribedFace[g] && !std::isfinite(boundary.prescribedVelocity[g]))
         throw std::invalid_argument("FaceBoundary: non-finite prescribed velocity at face " + std::to_string(g));
   }
+  for (const GhostRule& rule : boundary.ghosts) {
+    const bool inRange = rule.face >= 0 && rule.face < faces && rule.from >= 0 && rule.from < faces;
+    if (!inRange || !anyPrescribed || !boundary.prescribedFace[rule.face] || boundary.prescribedFace[rule.from])
+      throw std::invalid_argument("FaceBoundary: a ghost rule needs a prescribed face and a free face to extend from");
+    if (layout.faceCoord(rule.face).first != layout.faceCoord(rule.from).first)
+      throw std::invalid_argument("FaceBoundary: a ghost rule joins faces of different axes");
+    if (!(rule.factor >= -1 && rule.factor <= 0))
+      throw std::invalid_argument("FaceBoundary: ghost factor must lie in [-1, 0]");
+  }
   if (boundary.solidCell.empty()) return;
   // The sampler and ENO never read the field on faces touching a structure, so those faces need
   // a prescribed (structure) velocity: thesis Sec. 5.4.1 places the constraints exactly there.
@@ -65,6 +74,11 @@ void validateBoundary(const MacLayout<d>& layout, const FaceBoundary& boundary) 
       throw std::invalid_argument("FaceBoundary: face " + std::to_string(g) +
                                   " touches a solid cell but has no prescribed velocity");
   }
+}
+
+double ghostFactor(double theta) {
+  if (!(theta > 0) || !std::isfinite(theta)) throw std::invalid_argument("ghostFactor: theta must be finite and > 0");
+  return std::clamp(-(1.0 - theta) / theta, -1.0, 0.0);
 }
 
 template <int d>
@@ -92,6 +106,18 @@ FaceVelocitySampler<d>::FaceVelocitySampler(const MacLayout<d>& layout, const Ei
   if (u.size() != layout.totalFaces())
     throw std::invalid_argument("FaceVelocitySampler: field needs one value per face");
   validateBoundary(layout, boundary);
+  if (!boundary.ghosts.empty()) {
+    std::vector<double> sum(layout.totalFaces(), 0.0);
+    std::vector<int> count(layout.totalFaces(), 0);
+    for (const GhostRule& rule : boundary.ghosts) {  // in list order: the sums do not depend on threads
+      const double wall = boundary.prescribedVelocity[rule.face];
+      sum[rule.face] += wall + rule.factor * (u[rule.from] - wall);
+      ++count[rule.face];
+    }
+    ghost_.assign(layout.totalFaces(), std::numeric_limits<double>::quiet_NaN());
+    for (int g = 0; g < layout.totalFaces(); ++g)
+      if (count[g] > 0) ghost_[g] = sum[g] / count[g];
+  }
   if (!hasSolids()) return;
   insideSolid_.assign(layout.totalFaces(), 0);
   for (int g = 0; g < layout.totalFaces(); ++g) {
@@ -179,8 +205,8 @@ double FaceVelocitySampler<d>::component(int axis, const Vec& x, std::pair<doubl
     }
     if (w == 0) continue;  // also keeps exact face-centre samples free of neighbour values
     const int face = layout_.faceIndex(axis, f);
-    const double value = faceValue(face);
-    if (insideSolid(face)) {  // rule 4
+    const double value = sampleValue(face);        // rules 3, 3b
+    if (insideSolid(face) && !hasGhost(face)) {  // rule 4
       dropped = true;
       solidSum += w * value;
       solidLo = std::min(solidLo, value), solidHi = std::max(solidHi, value);

@@ -17,12 +17,20 @@
 //      uses the boundary faces themselves, a tangential component is held constant in the half
 //      cell between the wall and the first row of face centres (zero-gradient extrapolation).
 //   3. A face is read as prescribedVelocity if prescribed, else from the field.
-//   4. Faces "inside" a structure (all existing neighbour cells solid) are dropped from the
+//   3b. A face with ghost rules (FaceBoundary::ghosts, set when the no-slip wall sits at the
+//      obstacle's true surface) is read as its ghost value instead: the linear extension of the
+//      fluid velocity through the wall, so an interpolated sample falls to the wall velocity at
+//      the wall itself rather than at the obstacle face's centre (thesis Sec. 5.2: "ghost cells
+//      or clipping"; Gibou et al. 2002 place the wall the same way). Such faces count as fluid
+//      faces below, also when they lie inside a structure. A ghost value lies between the wall
+//      velocity u_w and its mirror 2 u_w - u_from, so samples stay within the range of the fluid
+//      values reflected about the wall's.
+//   4. Other faces "inside" a structure (all existing neighbour cells solid) are dropped from the
 //      stencil and the remaining weights renormalised, so a sample never pulls velocity from the
 //      interior of an obstacle; faces with one solid neighbour (the coupling faces) do contribute
 //      their prescribed structure velocity. For x in a fluid cell the faces of that cell carry
 //      weight >= 2^-(d-1), so the renormalisation never divides by zero and the sample is a convex
-//      combination of fluid and coupling-face values (bounded by them). Only if x is itself deep
+//      combination of fluid, coupling-face and ghost values (bounded by them). Only if x is itself deep
 //      inside a structure (every stencil face interior) is the prescribed structure velocity
 //      interpolated instead.
 //   5. Traced points are first clipped to the fluid region (clipToFluid): the segment from the
@@ -33,20 +41,37 @@
 #include "solvers/mac_layout.h"
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
 
 namespace monolith::solvers {
 
+// A no-slip wall crosses the segment from the centre of the free face `from` to the centre of the
+// prescribed face `face` (same axis, one cell apart), theta cells from `from`. The ghost value of
+// `face` extends the velocity linearly through the wall:
+//     u_ghost = u_w + factor (u_from - u_w),  factor = -(1 - theta) / theta,
+// u_w being `face`'s prescribed velocity (the wall's). ghostFactor clamps the factor to [-1, 0]
+// (theta >= 1/2): a steeper extension would leave the range of the fluid values and make the
+// advection's samples unbounded. The rules of one face are averaged.
+struct GhostRule {
+  int face = 0;
+  int from = 0;
+  double factor = 0;
+};
+double ghostFactor(double theta);
+
 struct FaceBoundary {
   std::vector<std::uint8_t> solidCell;       // empty, or one flag per cell (layout.cellCount())
   std::vector<std::uint8_t> prescribedFace;  // empty, or one flag per face (layout.totalFaces())
   Eigen::VectorXd prescribedVelocity;        // per face; read only where prescribedFace != 0
+  std::vector<GhostRule> ghosts;             // rule 3b; `face` prescribed, `from` not
 };
 
-// Throws std::invalid_argument on wrong sizes, non-finite prescribed values, or a face next to a
-// solid cell that is not prescribed.
+// Throws std::invalid_argument on wrong sizes, non-finite prescribed values, a face next to a
+// solid cell that is not prescribed, or a ghost rule whose faces are out of range, whose `face`
+// is not prescribed or whose `from` is, or whose factor lies outside [-1, 0].
 template <int d>
 void validateBoundary(const MacLayout<d>& layout, const FaceBoundary& boundary);
 
@@ -75,6 +100,10 @@ class FaceVelocitySampler {
   bool isPrescribed(int face) const { return !boundary_->prescribedFace.empty() && boundary_->prescribedFace[face]; }
   // Value of a stored face: the prescribed velocity if prescribed, else the field (rule 3).
   double faceValue(int face) const { return isPrescribed(face) ? boundary_->prescribedVelocity[face] : (*u_)[face]; }
+  // Value a sample or a stencil reads at a stored face: the ghost value if the face has ghost
+  // rules (rule 3b), else faceValue.
+  double sampleValue(int face) const { return hasGhost(face) ? ghost_[face] : faceValue(face); }
+  bool hasGhost(int face) const { return !ghost_.empty() && !std::isnan(ghost_[face]); }
   // True if every existing neighbour cell of face f of `axis` is solid (rule 4).
   bool faceInsideSolid(int axis, const Index& f) const;
   // Cell containing x (periodic axes wrapped, others clamped to the domain).
@@ -97,6 +126,8 @@ class FaceVelocitySampler {
   // for every corner of every sample, and the neighbour-cell lookup was the advection's hot spot.
   std::vector<std::uint8_t> insideSolid_;
   bool insideSolid(int face) const { return !insideSolid_.empty() && insideSolid_[face]; }
+  // Rule 3b's values for this field, NaN where a face has no rule (empty without rules).
+  std::vector<double> ghost_;
 };
 
 }  // namespace monolith::solvers

@@ -264,6 +264,10 @@ std::vector<Case> cases() {
       {"contact_iterations_negative", scene3(kBall, R"({ "dt": 0.1, "steps": 10 })",
                                              "  \"solvers\": { \"contact\": { \"collision_iterations\": -1 } },\n"),
        "solvers.contact.collision_iterations", {"an integer in [0, 100000]", "-1"}},
+      {"advection_wall_surface_without_wall_distances",
+       scene3(kBall, R"({ "dt": 0.1, "steps": 10 })",
+              "  \"solvers\": { \"fluid\": { \"obstacle_wall\": \"face\", \"advection_wall\": \"surface\" } },\n"),
+       "solvers.fluid.advection_wall", {"\"face\" unless \"obstacle_wall\" is \"surface\"", "\"surface\""}},
       // --- the file itself -----------------------------------------------------------------
       {"missing_scene_file", "", "", {"a readable scene file", "no such file"}, {}, Case::File::Missing},
       {"scene_is_directory", "", "", {"a scene file", "a directory"}, {}, Case::File::Directory},

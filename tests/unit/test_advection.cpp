@@ -6,6 +6,8 @@
 #include "solvers/advection/eno.h"
 #include "solvers/advection/semi_lagrangian.h"
 #include "solvers/advection/velocity_sampling.h"
+#include "solvers/advection/wall_ghosts.h"
+#include "solvers/fluid/boundary.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
@@ -237,6 +239,115 @@ TEST(VelocitySampling, NeverSamplesInsideTheSolid) {
   EXPECT_NEAR(s.component(0, clipped), 0.0, 1e-9);
   // Deep inside the block only the structure's own (prescribed) velocity is available.
   EXPECT_EQ(s.component(0, Vec<2>(16 * h, 12.5 * h)), BlockScene::kInside);
+}
+
+// A shear flow u = c (y - y_w) over a solid floor (cell rows 0 and 1, staircase top at y = 2h)
+// whose no-slip wall sits at y_w = 1.7 h, inside the top solid row: the free u-faces of row 2
+// (y = 2.5 h) are theta = 0.8 cells from the wall, and rule 3b extends their velocity into the
+// u-faces of row 1 (y = 1.5 h) with factor -(1 - 0.8) / 0.8 = -0.25.
+struct ShearOverFloor {
+  static constexpr double kRate = 3.0;
+  static constexpr double kWallCells = 1.7;
+  MacLayout<2> layout{Index<2>(8, 6), 0.125, Vec<2>::Zero(), {true, false}};
+  FaceBoundary boundary;
+  Eigen::VectorXd u;
+
+  ShearOverFloor() {
+    std::vector<std::uint8_t> solid(layout.cellCount(), 0);
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 8; ++i) solid[layout.cellIndex(Index<2>(i, j))] = 1;
+    boundary = staticObstacleBoundary(layout, solid);
+    const double h = layout.dx, yWall = kWallCells * h;
+    u = faceField<2>(layout, [&](int a, const Vec<2>& x) { return a == 0 ? kRate * (x[1] - yWall) : 0.0; });
+    for (int i = 0; i < 8; ++i)
+      boundary.ghosts.push_back({layout.faceIndex(0, Index<2>(i, 1)), layout.faceIndex(0, Index<2>(i, 2)),
+                                 ghostFactor((2.5 * h - yWall) / h)});
+  }
+};
+
+TEST(VelocitySampling, GhostRulesPutTheWallAtTheSurface) {
+  EXPECT_DOUBLE_EQ(ghostFactor(1.0), 0.0);    // wall at the obstacle face: its own value
+  EXPECT_DOUBLE_EQ(ghostFactor(0.8), -0.25);  // linear extension through the wall
+  EXPECT_DOUBLE_EQ(ghostFactor(0.5), -1.0);   // mirror
+  EXPECT_DOUBLE_EQ(ghostFactor(0.1), -1.0);   // clamped: samples stay within the fluid's range
+  EXPECT_THROW(ghostFactor(0.0), std::invalid_argument);
+  EXPECT_THROW(ghostFactor(kNaN), std::invalid_argument);
+
+  ShearOverFloor scene;
+  const double h = scene.layout.dx, yWall = ShearOverFloor::kWallCells * h;
+  const FaceVelocitySampler<2> s(scene.layout, scene.u, scene.boundary);
+  // The ghost row holds the shear profile's value at y = 1.5 h, so samples between the wall and
+  // the first fluid row follow the profile exactly and vanish at the wall.
+  for (double y : {yWall, 2.0 * h, 2.2 * h, 2.5 * h, 3.1 * h})
+    EXPECT_NEAR(s.component(0, Vec<2>(0.37, y)), ShearOverFloor::kRate * (y - yWall), 1e-12) << y / h;
+  // Without the rules the interior row is dropped (rule 4): zero-gradient below the fluid row.
+  FaceBoundary plain = scene.boundary;
+  plain.ghosts.clear();
+  const FaceVelocitySampler<2> p(scene.layout, scene.u, plain);
+  EXPECT_NEAR(p.component(0, Vec<2>(0.37, 2.0 * h)), ShearOverFloor::kRate * 0.8 * h, 1e-12);
+  // The advected field keeps prescribed faces at their prescribed value, and the shear flow
+  // (steady under pure transport along x) stays put to rounding with either scheme.
+  const Eigen::VectorXd sl = advectFacesSemiLagrangian(scene.layout, scene.u, 0.05, scene.boundary);
+  const Eigen::VectorXd mc = advectFacesMacCormack(scene.layout, scene.u, 0.05, scene.boundary);
+  for (int g = 0; g < scene.layout.totalFaces(); ++g) {
+    const double expected = scene.boundary.prescribedFace[g] ? scene.boundary.prescribedVelocity[g] : scene.u[g];
+    EXPECT_NEAR(sl[g], expected, 1e-12) << g;
+    EXPECT_NEAR(mc[g], expected, 1e-12) << g;
+  }
+}
+
+TEST(VelocitySampling, RejectsMalformedGhostRules) {
+  ShearOverFloor scene;
+  const auto& layout = scene.layout;
+  const int ghost = layout.faceIndex(0, Index<2>(3, 1)), fluid = layout.faceIndex(0, Index<2>(3, 2));
+  const auto rejects = [&](GhostRule rule) {
+    FaceBoundary b = scene.boundary;
+    b.ghosts = {rule};
+    EXPECT_THROW(validateBoundary(layout, b), std::invalid_argument);
+  };
+  rejects({fluid, ghost, -0.5});                                       // extends into a free face
+  rejects({ghost, ghost, -0.5});                                       // from a prescribed face
+  rejects({ghost, fluid, -1.5});                                       // factor below -1
+  rejects({ghost, fluid, kNaN});                                       // factor not a number
+  rejects({ghost, layout.totalFaces(), -0.5});                         // out of range
+  rejects({layout.faceIndex(1, Index<2>(3, 1)), fluid, -0.5});         // different axes
+  FaceBoundary ok = scene.boundary;
+  ok.ghosts = {{ghost, fluid, -0.5}};
+  EXPECT_NO_THROW(validateBoundary(layout, ok));
+}
+
+TEST(WallGhosts, RulesFromTheWallDistancesAreExactForLinearShear) {
+  // The floor of ShearOverFloor as a FluidDomain: the wall lies theta cells below the row-2
+  // u-faces. theta = 0.8 extends from row 2; theta = 0.3 from row 3 (extending from row 2 would
+  // need a factor below -1). Either way the ghost value is the linear profile's at y = 1.5 h.
+  const MacLayout<2> layout(Index<2>(8, 6), 0.125, Vec<2>::Zero(), {true, false});
+  BoxSpec<2> sides;
+  sides[0] = sides[1] = SideSpec<2>::periodic();
+  sides[2] = sides[3] = SideSpec<2>::wall();
+  FluidDomain<2> domain = boxDomain(layout, sides);
+  std::vector<std::uint8_t> solid(layout.cellCount(), 0);
+  for (int i = 0; i < 8; ++i) solid[layout.cellIndex(Index<2>(i, 0))] = solid[layout.cellIndex(Index<2>(i, 1))] = 1;
+  markSolid(domain, solid);
+  EXPECT_TRUE(obstacleWallGhosts(domain).empty());  // the thesis's staircase: no rules
+  const double h = layout.dx, rate = 2.0;
+  for (double theta : {0.8, 0.3}) {
+    domain.wallDistance.assign(static_cast<std::size_t>(layout.totalFaces()) * 4, 1.0);
+    for (int i = 0; i < 8; ++i) domain.wallDistance[static_cast<std::size_t>(layout.faceIndex(0, Index<2>(i, 2))) * 4 + 2] = theta;
+    const std::vector<GhostRule> rules = obstacleWallGhosts(domain);
+    ASSERT_EQ(rules.size(), 8u) << theta;  // one per row-2 u-face; none for the v-faces (normal)
+    const double yWall = 2.5 * h - theta * h;
+    FaceBoundary boundary = staticObstacleBoundary(layout, solid);
+    boundary.ghosts = rules;
+    const Eigen::VectorXd u = faceField<2>(layout, [&](int a, const Vec<2>& x) { return a == 0 ? rate * (x[1] - yWall) : 0.0; });
+    const FaceVelocitySampler<2> s(layout, u, boundary);
+    for (const GhostRule& rule : rules) {
+      EXPECT_EQ(layout.faceCoord(rule.face).second[1], 1);
+      EXPECT_EQ(layout.faceCoord(rule.from).second[1], theta < 0.5 ? 3 : 2);
+      EXPECT_GE(rule.factor, -1.0);
+      EXPECT_NEAR(s.sampleValue(rule.face), rate * (1.5 * h - yWall), 1e-12);
+    }
+    EXPECT_NEAR(s.component(0, Vec<2>(0.3, yWall)), 0.0, 1e-12) << theta;  // no slip at the wall
+  }
 }
 
 TEST(SemiLagrangian, SolidBlockStaysBoundedAndFinite) {
@@ -597,13 +708,28 @@ TEST(Determinism, OneAndTwoThreadsBitwiseEqual) {
   for (int g = 0; g < u0.size(); ++g)
     if (!scene.boundary.prescribedFace[g]) u0[g] += noise(rng);
   const Eigen::VectorXd phi0 = cellField<2>(scene.layout, [](const Vec<2>& x) { return std::cos(5 * x[0] + 3 * x[1]); });
+  // The same block with ghost rules (rule 3b) on every face next to it, wall half way.
+  FaceBoundary ghosted = scene.boundary;
+  for (int g = 0; g < scene.layout.totalFaces(); ++g) {
+    if (ghosted.prescribedFace[g]) continue;
+    const auto [a, f] = scene.layout.faceCoord(g);
+    const int b = 1 - a;
+    for (int step : {-1, 1}) {
+      Index<2> h = f;
+      h[b] += step;
+      if (h[b] < 0 || h[b] >= scene.layout.faceDims(a)[b]) continue;
+      const int face = scene.layout.faceIndex(a, h);
+      if (ghosted.prescribedFace[face]) ghosted.ghosts.push_back({face, g, ghostFactor(0.6)});
+    }
+  }
+  ASSERT_GT(ghosted.ghosts.size(), 20u);
   const MacLayout<3> layout3 = periodicBox<3>(12, 1.0);
   const Eigen::VectorXd w0 = faceField<3>(layout3, [](int a, const Vec<3>& x) { return std::sin(6 * x[a] + a) + x[(a + 1) % 3]; });
   auto run = [&](int threads) {
     tbb::task_arena arena(threads);
     std::vector<Eigen::VectorXd> out;
     arena.execute([&] {
-      Eigen::VectorXd sl = u0, mc = u0, eno = u0, weno = u0, phi = phi0, w = w0;
+      Eigen::VectorXd sl = u0, mc = u0, eno = u0, weno = u0, phi = phi0, w = w0, mcGhost = u0, wenoGhost = u0;
       for (int s = 0; s < 5; ++s) {
         sl = advectFacesSemiLagrangian(scene.layout, sl, 1.5 * scene.layout.dx, scene.boundary);
         mc = advectFacesMacCormack(scene.layout, mc, 1.5 * scene.layout.dx, scene.boundary);
@@ -611,8 +737,10 @@ TEST(Determinism, OneAndTwoThreadsBitwiseEqual) {
         weno = advectFacesEnoRk3(scene.layout, weno, 0.4 * scene.layout.dx, scene.boundary, HjStencil::Weno5);
         phi = advectScalarEnoRk3(scene.layout, phi, eno, 0.4 * scene.layout.dx, scene.boundary);
         w = advectFacesEnoRk3(layout3, advectFacesSemiLagrangian(layout3, w, 0.05), 0.02);
+        mcGhost = advectFacesMacCormack(scene.layout, mcGhost, 1.5 * scene.layout.dx, ghosted);
+        wenoGhost = advectFacesEnoRk3(scene.layout, wenoGhost, 0.4 * scene.layout.dx, ghosted, HjStencil::Weno5);
       }
-      out = {sl, mc, eno, weno, phi, w};
+      out = {sl, mc, eno, weno, phi, w, mcGhost, wenoGhost};
     });
     return out;
   };
@@ -623,6 +751,9 @@ TEST(Determinism, OneAndTwoThreadsBitwiseEqual) {
     EXPECT_EQ(std::memcmp(one[k].data(), two[k].data(), sizeof(double) * one[k].size()), 0) << "output " << k;
     EXPECT_TRUE(one[k].allFinite());
   }
+  // The ghost rules are read: they change the flow next to the block.
+  EXPECT_GT((one[1] - one[6]).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_GT((one[3] - one[7]).cwiseAbs().maxCoeff(), 1e-3);
 }
 
 }  // namespace
