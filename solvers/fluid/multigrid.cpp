@@ -24,10 +24,14 @@ struct Level {
   MacLayout<d> layout;
   std::vector<uint8_t> type;  // per cell
   std::vector<uint8_t> open;  // per face
+  // Per face, the open fraction weighting coef (cut faces, multigrid.h); empty: every open face
+  // has weight 1 (the staircase, no per-face tables in the smoother).
+  std::vector<double> weight;
   double coef = 0;            // h^(d-2) / rho
   std::vector<int> cellToUnknown, unknownToCell;
   std::vector<double> diag;                  // per unknown
   std::vector<std::array<int, 2 * d>> nbr;   // per unknown: unknown across an open face, else -1
+  std::vector<std::array<double, 2 * d>> nbrWeight;  // per unknown, with weight: that face's weight
   std::array<std::vector<int>, 2> colour;    // unknowns by parity of the coordinate sum
   bool redBlack = true;
   SparseMatrixR P, R;                        // to / from the next coarser level (R = P^T)
@@ -69,6 +73,7 @@ struct Level {
     const int m = unknowns();
     diag.assign(m, 0.0);
     nbr.resize(m);
+    nbrWeight.assign(weight.empty() ? 0 : m, {});
     colour[0].clear();
     colour[1].clear();
     for (int u = 0; u < m; ++u) {
@@ -77,10 +82,12 @@ struct Level {
         for (int side = 0; side < 2; ++side) {
           int& k = nbr[u][2 * a + side];
           k = -1;
-          if (!open[faceOf(ci, a, side)]) continue;
-          diag[u] += coef;
+          const int face = faceOf(ci, a, side);
+          if (!open[face]) continue;
+          diag[u] += weight.empty() ? coef : coef * weight[face];
           int other = -1;
           if (neighbour(ci, a, side, other)) k = cellToUnknown[other];
+          if (!weight.empty()) nbrWeight[u][2 * a + side] = weight[face];
         }
       colour[ci.sum() % 2].push_back(u);
     }
@@ -92,10 +99,16 @@ struct Level {
     r.setZero(m);
   }
 
+  // Sum over the open faces of u of (weight x) v at the neighbour unknown.
   double offSum(int u, const Eigen::VectorXd& v) const {
     double s = 0;
-    for (int k : nbr[u])
-      if (k >= 0) s += v[k];
+    if (weight.empty()) {
+      for (int k : nbr[u])
+        if (k >= 0) s += v[k];
+      return s;
+    }
+    for (int j = 0; j < 2 * d; ++j)
+      if (nbr[u][j] >= 0) s += nbrWeight[u][j] * v[nbr[u][j]];
     return s;
   }
   void residual() {
@@ -148,9 +161,12 @@ Level<d> coarsen(const Level<d>& fine) {
     else if (t == kUnknown && pt != kDirichlet) pt = kUnknown;
   }
   coarse.open.assign(layout.totalFaces(), 0);
+  if (!fine.weight.empty()) coarse.weight.assign(layout.totalFaces(), 0.0);
   for (int f = 0; f < layout.totalFaces(); ++f) {
     auto [a, F] = layout.faceCoord(f);
-    for (int k = 0; k < (1 << (d - 1)) && !coarse.open[f]; ++k) {
+    double weightSum = 0;
+    int counted = 0;
+    for (int k = 0; k < (1 << (d - 1)) && (!coarse.open[f] || !fine.weight.empty()); ++k) {
       Index ff = 2 * F;
       ff[a] = std::min(ff[a], fine.layout.cells[a]);  // the upper boundary face of an odd axis
       int bit = 0;
@@ -160,8 +176,17 @@ Level<d> coarsen(const Level<d>& fine) {
         ff[b] += (k >> bit++) & 1;
         exists &= ff[b] < fine.layout.cells[b];  // the missing half of an odd axis' last cell
       }
-      if (exists && fine.open[fine.layout.faceIndex(a, ff)]) coarse.open[f] = 1;
+      if (!exists) continue;
+      const int fineFace = fine.layout.faceIndex(a, ff);
+      if (fine.open[fineFace]) coarse.open[f] = 1;
+      if (!fine.weight.empty()) {  // a closed fine face counts with weight 0
+        weightSum += fine.open[fineFace] ? fine.weight[fineFace] : 0.0;
+        ++counted;
+      }
     }
+    // The coarse face carries the mean conductance of the fine faces it covers (rediscretization:
+    // with weights 1 this is the staircase's coefficient).
+    if (!fine.weight.empty() && coarse.open[f]) coarse.weight[f] = weightSum / counted;
   }
   coarse.finalize();
   return coarse;
@@ -283,6 +308,12 @@ PoissonMultigrid<d>::PoissonMultigrid(const FluidOperators<d>& ops, const Multig
                                                            : kSolid;
   top.open.resize(domain.layout.totalFaces());
   for (int f = 0; f < domain.layout.totalFaces(); ++f) top.open[f] = domain.faces[f] == FaceKind::Free;
+  // Cut faces: the Poisson block weights a free face by its open fraction (spd_systems.h).
+  if (!domain.openFraction.empty()) {
+    top.weight.assign(domain.layout.totalFaces(), 0.0);
+    for (int f = 0; f < domain.layout.totalFaces(); ++f)
+      if (top.open[f]) top.weight[f] = domain.openFraction[f];
+  }
   top.finalize();
   impl_->pressureToLevel0.resize(ops.pressureCount());
   for (int p = 0; p < ops.pressureCount(); ++p) impl_->pressureToLevel0[p] = top.cellToUnknown[ops.dofs.pressureToCell[p]];
@@ -305,8 +336,8 @@ PoissonMultigrid<d>::PoissonMultigrid(const FluidOperators<d>& ops, const Multig
     Eigen::MatrixXd A = Eigen::MatrixXd::Zero(C.unknowns(), C.unknowns());
     for (int u = 0; u < C.unknowns(); ++u) {
       A(u, u) = C.diag[u];
-      for (int k : C.nbr[u])
-        if (k >= 0) A(u, k) -= C.coef;
+      for (int j = 0; j < 2 * d; ++j)
+        if (C.nbr[u][j] >= 0) A(u, C.nbr[u][j]) -= C.weight.empty() ? C.coef : C.coef * C.nbrWeight[u][j];
     }
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A);
     const Eigen::VectorXd& lambda = eig.eigenvalues();
