@@ -275,7 +275,7 @@ std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d
     const auto x = layout.faceCenter(a, f);
     double t = std::numeric_limits<double>::infinity();
     for (const auto& [shape, body] : obstacles) t = std::min(t, rayEntry(*shape, *body, x, e, layout.dx));
-    distance[static_cast<std::size_t>(g) * 2 * d + 2 * b + (dir > 0)] =
+    distance[solvers::FluidDomain<d>::wallDistanceIndex(g, b, dir > 0)] =
         std::clamp(t / layout.dx, solvers::FluidDomain<d>::kMinWallDistance, 1.0);
   });
   return distance;
@@ -336,7 +336,7 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
     const std::vector<double>& wallDistance = grid.obstacleWallDistance;
     const auto isFree = [&](int g) { return gridFaceFree(layout, grid, g); };
     forEachPairIntoMarkedFaces(layout, isFree, mine, [&](int g, int a, const Index& fi, int b, int dir) {
-      const double theta = wallDistance.empty() ? 1.0 : wallDistance[static_cast<std::size_t>(g) * 2 * d + 2 * b + (dir > 0)];
+      const double theta = wallDistance.empty() ? 1.0 : wallDistance[solvers::FluidDomain<d>::wallDistanceIndex(g, b, dir > 0)];
       // The operator's known value: the obstacle face's prescribed velocity (its centre, one cell away).
       Eigen::Matrix<double, d, 1> wallPoint = layout.faceCenter(a, fi);
       wallPoint[b] += dir * layout.dx;

@@ -30,7 +30,7 @@ std::vector<GhostRule> obstacleWallGhosts(const FluidDomain<d>& domain) {
         const int towards = s == 0 ? -1 : 1;
         const auto h = stepFace(layout, a, f, b, towards);
         if (!h || domain.faces[*h] != FaceKind::Prescribed) continue;
-        const double theta = domain.wallDistance[static_cast<std::size_t>(g) * 2 * d + 2 * b + s];
+        const double theta = domain.wallDistance[FluidDomain<d>::wallDistanceIndex(g, b, s)];
         if (theta < 0.5) {
           const auto o = stepFace(layout, a, f, b, -towards);
           if (o && domain.faces[*o] == FaceKind::Free) {

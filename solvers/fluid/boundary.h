@@ -80,6 +80,10 @@ struct FluidDomain {
   // The viscous operator reads it for pairs whose other end is a prescribed face (operators.h).
   std::vector<double> wallDistance;
   static constexpr double kMinWallDistance = 0.1;  // bounds the wall term's weight by 1/0.1
+  // Position in wallDistance of face `face`'s entry along axis b towards side s (0: -e_b, 1: +e_b).
+  static std::size_t wallDistanceIndex(int face, int b, int s) {
+    return static_cast<std::size_t>(face) * 2 * d + 2 * b + s;
+  }
   // Optional cut faces (see cutFaces); empty: every face is wholly open or wholly covered (the
   // staircase). Else openFraction[face] in (0, 1] for Free faces: the part of the face's area
   // outside every obstacle. The rest of such a face moves with the obstacle: faceVelocity holds

@@ -157,8 +157,8 @@ void buildViscousRows(FluidOperators<d>& ops) {
           // ghost above); G_mu^T G_mu keeps its symmetric form. (Pairs ending on a domain wall's
           // normal face have theta = 1: the wall is at that face.)
           const auto theta = [&](const PairEnd& unknown, int towardsUpper) {
-            return domain.wallDistance[static_cast<std::size_t>(ops.dofs.velocityToFace[unknown.velocity]) * 2 * d + 2 * b +
-                                       towardsUpper];
+            return domain.wallDistance[FluidDomain<d>::wallDistanceIndex(ops.dofs.velocityToFace[unknown.velocity], b,
+                                                                         towardsUpper)];
           };
           if (e0.kind == PairEnd::Unknown && e1.kind == PairEnd::Known && !e1.ghost) c = w / std::sqrt(theta(e0, 1));
           if (e1.kind == PairEnd::Unknown && e0.kind == PairEnd::Known && !e0.ghost) c = w / std::sqrt(theta(e1, 0));

@@ -332,7 +332,7 @@ TEST(WallGhosts, RulesFromTheWallDistancesAreExactForLinearShear) {
   const double h = layout.dx, rate = 2.0;
   for (double theta : {0.8, 0.3}) {
     domain.wallDistance.assign(static_cast<std::size_t>(layout.totalFaces()) * 4, 1.0);
-    for (int i = 0; i < 8; ++i) domain.wallDistance[static_cast<std::size_t>(layout.faceIndex(0, Index<2>(i, 2))) * 4 + 2] = theta;
+    for (int i = 0; i < 8; ++i) domain.wallDistance[FluidDomain<2>::wallDistanceIndex(layout.faceIndex(0, Index<2>(i, 2)), 1, 0)] = theta;
     const std::vector<GhostRule> rules = obstacleWallGhosts(domain);
     ASSERT_EQ(rules.size(), 8u) << theta;  // one per row-2 u-face; none for the v-faces (normal)
     const double yWall = 2.5 * h - theta * h;
