@@ -34,6 +34,11 @@ struct FluidSolverSettings {
   Advection advection = Advection::SemiLagrangian;
   Projection projection = Projection::Coupled;
   Preconditioner preconditioner = Preconditioner::Multigrid;  // flat iteration counts (benchmarks)
+  // The coupled solve's preconditioner around the Poisson one: false (scene
+  // "coupled_preconditioner": "block_diagonal"): the Poisson preconditioner and a Jacobi viscous
+  // block (notes 4.4); true ("cut_corrected", default): the same plus an exact solve on the band
+  // of unknowns around cut faces (solvers/fluid/coupled_preconditioner.h). Identical without cut faces.
+  bool coupledCutCorrection = true;
   double tolerance = 1e-8;   // relative residual of the Krylov solve
   int maxIterations = 5000;
   // Where the viscous operator puts an obstacle's no-slip wall: false (scene "obstacle_wall":

@@ -385,6 +385,8 @@ void parseFluidSolverSettings(const Config& c, FluidSolverSettings& f) {
                      : pc == "ic0"    ? S::Preconditioner::IC0
                      : pc == "mic0"   ? S::Preconditioner::MIC0
                                       : S::Preconditioner::Multigrid;
+  f.coupledCutCorrection =
+      c.oneOf("coupled_preconditioner", {"block_diagonal", "cut_corrected"}, "cut_corrected") == "cut_corrected";
   f.tolerance = c.number("tolerance", f.tolerance, Bound::Positive);
   if (f.tolerance >= 1) c.failAt("tolerance", "a relative tolerance below 1", formatNumber(f.tolerance));
   f.maxIterations = static_cast<int>(c.integer("max_iterations", f.maxIterations, 1, 1000000));

@@ -17,7 +17,9 @@ struct FluidProjection<d>::Cache {
   double dt = -1, density = 0, viscosity = -1;
   solvers::PoissonPreconditionerKind kind = solvers::PoissonPreconditionerKind::None;
   std::unique_ptr<solvers::FluidOperators<d>> ops;
+  bool cutCorrection = false;
   std::unique_ptr<solvers::PoissonPreconditioner<d>> preconditioner;
+  std::unique_ptr<solvers::CoupledPreconditioner<d>> coupled;  // wraps `preconditioner`
 };
 
 template <int d>
@@ -54,11 +56,18 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
     Cache& c = *cache_;
     const auto kind = preconditionerKind(settings.preconditioner);
     if (!c.ops || c.dt != ctx.dt || c.density != rho || c.viscosity != mu || c.solid != grid.solid || c.kind != kind ||
+        c.cutCorrection != settings.coupledCutCorrection ||
         c.wallDistance != grid.obstacleWallDistance || c.openFraction != grid.openFraction ||
         ((grid.obstaclesMove() || !c.motions.empty()) && c.motions != grid.obstacleMotions)) {
       c.ops = std::make_unique<solvers::FluidOperators<d>>(
           solvers::buildFluidOperators(fluidDomainOf(grid), solvers::FluidParameters{rho, mu, ctx.dt}));
       c.preconditioner = std::make_unique<solvers::PoissonPreconditioner<d>>(*c.ops, kind);
+      c.cutCorrection = settings.coupledCutCorrection;
+      if (settings.projection == FluidSolverSettings::Projection::Coupled)
+        c.coupled = std::make_unique<solvers::CoupledPreconditioner<d>>(
+            *c.ops, *c.preconditioner,
+            c.cutCorrection ? solvers::CoupledPreconditionerKind::CutCorrected
+                            : solvers::CoupledPreconditionerKind::BlockDiagonal);
       c.dt = ctx.dt;
       c.density = rho;
       c.viscosity = mu;
@@ -70,6 +79,8 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
     }
     solvers::ProjectionSettings ps;
     ps.preconditioner = kind;
+    ps.coupledPreconditioner = settings.coupledCutCorrection ? solvers::CoupledPreconditionerKind::CutCorrected
+                                                             : solvers::CoupledPreconditionerKind::BlockDiagonal;
     ps.solve.maxIterations = settings.maxIterations;
     ps.solve.relativeTolerance = settings.tolerance;
     ps.viscosity.maxIterations = settings.maxIterations;
@@ -79,7 +90,7 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
     const solvers::ProjectionReport report =
         settings.projection == FluidSolverSettings::Projection::Chorin
             ? solvers::chorinProjection(*c.ops, u, ps, c.preconditioner.get())
-            : solvers::coupledProjection(*c.ops, u, ps, c.preconditioner.get());
+            : solvers::coupledProjection(*c.ops, u, ps, c.preconditioner.get(), c.coupled.get());
     Eigen::Map<Eigen::VectorXd>(grid.u.data(), grid.u.size()) = u;
     for (std::size_t i = 0; i < grid.p.size(); ++i) grid.p[i] = report.pressure[static_cast<Eigen::Index>(i)];
 

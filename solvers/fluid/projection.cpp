@@ -80,9 +80,15 @@ ProjectionReport chorinProjection(const FluidOperators<d>& ops, Eigen::VectorXd&
 
 template <int d>
 ProjectionReport coupledProjection(const FluidOperators<d>& ops, Eigen::VectorXd& faceVelocities,
-                                   const ProjectionSettings& settings, const PoissonPreconditioner<d>* given) {
+                                   const ProjectionSettings& settings, const PoissonPreconditioner<d>* given,
+                                   const CoupledPreconditioner<d>* coupled) {
   std::unique_ptr<PoissonPreconditioner<d>> owned;
-  const PoissonPreconditioner<d>* pre = choosePreconditioner(ops, settings, given, owned);
+  std::unique_ptr<CoupledPreconditioner<d>> ownedCoupled;
+  if (!coupled) {
+    const PoissonPreconditioner<d>* pre = choosePreconditioner(ops, settings, given, owned);
+    ownedCoupled = std::make_unique<CoupledPreconditioner<d>>(ops, *pre, settings.coupledPreconditioner);
+    coupled = ownedCoupled.get();
+  }
   const int np = ops.pressureCount(), nr = ops.viscousCount();
   const Eigen::VectorXd uStar = freeVelocities(ops, faceVelocities);
 
@@ -95,20 +101,11 @@ ProjectionReport coupledProjection(const FluidOperators<d>& ops, Eigen::VectorXd
     rhs.tail(nr) += ops.viscousKnown;
   }
 
-  // Block-diagonal preconditioner: Poisson preconditioner on p_hat, Jacobi on u_hat.
   CoupledOperator<d> system(ops);
-  const Eigen::VectorXd viscousInverse = system.viscousDiagonal().cwiseInverse();
-  Eigen::VectorXd rp(np), zp(np);
-  LinearOperator block = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
-    rp = r.head(np);
-    pre->apply(rp, zp);
-    z.head(np) = zp;
-    if (nr > 0) z.tail(nr) = r.tail(nr).cwiseProduct(viscousInverse);
-  };
-
   ProjectionReport report;
   Eigen::VectorXd z = Eigen::VectorXd::Zero(np + nr);
-  report.solve = conjugateGradient(system.asOperator(), block, closedRegionProjector(ops.dofs, 0), rhs, z, settings.solve);
+  report.solve = conjugateGradient(system.asOperator(), coupled->asOperator(), closedRegionProjector(ops.dofs, 0), rhs,
+                                   z, settings.solve);
 
   // u = u* - beta^-1 (G p_hat + G_mu^T u_hat)
   Eigen::VectorXd faces(ops.velocityCount()), visc(ops.velocityCount());
@@ -132,7 +129,8 @@ ProjectionReport coupledProjection(const FluidOperators<d>& ops, Eigen::VectorXd
   template ProjectionReport chorinProjection<D>(const FluidOperators<D>&, Eigen::VectorXd&,                 \
                                                 const ProjectionSettings&, const PoissonPreconditioner<D>*);   \
   template ProjectionReport coupledProjection<D>(const FluidOperators<D>&, Eigen::VectorXd&,                \
-                                                 const ProjectionSettings&, const PoissonPreconditioner<D>*);
+                                                 const ProjectionSettings&, const PoissonPreconditioner<D>*, \
+                                                 const CoupledPreconditioner<D>*);
 
 MONOLITH_FLUID_PROJECTION(2)
 MONOLITH_FLUID_PROJECTION(3)

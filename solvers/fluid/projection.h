@@ -24,6 +24,7 @@
 // is projected to zero mean on each such region (this only removes rounding when the prescribed
 // fluxes are compatible, and gives the least-squares answer when they are not), and CG projects
 // every preconditioned residual (krylov.h), so the returned pressure has zero mean on the region.
+#include "solvers/fluid/coupled_preconditioner.h"
 #include "solvers/fluid/krylov.h"
 #include "solvers/fluid/operators.h"
 #include "solvers/fluid/poisson_preconditioner.h"
@@ -32,6 +33,7 @@ namespace monolith::solvers {
 
 struct ProjectionSettings {
   PoissonPreconditionerKind preconditioner = PoissonPreconditionerKind::MIC0;
+  CoupledPreconditionerKind coupledPreconditioner = CoupledPreconditionerKind::CutCorrected;  // (b) only
   CgSettings solve{10000, 1e-10, 0};     // pressure Poisson or the coupled (5.31) solve
   CgSettings viscosity{10000, 1e-10, 0}; // Chorin's implicit viscosity solve (Jacobi-PCG)
 };
@@ -62,10 +64,13 @@ ProjectionReport chorinProjection(const FluidOperators<d>& ops, Eigen::VectorXd&
 
 // (b). Block preconditioner: `preconditioner` (settings.preconditioner, MIC(0) by default) on the
 // pressure block, Jacobi on the viscous block (notes 4.4: IC(0) on the pressure block and a
-// diagonal on the others).
+// diagonal on the others), with cut faces corrected by an exact solve on the band around them
+// (settings.coupledPreconditioner, coupled_preconditioner.h). `coupled` may be null: one is then
+// built for this call around `preconditioner`.
 template <int d>
 ProjectionReport coupledProjection(const FluidOperators<d>& ops, Eigen::VectorXd& faceVelocities,
                                    const ProjectionSettings& settings,
-                                   const PoissonPreconditioner<d>* preconditioner = nullptr);
+                                   const PoissonPreconditioner<d>* preconditioner = nullptr,
+                                   const CoupledPreconditioner<d>* coupled = nullptr);
 
 }  // namespace monolith::solvers

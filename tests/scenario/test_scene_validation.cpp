@@ -268,6 +268,10 @@ std::vector<Case> cases() {
        scene3(kBall, R"({ "dt": 0.1, "steps": 10 })",
               "  \"solvers\": { \"fluid\": { \"obstacle_wall\": \"face\", \"advection_wall\": \"surface\" } },\n"),
        "solvers.fluid.advection_wall", {"\"face\" unless \"obstacle_wall\" is \"surface\"", "\"surface\""}},
+      {"coupled_preconditioner_unknown",
+       scene3(kBall, R"({ "dt": 0.1, "steps": 10 })",
+              "  \"solvers\": { \"fluid\": { \"coupled_preconditioner\": \"cut\" } },\n"),
+       "solvers.fluid.coupled_preconditioner", {"one of \"block_diagonal\", \"cut_corrected\"", "the string \"cut\""}},
       // --- the file itself -----------------------------------------------------------------
       {"missing_scene_file", "", "", {"a readable scene file", "no such file"}, {}, Case::File::Missing},
       {"scene_is_directory", "", "", {"a scene file", "a directory"}, {}, Case::File::Directory},
