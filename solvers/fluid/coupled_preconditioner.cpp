@@ -136,7 +136,8 @@ void CoupledPreconditioner<d>::apply(const Eigen::VectorXd& r, Eigen::VectorXd& 
   const int m = static_cast<int>(band_.size());
   // z1 = L r, supported on the band.
   for (int k = 0; k < m; ++k) local_[k] = r[band_[k]];
-  const Eigen::VectorXd z1 = bandSolve_.solve(local_);
+  bandZ1_ = bandSolve_.solve(local_);
+  const Eigen::VectorXd& z1 = bandZ1_;
   // z2 = B^-1 (r - A z1); A z1 = bandRows_^T z1 (A symmetric).
   residual_ = r;
   for (int k = 0; k < m; ++k)
@@ -145,8 +146,8 @@ void CoupledPreconditioner<d>::apply(const Eigen::VectorXd& r, Eigen::VectorXd& 
   applyBlockDiagonal(residual_, z);
   // z = z1 + z2 - L A z2, with (A z2)_band = bandRows_ z2.
   correction_ = bandRows_ * z;
-  const Eigen::VectorXd lz2 = bandSolve_.solve(correction_);
-  for (int k = 0; k < m; ++k) z[band_[k]] += z1[k] - lz2[k];
+  local_ = bandSolve_.solve(correction_);
+  for (int k = 0; k < m; ++k) z[band_[k]] += z1[k] - local_[k];
 }
 
 template <int d>

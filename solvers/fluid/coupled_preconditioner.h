@@ -49,6 +49,10 @@ class CoupledPreconditioner {
   LinearOperator asOperator() const;
   // Unknowns of the band (0 for BlockDiagonal or without cut faces).
   int bandSize() const { return static_cast<int>(band_.size()); }
+  // The band (indices into z, ascending) and A's rows for it, built from the face stencils (for
+  // tests: they must equal the rows of assembleCoupled).
+  const std::vector<int>& band() const { return band_; }
+  const Eigen::SparseMatrix<double, Eigen::RowMajor>& bandRows() const { return bandRows_; }
 
  private:
   void applyBlockDiagonal(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
@@ -61,7 +65,7 @@ class CoupledPreconditioner {
   Eigen::SparseMatrix<double, Eigen::RowMajor> bandRows_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> bandSolve_;
   // Workspace (one instance must not be applied from two threads at once).
-  mutable Eigen::VectorXd rp_, zp_, residual_, local_, correction_;
+  mutable Eigen::VectorXd rp_, zp_, residual_, local_, bandZ1_, correction_;
 };
 
 }  // namespace monolith::solvers

@@ -177,6 +177,18 @@ TEST(CoupledPreconditioner, IsSymmetricPositive) {
       }
     }
   }
+  // The band's rows, built from the face stencils, are the rows of the assembled (5.31).
+  {
+    const FluidOperators<2> ops = buildFluidOperators(cutObstacleChannel2(45, 21), kViscousCut);
+    const PoissonPreconditioner<2> mg(ops, Kind::Multigrid);
+    const CoupledPreconditioner<2> pre(ops, mg, CoupledPreconditionerKind::CutCorrected);
+    const SparseMatrixR assembled = assembleCoupled(ops);
+    ASSERT_EQ(pre.bandRows().rows(), pre.bandSize());
+    for (int k = 0; k < pre.bandSize(); ++k) {
+      const Eigen::SparseVector<double> difference = pre.bandRows().row(k) - assembled.row(pre.band()[k]);
+      EXPECT_LE(difference.cwiseAbs().sum(), 1e-12 * assembled.row(pre.band()[k]).cwiseAbs().sum()) << "band row " << k;
+    }
+  }
   // The closed box's cells all border a cut face, yet none may be in the band: only viscous rows.
   const FluidOperators<2> ops = buildFluidOperators(tiny, kViscousCut);
   const PoissonPreconditioner<2> mg(ops, Kind::Multigrid);
