@@ -55,6 +55,8 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
     // obstacle changes the prescribed face velocities folded into them).
     Cache& c = *cache_;
     const auto kind = preconditionerKind(settings.preconditioner);
+    const auto coupledKind = settings.coupledCutCorrection ? solvers::CoupledPreconditionerKind::CutCorrected
+                                                           : solvers::CoupledPreconditionerKind::BlockDiagonal;
     if (!c.ops || c.dt != ctx.dt || c.density != rho || c.viscosity != mu || c.solid != grid.solid || c.kind != kind ||
         c.cutCorrection != settings.coupledCutCorrection ||
         c.wallDistance != grid.obstacleWallDistance || c.openFraction != grid.openFraction ||
@@ -63,11 +65,9 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
           solvers::buildFluidOperators(fluidDomainOf(grid), solvers::FluidParameters{rho, mu, ctx.dt}));
       c.preconditioner = std::make_unique<solvers::PoissonPreconditioner<d>>(*c.ops, kind);
       c.cutCorrection = settings.coupledCutCorrection;
-      if (settings.projection == FluidSolverSettings::Projection::Coupled)
-        c.coupled = std::make_unique<solvers::CoupledPreconditioner<d>>(
-            *c.ops, *c.preconditioner,
-            c.cutCorrection ? solvers::CoupledPreconditionerKind::CutCorrected
-                            : solvers::CoupledPreconditionerKind::BlockDiagonal);
+      c.coupled = settings.projection == FluidSolverSettings::Projection::Coupled
+                      ? std::make_unique<solvers::CoupledPreconditioner<d>>(*c.ops, *c.preconditioner, coupledKind)
+                      : nullptr;
       c.dt = ctx.dt;
       c.density = rho;
       c.viscosity = mu;
@@ -79,8 +79,7 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
     }
     solvers::ProjectionSettings ps;
     ps.preconditioner = kind;
-    ps.coupledPreconditioner = settings.coupledCutCorrection ? solvers::CoupledPreconditionerKind::CutCorrected
-                                                             : solvers::CoupledPreconditionerKind::BlockDiagonal;
+    ps.coupledPreconditioner = coupledKind;
     ps.solve.maxIterations = settings.maxIterations;
     ps.solve.relativeTolerance = settings.tolerance;
     ps.viscosity.maxIterations = settings.maxIterations;
