@@ -18,29 +18,10 @@ void Collisions<d>::run(World<d>& world, StepContext& ctx) {
   std::vector<int> impulses(ws.islands.members.size(), 0), clamps(ws.islands.members.size(), 0);
   std::vector<double> clampChange(ws.islands.members.size(), 0.0);
   ws.forEachIsland([&](int island) {
-    std::vector<solvers::collision::ContactPoint<d>> scratch;
-    const auto& list = ws.islands.pairs[island];
-    long stamp = 1;  // per island: "checked" after both bodies last moved -> skip (notes 1.4)
     for (int sweep = 0; sweep < ws.settings.collisionIterations; ++sweep) {
-      bool any = false;
-      for (int p : list) {
-        ContactPairState& pair = ws.pairs[p];
-        auto& A = ws.bodies[pair.a];
-        auto& B = ws.bodies[pair.b];
-        if (pair.checkedStamp > std::max(A.movedStamp, B.movedStamp)) continue;
-        const int n = ws.updatePair(pair, ImpulseMode::Collision, 0.0, ws.settings.collisionPairIterations, 0.0,
-                                    scratch, &clampChange[island], &clamps[island]);
-        ++stamp;
-        if (n > 0) {
-          any = true;
-          impulses[island] += n;
-          if (!A.infinite()) A.movedStamp = stamp;
-          if (!B.infinite()) B.movedStamp = stamp;
-          ++stamp;
-        }
-        pair.checkedStamp = stamp;
-      }
-      if (!any) break;
+      const int n = ws.collisionSweep(island, sweep, &clampChange[island], &clamps[island]);
+      impulses[island] += n;
+      if (n == 0) break;
     }
   });
 

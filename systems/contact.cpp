@@ -13,10 +13,8 @@ void Contact<d>::run(World<d>&, StepContext& ctx) {
   if (ws.bodies.empty()) return;
   ws.updateAllCandidates();
   std::vector<int> impulses(ws.islands.members.size(), 0);
-  ws.forEachIsland([&](int island) {
-    std::vector<solvers::collision::ContactPoint<d>> scratch;
-    impulses[island] = ws.contactSweeps(island, ImpulseMode::Contact, false, scratch, nullptr, nullptr);
-  });
+  ws.forEachIsland(
+      [&](int island) { impulses[island] = ws.contactSweeps(island, ImpulseMode::Contact, false, nullptr, nullptr); });
   ws.unpack(false);
   int total = 0;
   for (int n : impulses) total += n;
@@ -30,11 +28,9 @@ template <int d>
 void ShockPropagation<d>::run(World<d>&, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (ws.bodies.empty()) return;
-    std::vector<int> impulses(ws.islands.members.size(), 0);
-  ws.forEachIsland([&](int island) {
-    std::vector<solvers::collision::ContactPoint<d>> scratch;
-    impulses[island] = ws.propagateShock(island, ImpulseMode::Contact, false, scratch, nullptr, nullptr);
-  });
+  std::vector<int> impulses(ws.islands.members.size(), 0);
+  ws.forEachIsland(
+      [&](int island) { impulses[island] = ws.propagateShock(island, ImpulseMode::Contact, false, nullptr, nullptr); });
   ws.unpack(false);
   int total = 0;
   for (int n : impulses) total += n;

@@ -203,6 +203,10 @@ void ContactWorkspace<d>::findPairs() {
   }
   islands = con::computeIslands(n, found, infinite_);
   islandPairsByLevel = islands.pairs;
+  memberIndex_.assign(n, -1);
+  for (const auto& members : islands.members)
+    for (std::size_t k = 0; k < members.size(); ++k) memberIndex_[members[k]] = static_cast<int>(k);
+  schedules_.resize(islands.members.size());
 }
 
 template <int d>
@@ -376,7 +380,7 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
 }
 
 template <int d>
-int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const std::vector<int>& pairList, ImpulseMode mode,
+int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int count, ImpulseMode mode,
                                                  double epsilon, int iterations, double margin,
                                                  std::vector<col::ContactPoint<d>>& scratch,
                                                  double* clampEnergyChange, int* clampsApplied) {
@@ -401,8 +405,8 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const std::vector<int>& 
   bool anyApproaching = false;
   VecD frameVelocity = VecD::Zero();
   bool frameSet = false;
-  for (int pi : pairList) {
-    ContactPairState& pair = pairs[pi];
+  for (int q = 0; q < count; ++q) {
+    ContactPairState& pair = pairs[pairList[q]];
     const bool cIsA = pair.a == c;
     const ContactBody<d>& P = bodies[cIsA ? pair.b : pair.a];
     scratch.clear();
@@ -456,10 +460,113 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const std::vector<int>& 
 }
 
 template <int d>
-int ContactWorkspace<d>::contactSweeps(int island, ImpulseMode mode, bool onlyContacted,
-                                       std::vector<col::ContactPoint<d>>& scratch, double* clampEnergyChange,
-                                       int* clampsApplied) {
+typename ContactWorkspace<d>::IslandSchedule& ContactWorkspace<d>::startSchedule(int island) {
+  IslandSchedule& s = schedules_[island];
+  const int members = static_cast<int>(islands.members[island].size());
+  s.island = island;
+  s.order.reset(members);
+  s.tasks.clear();
+  s.jointPairs.clear();
+  s.frozen.assign(members, 0);
+  return s;
+}
+
+template <int d>
+bool ContactWorkspace<d>::infiniteIn(const IslandSchedule& s, int body) const {
+  const ContactBody<d>& b = bodies[body];
+  return b.isStatic || b.kinematic || (memberIndex_[body] >= 0 && s.frozen[memberIndex_[body]]);
+}
+
+template <int d>
+void ContactWorkspace<d>::addTask(IslandSchedule& s, const SweepTask& task, const int* touched, int count) {
+  thread_local std::vector<int> writes, reads;
+  writes.clear();
+  reads.clear();
+  for (int i = 0; i < count; ++i) {
+    const ContactBody<d>& b = bodies[touched[i]];
+    if (b.isStatic || b.kinematic) continue;
+    const int local = memberIndex_[touched[i]];
+    (s.frozen[local] ? reads : writes).push_back(local);
+  }
+  s.order.add(writes.data(), static_cast<int>(writes.size()), reads.data(), static_cast<int>(reads.size()));
+  s.tasks.push_back(task);
+}
+
+template <int d>
+int ContactWorkspace<d>::runSchedule(IslandSchedule& s, ImpulseMode mode, double* clampEnergyChange,
+                                     int* clampsApplied) {
+  const std::size_t n = s.tasks.size();
+  s.impulses.assign(n, 0);
+  s.clamps.assign(n, 0);
+  s.energyChange.assign(n, 0.0);
+  s.order.run([&](int k) {
+    thread_local std::vector<col::ContactPoint<d>> scratch;
+    const SweepTask& t = s.tasks[k];
+    double* energy = &s.energyChange[k];
+    int* clamps = &s.clamps[k];
+    switch (t.kind) {
+      case SweepTask::Kind::Collision: {
+        ContactPairState& pair = pairs[t.index];
+        ContactBody<d>& A = bodies[pair.a];
+        ContactBody<d>& B = bodies[pair.b];
+        // Checked after both bodies last moved: nothing new to find (notes 1.4).
+        if (pair.checkedStamp > std::max(A.movedStamp, B.movedStamp)) return;
+        const int impulses = updatePair(pair, ImpulseMode::Collision, 0.0, t.iterations, 0.0, scratch, energy, clamps);
+        if (impulses > 0) {
+          if (!A.infinite()) A.movedStamp = t.stamp;
+          if (!B.infinite()) B.movedStamp = t.stamp;
+        }
+        pair.checkedStamp = t.stamp + 1;
+        s.impulses[k] = impulses;
+        return;
+      }
+      case SweepTask::Kind::Pair:
+        s.impulses[k] = updatePair(pairs[t.index], mode, t.epsilon, t.iterations, settings.thickness, scratch, energy,
+                                   clamps);
+        return;
+      case SweepTask::Kind::Joint:
+        s.impulses[k] = updateBodyAgainstFrozen(t.index, s.jointPairs.data() + t.listBegin, t.listEnd - t.listBegin,
+                                                mode, t.epsilon, t.iterations, settings.thickness, scratch, energy,
+                                                clamps);
+        return;
+      case SweepTask::Kind::Freeze:
+        bodies[t.index].frozen = true;
+        return;
+    }
+  });
+  // Diagnostics summed in the sequential order, so they too do not depend on the thread count.
   int impulses = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    impulses += s.impulses[k];
+    if (clampsApplied) *clampsApplied += s.clamps[k];
+    if (clampEnergyChange && (s.clamps[k] != 0 || s.energyChange[k] != 0)) *clampEnergyChange += s.energyChange[k];
+  }
+  return impulses;
+}
+
+template <int d>
+int ContactWorkspace<d>::collisionSweep(int island, int sweep, double* clampEnergyChange, int* clampsApplied) {
+  IslandSchedule& s = startSchedule(island);
+  const auto& list = islands.pairs[island];
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    SweepTask t;
+    t.kind = SweepTask::Kind::Collision;
+    t.index = list[k];
+    t.iterations = settings.collisionPairIterations;
+    // Stamps that grow along the whole sequence of checks, sweep after sweep: "moved" gets the
+    // even stamp of the check that moved the body, "checked" the odd one after it, both above
+    // the initial values (moved 0, checked -1), so the skip test compares the order of events.
+    t.stamp = 2 * (static_cast<long>(sweep) * static_cast<long>(list.size()) + static_cast<long>(k) + 1);
+    const int touched[2] = {pairs[t.index].a, pairs[t.index].b};
+    addTask(s, t, touched, 2);
+  }
+  return runSchedule(s, ImpulseMode::Collision, clampEnergyChange, clampsApplied);
+}
+
+template <int d>
+int ContactWorkspace<d>::contactSweeps(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange,
+                                       int* clampsApplied) {
+  IslandSchedule& s = startSchedule(island);
   const auto& list = islandPairsByLevel[island];
   const int iterations = settings.contactIterations, levelIterations = settings.contactLevelIterations;
   for (int it = 0; it < iterations; ++it) {
@@ -469,23 +576,29 @@ int ContactWorkspace<d>::contactSweeps(int island, ImpulseMode mode, bool onlyCo
       for (int li = 0; li < levelIterations; ++li) {
         const double eps = double((it + 1) * (li + 1)) / double(iterations * levelIterations);
         for (std::size_t k = begin; k < end; ++k) {
-          ContactPairState& pair = pairs[list[k]];
+          const ContactPairState& pair = pairs[list[k]];
+          // Step V's pairs: those Step III touched (fixed during the sweeps: a pair update only
+          // ever sets the flag on a pair that already has it here).
           if (onlyContacted && !pair.contacted) continue;
-          impulses += updatePair(pair, mode, eps, settings.contactPairIterations, settings.thickness, scratch,
-                                 clampEnergyChange, clampsApplied);
+          SweepTask t;
+          t.kind = SweepTask::Kind::Pair;
+          t.index = list[k];
+          t.epsilon = eps;
+          t.iterations = settings.contactPairIterations;
+          const int touched[2] = {pair.a, pair.b};
+          addTask(s, t, touched, 2);
         }
       }
       begin = end;
     }
   }
-  return impulses;
+  return runSchedule(s, mode, clampEnergyChange, clampsApplied);
 }
 
 template <int d>
-int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyContacted,
-                                        std::vector<col::ContactPoint<d>>& scratch, double* clampEnergyChange,
+int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange,
                                         int* clampsApplied) {
-  int impulses = 0;
+  IslandSchedule& s = startSchedule(island);
   const auto& list = islandPairsByLevel[island];
   std::vector<int> own;
   for (std::size_t begin = 0; begin < list.size();) {
@@ -497,11 +610,14 @@ int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyC
     for (int li = 0; li < settings.shockLevelIterations; ++li) {
       const double eps = double(li + 1) / double(settings.shockLevelIterations);
       for (std::size_t k = begin; k < end; ++k) {
-        ContactPairState& pair = pairs[list[k]];
+        const ContactPairState& pair = pairs[list[k]];
         if (onlyContacted && !pair.contacted) continue;
         const int upper = levels.levelOf[pair.a] == level ? pair.a : pair.b;
         const int other = upper == pair.a ? pair.b : pair.a;
-        if (bodies[other].infinite() && !bodies[upper].infinite()) {
+        SweepTask t;
+        t.epsilon = eps;
+        t.iterations = settings.shockPairIterations;
+        if (infiniteIn(s, other) && !infiniteIn(s, upper)) {
           // Handled once per body, at its first such pair.
           bool first = true;
           for (std::size_t q = begin; q < k && first; ++q) {
@@ -509,7 +625,7 @@ int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyC
             if (onlyContacted && !earlier.contacted) continue;
             const int u = levels.levelOf[earlier.a] == level ? earlier.a : earlier.b;
             const int o = u == earlier.a ? earlier.b : earlier.a;
-            first = !(u == upper && bodies[o].infinite());
+            first = !(u == upper && infiniteIn(s, o));
           }
           if (!first) continue;
           own.clear();
@@ -518,25 +634,42 @@ int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyC
             if (onlyContacted && !later.contacted) continue;
             const int u = levels.levelOf[later.a] == level ? later.a : later.b;
             const int o = u == later.a ? later.b : later.a;
-            if (u == upper && bodies[o].infinite() && !bodies[o].kinematic) own.push_back(list[q]);
+            if (u == upper && infiniteIn(s, o) && !bodies[o].kinematic) own.push_back(list[q]);
           }
           if (own.size() > 1 && !bodies[other].kinematic) {
-            impulses += updateBodyAgainstFrozen(upper, own, mode, eps, settings.shockPairIterations,
-                                                settings.thickness, scratch, clampEnergyChange, clampsApplied);
+            t.kind = SweepTask::Kind::Joint;
+            t.index = upper;
+            t.listBegin = static_cast<int>(s.jointPairs.size());
+            std::vector<int> touched{upper};
+            for (int p : own) {
+              s.jointPairs.push_back(p);
+              touched.push_back(pairs[p].a == upper ? pairs[p].b : pairs[p].a);
+            }
+            t.listEnd = static_cast<int>(s.jointPairs.size());
+            addTask(s, t, touched.data(), static_cast<int>(touched.size()));
             continue;
           }
         }
-        impulses += updatePair(pair, mode, eps, settings.shockPairIterations, settings.thickness, scratch,
-                               clampEnergyChange, clampsApplied);
+        t.kind = SweepTask::Kind::Pair;
+        t.index = list[k];
+        const int touched[2] = {pair.a, pair.b};
+        addTask(s, t, touched, 2);
       }
     }
     for (std::size_t k = begin; k < end; ++k) {
       const ContactPairState& p = pairs[list[k]];
-      if (levels.levelOf[p.a] == level) bodies[p.a].frozen = true;
-      if (levels.levelOf[p.b] == level) bodies[p.b].frozen = true;
+      for (int body : {p.a, p.b}) {
+        if (levels.levelOf[body] != level || infiniteIn(s, body)) continue;
+        SweepTask t;
+        t.kind = SweepTask::Kind::Freeze;
+        t.index = body;
+        addTask(s, t, &body, 1);
+        s.frozen[memberIndex_[body]] = 1;
+      }
     }
     begin = end;
   }
+  const int impulses = runSchedule(s, mode, clampEnergyChange, clampsApplied);
   for (int m : islands.members[island]) bodies[m].frozen = false;
   return impulses;
 }

@@ -21,6 +21,7 @@
 #include "solvers/collision/narrow_phase.h"
 #include "solvers/contact/contact_graph.h"
 #include "solvers/contact/rigid_math.h"
+#include "solvers/parallel/ordered_tasks.h"
 
 namespace monolith {
 
@@ -121,22 +122,23 @@ class ContactWorkspace {
                  std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
                  int* clampsApplied);
 
+  // One Gauss-Seidel collision sweep (Step II, notes 1.4) over one island's pairs; `sweep` counts
+  // from 0. A pair is skipped when it was checked after both its bodies last moved. Returns the
+  // number of impulses applied.
+  int collisionSweep(int island, int sweep, double* clampEnergyChange, int* clampsApplied);
+
   // The epsilon-scaled contact sweeps of notes 1.6 over one island: contact iterations, each
   // level from the bottom, level iterations, eps = (it+1)(li+1)/(iterations*level iterations).
-  int contactSweeps(int island, ImpulseMode mode, bool onlyContacted,
-                    std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
-                    int* clampsApplied);
+  int contactSweeps(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange, int* clampsApplied);
 
-  // Joint contact solve of body c against the bodies of infinite mass in pairList.
-  int updateBodyAgainstFrozen(int c, const std::vector<int>& pairList, ImpulseMode mode, double epsilon, int iterations,
+  // Joint contact solve of body c against the bodies of infinite mass among `count` pairs.
+  int updateBodyAgainstFrozen(int c, const int* pairList, int count, ImpulseMode mode, double epsilon, int iterations,
                               double margin, std::vector<solvers::collision::ContactPoint<d>>& scratch,
                               double* clampEnergyChange, int* clampsApplied);
 
   // Shock propagation over one island (GBF 2003; notes 1.6): bottom-up through the levels, each
   // level's bodies frozen (infinite mass) once its pairs are done; all unfrozen at the end.
-  int propagateShock(int island, ImpulseMode mode, bool onlyContacted,
-                     std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
-                     int* clampsApplied);
+  int propagateShock(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange, int* clampsApplied);
 
   // Runs f(islandIndex) for every island in parallel (bodies of different islands are disjoint,
   // so results do not depend on the thread count).
@@ -155,6 +157,38 @@ class ContactWorkspace {
   Vec<d> gravity = Vec<d>::Zero();
 
  private:
+  // The sweeps above first record their pair updates, in the thesis's order, as a task
+  // sequence, then run it with OrderedTasks: each update still sees exactly the bodies the
+  // sequential sweep would give it (results are bitwise those of one thread), and updates far
+  // apart in the sequence that share no body run at once -- an island is otherwise serial.
+  struct SweepTask {
+    enum class Kind : char { Collision, Pair, Joint, Freeze };
+    Kind kind = Kind::Pair;
+    int index = 0;                   // the pair (Collision, Pair) or the body (Joint, Freeze)
+    int listBegin = 0, listEnd = 0;  // Joint: its pairs, in IslandSchedule::jointPairs
+    double epsilon = 0;
+    int iterations = 0;
+    long stamp = 0;  // Collision: the stamp of this check (increasing along the sequence)
+  };
+  struct IslandSchedule {
+    solvers::parallel::OrderedTasks order;
+    std::vector<SweepTask> tasks;
+    std::vector<int> jointPairs;
+    std::vector<char> frozen;  // per island member: frozen by the Freeze tasks recorded so far
+    std::vector<int> impulses, clamps;
+    std::vector<double> energyChange;
+    int island = 0;
+  };
+  IslandSchedule& startSchedule(int island);
+  // Whether body i has infinite mass at the point of the sequence being recorded.
+  bool infiniteIn(const IslandSchedule& s, int body) const;
+  // Appends a task touching the given bodies: bodies of finite mass are written, frozen ones
+  // read, static and kinematic ones (never changed by contact) not declared.
+  void addTask(IslandSchedule& s, const SweepTask& task, const int* touched, int count);
+  int runSchedule(IslandSchedule& s, ImpulseMode mode, double* clampEnergyChange, int* clampsApplied);
+  std::vector<IslandSchedule> schedules_;  // per island (islands are recorded and run at once)
+  std::vector<int> memberIndex_;           // per body: its position in its island's members
+
   void ensureGeometry(World<d>& world);
   std::vector<Entity> entities_;
   std::vector<std::unique_ptr<solvers::collision::PreparedGeometry<d>>> geometries_;

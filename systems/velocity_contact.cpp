@@ -22,16 +22,14 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
   std::vector<int> impulses(ws.islands.members.size(), 0), clamps(ws.islands.members.size(), 0);
   std::vector<double> change(ws.islands.members.size(), 0.0);
   ws.forEachIsland([&](int island) {
-    std::vector<solvers::collision::ContactPoint<d>> scratch;
-    impulses[island] = ws.contactSweeps(island, ImpulseMode::ClampedContact, true, scratch, &change[island],
-                                        &clamps[island]);
+    impulses[island] =
+        ws.contactSweeps(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
     // Shock propagation here too (not in the thesis's Step V): the sweeps end with the top
     // levels, whose last impulses push the lower bodies down, so a resting stack would keep a
     // downward velocity of the order of dt g / levels. A bottom-up pass with each level frozen
     // leaves it at rest; its impulses are clamped like the others.
     if (s.shockPropagation)
-      impulses[island] += ws.propagateShock(island, ImpulseMode::ClampedContact, true, scratch, &change[island],
-                                            &clamps[island]);
+      impulses[island] += ws.propagateShock(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
   });
   double energyAfter = 0;
   for (const auto& b : ws.bodies) energyAfter += b.kineticEnergy();
