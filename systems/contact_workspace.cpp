@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <tbb/task_arena.h>
+
 #include "solvers/contact/energy_clamp.h"
 #include "solvers/contact/impulse.h"
 #include "solvers/contact/manifold_pgs.h"
@@ -464,7 +466,11 @@ typename ContactWorkspace<d>::IslandSchedule& ContactWorkspace<d>::startSchedule
   IslandSchedule& s = schedules_[island];
   const int members = static_cast<int>(islands.members[island].size());
   s.island = island;
-  s.order.reset(members);
+  // Blocks of 4 pair updates: measured on 2 threads (docs/benchmarks.md) against 1, 2, 8 and
+  // 16, it keeps pyramid_20's speed-up and stops the cheap sphere-pair checks of a pour from
+  // costing more to hand over than to run. One thread (or one body): no dependencies needed.
+  constexpr int kGrain = 4;
+  s.order.reset(members, kGrain, members > 1 && tbb::this_task_arena::max_concurrency() > 1);
   s.tasks.clear();
   s.jointPairs.clear();
   s.frozen.assign(members, 0);
@@ -479,6 +485,11 @@ bool ContactWorkspace<d>::infiniteIn(const IslandSchedule& s, int body) const {
 
 template <int d>
 void ContactWorkspace<d>::addTask(IslandSchedule& s, const SweepTask& task, const int* touched, int count) {
+  s.tasks.push_back(task);
+  if (!s.order.tracking()) {
+    s.order.add(nullptr, 0, nullptr, 0);
+    return;
+  }
   thread_local std::vector<int> writes, reads;
   writes.clear();
   reads.clear();
@@ -489,7 +500,6 @@ void ContactWorkspace<d>::addTask(IslandSchedule& s, const SweepTask& task, cons
     (s.frozen[local] ? reads : writes).push_back(local);
   }
   s.order.add(writes.data(), static_cast<int>(writes.size()), reads.data(), static_cast<int>(reads.size()));
-  s.tasks.push_back(task);
 }
 
 template <int d>
@@ -502,8 +512,23 @@ int ContactWorkspace<d>::runSchedule(IslandSchedule& s, ImpulseMode mode, double
   s.order.run([&](int k) {
     thread_local std::vector<col::ContactPoint<d>> scratch;
     const SweepTask& t = s.tasks[k];
-    double* energy = &s.energyChange[k];
-    int* clamps = &s.clamps[k];
+    // Results go to per-task slots, written only when not zero (most updates apply nothing, and
+    // neighbouring slots may belong to tasks running on the other core).
+    double energyChange = 0;
+    int clampCount = 0, impulseCount = 0;
+    struct Store {
+      IslandSchedule& s;
+      int k;
+      double& energy;
+      int &clamps, &impulses;
+      ~Store() {
+        if (energy != 0) s.energyChange[k] = energy;
+        if (clamps != 0) s.clamps[k] = clamps;
+        if (impulses != 0) s.impulses[k] = impulses;
+      }
+    } store{s, k, energyChange, clampCount, impulseCount};
+    double* energy = &energyChange;
+    int* clamps = &clampCount;
     switch (t.kind) {
       case SweepTask::Kind::Collision: {
         ContactPairState& pair = pairs[t.index];
@@ -517,17 +542,17 @@ int ContactWorkspace<d>::runSchedule(IslandSchedule& s, ImpulseMode mode, double
           if (!B.infinite()) B.movedStamp = t.stamp;
         }
         pair.checkedStamp = t.stamp + 1;
-        s.impulses[k] = impulses;
+        impulseCount = impulses;
         return;
       }
       case SweepTask::Kind::Pair:
-        s.impulses[k] = updatePair(pairs[t.index], mode, t.epsilon, t.iterations, settings.thickness, scratch, energy,
-                                   clamps);
+        impulseCount = updatePair(pairs[t.index], mode, t.epsilon, t.iterations, settings.thickness, scratch, energy,
+                                  clamps);
         return;
       case SweepTask::Kind::Joint:
-        s.impulses[k] = updateBodyAgainstFrozen(t.index, s.jointPairs.data() + t.listBegin, t.listEnd - t.listBegin,
-                                                mode, t.epsilon, t.iterations, settings.thickness, scratch, energy,
-                                                clamps);
+        impulseCount = updateBodyAgainstFrozen(t.index, s.jointPairs.data() + t.listBegin, t.listEnd - t.listBegin,
+                                               mode, t.epsilon, t.iterations, settings.thickness, scratch, energy,
+                                               clamps);
         return;
       case SweepTask::Kind::Freeze:
         bodies[t.index].frozen = true;

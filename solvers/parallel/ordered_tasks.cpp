@@ -11,19 +11,32 @@
 
 namespace monolith::solvers::parallel {
 
-void OrderedTasks::reset(int objectCount) {
-  lastWriter_.assign(static_cast<std::size_t>(objectCount), -1);
-  readers_.resize(static_cast<std::size_t>(objectCount));
-  for (auto& r : readers_) r.clear();
+void OrderedTasks::reset(int objectCount, int grain, bool track) {
+  if (grain < 1) throw std::invalid_argument("OrderedTasks: grain must be at least 1");
+  track_ = track;
+  grain_ = grain;
+  size_ = 0;
   depth_.clear();
   predecessorCount_.clear();
   edges_.clear();
+  openDependencies_.clear();
   criticalPath_ = 0;
+  if (!track) return;
+  lastWriter_.assign(static_cast<std::size_t>(objectCount), -1);
+  readers_.resize(static_cast<std::size_t>(objectCount));
+  for (auto& r : readers_) r.clear();
 }
 
-void OrderedTasks::addDependency(int from, std::vector<int>& deps) const {
-  if (from < 0) return;
-  if (std::find(deps.begin(), deps.end(), from) == deps.end()) deps.push_back(from);
+// Makes the open (last) block wait for `block`, unless that is itself or already a predecessor.
+void OrderedTasks::depend(int block) {
+  const int open = blocks() - 1;
+  if (block < 0 || block == open) return;
+  if (std::find(openDependencies_.begin(), openDependencies_.end(), block) != openDependencies_.end()) return;
+  openDependencies_.push_back(block);
+  edges_.emplace_back(block, open);
+  ++predecessorCount_[open];
+  depth_[open] = std::max(depth_[open], depth_[block] + 1);
+  criticalPath_ = std::max(criticalPath_, depth_[open]);
 }
 
 int OrderedTasks::add(std::initializer_list<int> writes, std::initializer_list<int> reads) {
@@ -31,48 +44,46 @@ int OrderedTasks::add(std::initializer_list<int> writes, std::initializer_list<i
 }
 
 int OrderedTasks::add(const int* writes, int writeCount, const int* reads, int readCount) {
-  const int k = size();
-  thread_local std::vector<int> deps;
-  deps.clear();
+  const int k = size_++;
+  if (!track_) {
+    criticalPath_ = size_;
+    return k;
+  }
   const int objects = static_cast<int>(lastWriter_.size());
-  auto check = [&](int o) {
-    if (o < 0 || o >= objects) throw std::out_of_range("OrderedTasks: object index out of range");
-  };
+  for (int i = 0; i < writeCount; ++i)
+    if (writes[i] < 0 || writes[i] >= objects) throw std::out_of_range("OrderedTasks: object index out of range");
+  for (int i = 0; i < readCount; ++i)
+    if (reads[i] < 0 || reads[i] >= objects) throw std::out_of_range("OrderedTasks: object index out of range");
+  if (k % grain_ == 0) {  // a new block
+    depth_.push_back(1);
+    predecessorCount_.push_back(0);
+    openDependencies_.clear();
+    criticalPath_ = std::max(criticalPath_, 1);
+  }
+  const int block = blocks() - 1;
   for (int i = 0; i < writeCount; ++i) {
     const int o = writes[i];
-    check(o);
-    addDependency(lastWriter_[o], deps);
-    for (int r : readers_[o]) addDependency(r, deps);
+    depend(lastWriter_[o]);
+    for (int r : readers_[o]) depend(r);
   }
-  for (int i = 0; i < readCount; ++i) {
-    check(reads[i]);
-    addDependency(lastWriter_[reads[i]], deps);
-  }
-  // Record this task's accesses only after collecting its dependencies, so an object both
-  // read and written (or named twice) makes no self-edge.
+  for (int i = 0; i < readCount; ++i) depend(lastWriter_[reads[i]]);
+  // Recorded after the dependencies are collected, and as blocks: accesses within one block
+  // make no edges (an object both read and written, or named twice, makes none either).
   for (int i = 0; i < writeCount; ++i) {
-    lastWriter_[writes[i]] = k;
+    lastWriter_[writes[i]] = block;
     readers_[writes[i]].clear();
   }
   for (int i = 0; i < readCount; ++i) {
     auto& r = readers_[reads[i]];
-    if (lastWriter_[reads[i]] != k && (r.empty() || r.back() != k)) r.push_back(k);
+    if (lastWriter_[reads[i]] != block && (r.empty() || r.back() != block)) r.push_back(block);
   }
-  int depth = 1;
-  for (int p : deps) {
-    depth = std::max(depth, depth_[p] + 1);
-    edges_.emplace_back(p, k);
-  }
-  depth_.push_back(depth);
-  predecessorCount_.push_back(static_cast<int>(deps.size()));
-  criticalPath_ = std::max(criticalPath_, depth);
   return k;
 }
 
-std::vector<int> OrderedTasks::predecessors(int k) const {
+std::vector<int> OrderedTasks::predecessors(int block) const {
   std::vector<int> result;
   for (const auto& [from, to] : edges_)
-    if (to == k) result.push_back(from);
+    if (to == block) result.push_back(from);
   std::sort(result.begin(), result.end());
   return result;
 }
@@ -80,7 +91,8 @@ std::vector<int> OrderedTasks::predecessors(int k) const {
 void OrderedTasks::run(const std::function<void(int)>& task) {
   const int n = size();
   const int threads = tbb::this_task_arena::max_concurrency();
-  const bool share = threads > 1 && n >= kMinimumTasks && n >= kMinimumParallelism * criticalPath_;
+  const bool share =
+      track_ && threads > 1 && blocks() >= kMinimumBlocks && blocks() >= kMinimumParallelism * criticalPath_;
   if (!share) {
     for (int k = 0; k < n; ++k) task(k);
     return;
@@ -89,7 +101,7 @@ void OrderedTasks::run(const std::function<void(int)>& task) {
 }
 
 void OrderedTasks::runParallel(const std::function<void(int)>& task, int threads) {
-  const int n = size();
+  const int n = blocks();
   // Successors in compressed rows, in the order the edges were added (ascending successor).
   std::vector<int> start(static_cast<std::size_t>(n) + 1, 0), successors(edges_.size());
   for (const auto& e : edges_) ++start[e.first + 1];
@@ -114,17 +126,22 @@ void OrderedTasks::runParallel(const std::function<void(int)>& task, int threads
   // others go to the queue. A worker with nothing ready waits for the tasks under way; it is
   // never waiting on itself, since the earliest unfinished task always has its predecessors
   // done. A single worker therefore finishes the whole run if the other thread never joins.
+  // Finished tasks are counted per worker and added to the shared count only when the worker
+  // runs out of ready tasks: one shared counter touched by every task would bounce its cache
+  // line between the cores at each step.
   auto worker = [&] {
-    int next = -1, idle = 0;
+    int next = -1, idle = 0, finished = 0;
     while (!failed.load(std::memory_order_relaxed)) {
       if (next < 0 && !ready.try_pop(next)) {
+        if (finished > 0) done.fetch_add(finished, std::memory_order_acq_rel), finished = 0;
         if (done.load(std::memory_order_acquire) == n) return;
         if (++idle > 64) std::this_thread::yield();
         continue;
       }
       idle = 0;
       try {
-        task(next);
+        const int end = std::min(size_, (next + 1) * grain_);
+        for (int k = next * grain_; k < end; ++k) task(k);
       } catch (...) {
         if (!errorTaken.test_and_set()) error = std::current_exception();
         failed.store(true);
@@ -138,7 +155,7 @@ void OrderedTasks::runParallel(const std::function<void(int)>& task, int threads
           else ready.push(succ);
         }
       }
-      done.fetch_add(1, std::memory_order_acq_rel);
+      ++finished;
       next = follow;
     }
   };

@@ -26,41 +26,51 @@ namespace monolith::solvers::parallel {
 
 class OrderedTasks {
  public:
-  // Forgets all tasks. Objects are numbered 0 .. objectCount-1.
-  void reset(int objectCount);
+  // Forgets all tasks. Objects are numbered 0 .. objectCount-1. Consecutive tasks are handed out
+  // in blocks of `grain` (a block runs in order on one thread and waits for what any of its
+  // tasks waits for): tiny tasks would otherwise cost more to hand over than to run. With
+  // `track` false the tasks will run in order on the calling thread and add() records nothing
+  // but their count (an arena of one thread, where the dependencies would only cost time).
+  void reset(int objectCount, int grain = 1, bool track = true);
 
   // Appends a task; returns its position in the sequential order.
   int add(std::initializer_list<int> writes, std::initializer_list<int> reads = {});
   int add(const int* writes, int writeCount, const int* reads, int readCount);
 
-  int size() const { return static_cast<int>(depth_.size()); }
-  // The longest chain of tasks that must run one after another; size() / criticalPath() bounds
-  // the speed-up.
+  int size() const { return size_; }
+  bool tracking() const { return track_; }
+  // Blocks of tasks, and the longest chain of blocks that must run one after another;
+  // blocks() / criticalPath() bounds the speed-up.
+  int blocks() const { return static_cast<int>(depth_.size()); }
   int criticalPath() const { return criticalPath_; }
-  // The tasks that task k waits for (its direct predecessors), for tests.
-  std::vector<int> predecessors(int k) const;
+  // The blocks that block b waits for (its direct predecessors), ascending, for tests.
+  std::vector<int> predecessors(int block) const;
 
   // Calls task(k) once for every task. Sequentially in order when the arena has one thread or
   // the sequence is too short or too chained to be worth sharing; otherwise on up to the
-  // arena's threads, each task after its predecessors. An exception from a task stops the run
+  // arena's threads, each block after its predecessors. An exception from a task stops the run
   // and is rethrown here (tasks already started finish first).
   void run(const std::function<void(int)>& task);
 
-  // Below this many tasks, or with less than this much average parallelism
-  // (size() / criticalPath()), run() stays sequential: the hand-over costs ~0.1 us per task.
-  static constexpr int kMinimumTasks = 32;
+  // Below this many blocks, or with less than this much average parallelism
+  // (blocks() / criticalPath()), run() stays sequential.
+  static constexpr int kMinimumBlocks = 16;
   static constexpr double kMinimumParallelism = 1.25;
 
  private:
-  void addDependency(int from, std::vector<int>& deps) const;
+  void depend(int block);
   void runParallel(const std::function<void(int)>& task, int threads);
 
-  std::vector<int> lastWriter_;               // per object: last task that writes it, or -1
-  std::vector<std::vector<int>> readers_;     // per object: tasks reading it since that write
-  std::vector<int> depth_;                    // per task: 1 + the deepest predecessor's depth
-  std::vector<int> predecessorCount_;         // per task
-  std::vector<std::pair<int, int>> edges_;    // (predecessor, successor), in order of adding
+  std::vector<int> lastWriter_;            // per object: last block that writes it, or -1
+  std::vector<std::vector<int>> readers_;  // per object: blocks reading it since that write
+  std::vector<int> depth_;                 // per block: 1 + the deepest predecessor's depth
+  std::vector<int> predecessorCount_;      // per block
+  std::vector<std::pair<int, int>> edges_;  // (predecessor, successor) blocks, in order of adding
+  std::vector<int> openDependencies_;      // predecessors of the last block, while it fills
   int criticalPath_ = 0;
+  int size_ = 0;
+  int grain_ = 1;
+  bool track_ = true;
 };
 
 }  // namespace monolith::solvers::parallel
