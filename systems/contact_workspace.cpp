@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include "solvers/contact/energy_clamp.h"
@@ -232,26 +234,31 @@ void ContactWorkspace<d>::computeLevels() {
   // last collision sweep): bodies resting on each other fall together in the candidate
   // positions, so only moving one of them with its new velocity shows that they touch. A
   // separation within the contact thickness counts as touching.
-  std::vector<col::ContactPoint<d>> scratch;
   col::ContactQuery query;
   query.margin = settings.thickness;
   query.maxPoints = 1;
   auto touches = [&](const ContactBody<d>& mover, const ContactBody<d>& other) {
+    thread_local std::vector<col::ContactPoint<d>> scratch;
     scratch.clear();
     return col::findContacts(*mover.geometry, poseWith(mover, 1.0), *other.geometry, poseWith(other, 0.0), query,
                              scratch) > 0;
   };
-  for (ContactPairState& pair : pairs) {
-    const ContactBody<d>& A = bodies[pair.a];
-    const ContactBody<d>& B = bodies[pair.b];
-    if (!(A.isStatic || A.kinematic) && touches(A, B)) {
-      edges.emplace_back(pair.b, pair.a);
-      pair.processed = true;
+  // The tests only read the bodies: each pair's two answers in its own slot, in parallel, then
+  // the edges in pair order (the same list on any thread count).
+  std::vector<char> aOverB(pairs.size(), 0), bOverA(pairs.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k) {
+      const ContactBody<d>& A = bodies[pairs[k].a];
+      const ContactBody<d>& B = bodies[pairs[k].b];
+      aOverB[k] = !(A.isStatic || A.kinematic) && touches(A, B);
+      bOverA[k] = !(B.isStatic || B.kinematic) && touches(B, A);
     }
-    if (!(B.isStatic || B.kinematic) && touches(B, A)) {
-      edges.emplace_back(pair.a, pair.b);
-      pair.processed = true;
-    }
+  });
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    ContactPairState& pair = pairs[k];
+    if (aOverB[k]) edges.emplace_back(pair.b, pair.a);
+    if (bOverA[k]) edges.emplace_back(pair.a, pair.b);
+    if (aOverB[k] || bOverA[k]) pair.processed = true;
   }
   levels = con::computeLevels(static_cast<int>(bodies.size()), edges);
   for (ContactPairState& pair : pairs) pair.level = std::max(levels.levelOf[pair.a], levels.levelOf[pair.b]);
@@ -462,32 +469,20 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
 }
 
 template <int d>
-typename ContactWorkspace<d>::IslandSchedule& ContactWorkspace<d>::startSchedule(int island) {
-  IslandSchedule& s = schedules_[island];
+void ContactWorkspace<d>::startOrder(solvers::parallel::OrderedTasks& order, int island) const {
   const int members = static_cast<int>(islands.members[island].size());
-  s.island = island;
-  // Blocks of 4 pair updates: measured on 2 threads (docs/benchmarks.md) against 1, 2, 8 and
-  // 16, it keeps pyramid_20's speed-up and stops the cheap sphere-pair checks of a pour from
-  // costing more to hand over than to run. One thread (or one body): no dependencies needed.
+  // Blocks of 4 updates: measured on 2 threads (docs/benchmarks.md) against 1, 2, 8 and 16, it
+  // keeps pyramid_20's speed-up and stops the cheap sphere-pair checks of a pour from costing
+  // more to hand over than to run. One thread (or one body): no dependencies needed.
   constexpr int kGrain = 4;
-  s.order.reset(members, kGrain, members > 1 && tbb::this_task_arena::max_concurrency() > 1);
-  s.tasks.clear();
-  s.jointPairs.clear();
-  s.frozen.assign(members, 0);
-  return s;
+  order.reset(members, kGrain, members > 1 && tbb::this_task_arena::max_concurrency() > 1);
 }
 
 template <int d>
-bool ContactWorkspace<d>::infiniteIn(const IslandSchedule& s, int body) const {
-  const ContactBody<d>& b = bodies[body];
-  return b.isStatic || b.kinematic || (memberIndex_[body] >= 0 && s.frozen[memberIndex_[body]]);
-}
-
-template <int d>
-void ContactWorkspace<d>::addTask(IslandSchedule& s, const SweepTask& task, const int* touched, int count) {
-  s.tasks.push_back(task);
-  if (!s.order.tracking()) {
-    s.order.add(nullptr, 0, nullptr, 0);
+void ContactWorkspace<d>::addOrdered(solvers::parallel::OrderedTasks& order, const std::vector<char>& frozen,
+                                     const int* touched, int count) const {
+  if (!order.tracking()) {
+    order.add(nullptr, 0, nullptr, 0);
     return;
   }
   thread_local std::vector<int> writes, reads;
@@ -497,9 +492,26 @@ void ContactWorkspace<d>::addTask(IslandSchedule& s, const SweepTask& task, cons
     const ContactBody<d>& b = bodies[touched[i]];
     if (b.isStatic || b.kinematic) continue;
     const int local = memberIndex_[touched[i]];
-    (s.frozen[local] ? reads : writes).push_back(local);
+    (frozen[local] ? reads : writes).push_back(local);
   }
-  s.order.add(writes.data(), static_cast<int>(writes.size()), reads.data(), static_cast<int>(reads.size()));
+  order.add(writes.data(), static_cast<int>(writes.size()), reads.data(), static_cast<int>(reads.size()));
+}
+
+template <int d>
+typename ContactWorkspace<d>::IslandSchedule& ContactWorkspace<d>::startSchedule(int island) {
+  IslandSchedule& s = schedules_[island];
+  s.island = island;
+  startOrder(s.order, island);
+  s.tasks.clear();
+  s.jointPairs.clear();
+  s.frozen.assign(islands.members[island].size(), 0);
+  return s;
+}
+
+template <int d>
+bool ContactWorkspace<d>::infiniteIn(const IslandSchedule& s, int body) const {
+  const ContactBody<d>& b = bodies[body];
+  return b.isStatic || b.kinematic || (memberIndex_[body] >= 0 && s.frozen[memberIndex_[body]]);
 }
 
 template <int d>

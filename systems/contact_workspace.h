@@ -140,6 +140,15 @@ class ContactWorkspace {
   // level's bodies frozen (infinite mass) once its pairs are done; all unfrozen at the end.
   int propagateShock(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange, int* clampsApplied);
 
+  // Ordered tasks over one island's bodies (see the private part below): `startOrder` resets
+  // `order` for the island; `addOrdered` appends a task touching the given bodies, declaring
+  // those of finite mass as written, those frozen (per island member, `frozen`) as read, and
+  // static and kinematic ones, which contact never changes, not at all.
+  void startOrder(solvers::parallel::OrderedTasks& order, int island) const;
+  void addOrdered(solvers::parallel::OrderedTasks& order, const std::vector<char>& frozen, const int* touched,
+                  int count) const;
+  int memberIndex(int body) const { return memberIndex_[body]; }
+
   // Runs f(islandIndex) for every island in parallel (bodies of different islands are disjoint,
   // so results do not depend on the thread count).
   template <class F>
@@ -182,9 +191,10 @@ class ContactWorkspace {
   IslandSchedule& startSchedule(int island);
   // Whether body i has infinite mass at the point of the sequence being recorded.
   bool infiniteIn(const IslandSchedule& s, int body) const;
-  // Appends a task touching the given bodies: bodies of finite mass are written, frozen ones
-  // read, static and kinematic ones (never changed by contact) not declared.
-  void addTask(IslandSchedule& s, const SweepTask& task, const int* touched, int count);
+  void addTask(IslandSchedule& s, const SweepTask& task, const int* touched, int count) {
+    s.tasks.push_back(task);
+    addOrdered(s.order, s.frozen, touched, count);
+  }
   int runSchedule(IslandSchedule& s, ImpulseMode mode, double* clampEnergyChange, int* clampsApplied);
   std::vector<IslandSchedule> schedules_;  // per island (islands are recorded and run at once)
   std::vector<int> memberIndex_;           // per body: its position in its island's members

@@ -7,6 +7,9 @@
 // only positions and orientations move (App. B.1). Finally the velocity is reset to the
 // post-collision \hat v^n plus the Step I kick, so that Step V's half kick completes the
 // trapezoid update from \hat v^n (the contact impulses of Step III only served the positions).
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 
 #include "solvers/contact/push_out.h"
@@ -46,85 +49,136 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
 
   if (s.pushOut) {
     ws.forEachIsland([&](int island) {
-      std::vector<col::ContactPoint<d>> scratch;
-      std::vector<con::PushOutOuter<d>> outers;
-      std::vector<int> outerIndex;
+      // Recorded first as ordered tasks (one per central body and level iteration, then the
+      // level's freezes) and run on the arena's threads with the sequential result, as the
+      // contact sweeps are (systems/contact_workspace.h).
+      struct PushTask {
+        int central = -1;  // -1: freeze `frozenBody`
+        int frozenBody = -1;
+        std::size_t begin = 0, end = 0;  // the level's pairs in islandPairsByLevel
+        double fraction = 0;
+      };
+      std::vector<PushTask> tasks;
+      solvers::parallel::OrderedTasks order;
+      ws.startOrder(order, island);
+      const auto& members = ws.islands.members[island];
+      std::vector<char> frozen(members.size(), 0);
       const auto& list = ws.islandPairsByLevel[island];
-      col::ContactQuery query;
+      std::vector<int> touched, levelMembers;
       for (std::size_t begin = 0; begin < list.size();) {
         const int level = ws.pairs[list[begin]].level;
         std::size_t end = begin;
         while (end < list.size() && ws.pairs[list[end]].level == level) ++end;
+        // This island's bodies on the level, ascending (a level is one component of the contact
+        // graph; scanning all members per level instead made large piles quadratic).
+        levelMembers.clear();
+        for (int c : ws.levels.nodes[level])
+          if (ws.islands.islandOf[c] == island) levelMembers.push_back(c);
         for (int li = 1; li <= s.pushOutLevelIterations; ++li) {
           const double fraction = double(li) / double(s.pushOutLevelIterations);
-          for (int c : ws.islands.members[island]) {
-            if (ws.levels.levelOf[c] != level) continue;
-            ContactBody<d>& C = ws.bodies[c];
-            if (C.infinite()) continue;
-            for (int iteration = 0; iteration < s.pushOutBodyIterations; ++iteration) {
-              outers.clear();
-              outerIndex.clear();
-              for (std::size_t k = begin; k < end; ++k) {
-                const ContactPairState& p = ws.pairs[list[k]];
-                if (p.a != c && p.b != c) continue;
-                const int o = p.a == c ? p.b : p.a;
-                ContactBody<d>& O = ws.bodies[o];
-                scratch.clear();
-                // Normal out of c towards o.
-                col::findContacts(*O.geometry, O.candidate, *C.geometry, C.candidate, query, scratch);
-                const col::ContactPoint<d>* deepest = nullptr;
-                for (const auto& cp : scratch)
-                  if (cp.depth > s.pushOutTolerance && (!deepest || cp.depth > deepest->depth)) deepest = &cp;
-                if (!deepest) continue;
-                con::PushOutOuter<d> out;
-                out.isStatic = O.infinite();
-                out.r = deepest->point - C.x0;
-                out.q = deepest->point - O.x0;
-                out.mass = O.mass;
-                out.inertia = O.inertia0;
-                // d_o: from the point on c's surface to the point on o's surface (App. B.1).
-                out.displacement = -fraction * deepest->depth * deepest->normal;
-                outers.push_back(out);
-                outerIndex.push_back(o);
-              }
-              if (outers.empty()) break;
-              con::PushOutCentral<d> central;
-              central.mass = C.mass;
-              central.inertia = C.inertia0;
-              central.lengthScale = C.geometry->boundingRadius();
-              const con::PushOutResult<d> r = con::solvePushOut(central, outers);
-              setBasePose<d>(C, C.x0 + r.centralDisplacement, rotatedBy<d>(C.q0, r.centralRotation));
-              for (std::size_t k = 0; k < outers.size(); ++k) {
-                ContactBody<d>& O = ws.bodies[outerIndex[k]];
-                if (O.infinite()) continue;
-                setBasePose<d>(O, O.x0 + r.outerDisplacements[k], rotatedBy<d>(O.q0, r.outerRotations[k]));
-              }
-              ++pushes[island];
+          for (int c : levelMembers) {
+            touched.assign(1, c);
+            for (std::size_t k = begin; k < end; ++k) {
+              const ContactPairState& p = ws.pairs[list[k]];
+              if (p.a == c || p.b == c) touched.push_back(p.a == c ? p.b : p.a);
             }
+            tasks.push_back({c, -1, begin, end, fraction});
+            ws.addOrdered(order, frozen, touched.data(), static_cast<int>(touched.size()));
           }
         }
-        for (int m : ws.islands.members[island])
-          if (ws.levels.levelOf[m] == level) ws.bodies[m].frozen = true;
+        for (int m : levelMembers) {
+          tasks.push_back({-1, m, 0, 0, 0});
+          ws.addOrdered(order, frozen, &m, 1);
+          frozen[ws.memberIndex(m)] = 1;
+        }
         begin = end;
       }
-      for (int m : ws.islands.members[island]) ws.bodies[m].frozen = false;
+      std::vector<int> solves(tasks.size(), 0);
+      order.run([&](int t) {
+        const PushTask& task = tasks[t];
+        if (task.central < 0) {
+          ws.bodies[task.frozenBody].frozen = true;
+          return;
+        }
+        thread_local std::vector<col::ContactPoint<d>> scratch;
+        thread_local std::vector<con::PushOutOuter<d>> outers;
+        thread_local std::vector<int> outerIndex;
+        const col::ContactQuery query;
+        const int c = task.central;
+        ContactBody<d>& C = ws.bodies[c];
+        if (C.infinite()) return;
+        int count = 0;
+        for (int iteration = 0; iteration < s.pushOutBodyIterations; ++iteration) {
+          outers.clear();
+          outerIndex.clear();
+          for (std::size_t k = task.begin; k < task.end; ++k) {
+            const ContactPairState& p = ws.pairs[list[k]];
+            if (p.a != c && p.b != c) continue;
+            const int o = p.a == c ? p.b : p.a;
+            ContactBody<d>& O = ws.bodies[o];
+            scratch.clear();
+            // Normal out of c towards o.
+            col::findContacts(*O.geometry, O.candidate, *C.geometry, C.candidate, query, scratch);
+            const col::ContactPoint<d>* deepest = nullptr;
+            for (const auto& cp : scratch)
+              if (cp.depth > s.pushOutTolerance && (!deepest || cp.depth > deepest->depth)) deepest = &cp;
+            if (!deepest) continue;
+            con::PushOutOuter<d> out;
+            out.isStatic = O.infinite();
+            out.r = deepest->point - C.x0;
+            out.q = deepest->point - O.x0;
+            out.mass = O.mass;
+            out.inertia = O.inertia0;
+            // d_o: from the point on c's surface to the point on o's surface (App. B.1).
+            out.displacement = -task.fraction * deepest->depth * deepest->normal;
+            outers.push_back(out);
+            outerIndex.push_back(o);
+          }
+          if (outers.empty()) break;
+          con::PushOutCentral<d> central;
+          central.mass = C.mass;
+          central.inertia = C.inertia0;
+          central.lengthScale = C.geometry->boundingRadius();
+          const con::PushOutResult<d> r = con::solvePushOut(central, outers);
+          setBasePose<d>(C, C.x0 + r.centralDisplacement, rotatedBy<d>(C.q0, r.centralRotation));
+          for (std::size_t k = 0; k < outers.size(); ++k) {
+            ContactBody<d>& O = ws.bodies[outerIndex[k]];
+            if (O.infinite()) continue;
+            setBasePose<d>(O, O.x0 + r.outerDisplacements[k], rotatedBy<d>(O.q0, r.outerRotations[k]));
+          }
+          ++count;
+        }
+        if (count) solves[t] = count;
+      });
+      for (int n : solves) pushes[island] += n;
+      for (int m : members) ws.bodies[m].frozen = false;
     });
   }
 
   // Deepest remaining overlap of the pairs in contact, relative to the smaller body's size.
-  double worst = 0, worstDepth = 0;
-  std::vector<col::ContactPoint<d>> scratch;
-  for (const ContactPairState& p : ws.pairs) {
-    if (!p.processed) continue;
-    const ContactBody<d>& A = ws.bodies[p.a];
-    const ContactBody<d>& B = ws.bodies[p.b];
-    scratch.clear();
-    col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, col::ContactQuery{}, scratch);
-    const double size = std::min(A.geometry->minimumSize(), B.geometry->minimumSize());
-    for (const auto& cp : scratch) {
-      worstDepth = std::max(worstDepth, cp.depth);
-      worst = std::max(worst, cp.depth / size);
+  // Per pair in parallel (the queries only read), then the largest: a maximum does not depend on
+  // the order it is taken in.
+  std::vector<double> pairDepth(ws.pairs.size(), 0.0), pairRatio(ws.pairs.size(), 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ws.pairs.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
+    thread_local std::vector<col::ContactPoint<d>> scratch;
+    for (std::size_t k = range.begin(); k != range.end(); ++k) {
+      const ContactPairState& p = ws.pairs[k];
+      if (!p.processed) continue;
+      const ContactBody<d>& A = ws.bodies[p.a];
+      const ContactBody<d>& B = ws.bodies[p.b];
+      scratch.clear();
+      col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, col::ContactQuery{}, scratch);
+      const double size = std::min(A.geometry->minimumSize(), B.geometry->minimumSize());
+      for (const auto& cp : scratch) {
+        pairDepth[k] = std::max(pairDepth[k], cp.depth);
+        pairRatio[k] = std::max(pairRatio[k], cp.depth / size);
+      }
     }
+  });
+  double worst = 0, worstDepth = 0;
+  for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
+    worstDepth = std::max(worstDepth, pairDepth[k]);
+    worst = std::max(worst, pairRatio[k]);
   }
 
   for (auto& b : ws.bodies) {
