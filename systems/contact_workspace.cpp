@@ -498,9 +498,18 @@ void ContactWorkspace<d>::addOrdered(solvers::parallel::OrderedTasks& order, con
 }
 
 template <int d>
-typename ContactWorkspace<d>::IslandSchedule& ContactWorkspace<d>::startSchedule(int island) {
+typename ContactWorkspace<d>::IslandSchedule& ContactWorkspace<d>::startSchedule(int island, ImpulseMode mode,
+                                                                                  double* clampEnergyChange,
+                                                                                  int* clampsApplied) {
   IslandSchedule& s = schedules_[island];
   s.island = island;
+  s.mode = mode;
+  s.energyOut = clampEnergyChange;
+  s.clampsOut = clampsApplied;
+  s.impulseSum = 0;
+  s.impulses.clear();
+  s.clamps.clear();
+  s.energyChange.clear();
   startOrder(s.order, island);
   s.tasks.clear();
   s.jointPairs.clear();
@@ -515,75 +524,89 @@ bool ContactWorkspace<d>::infiniteIn(const IslandSchedule& s, int body) const {
 }
 
 template <int d>
-int ContactWorkspace<d>::runSchedule(IslandSchedule& s, ImpulseMode mode, double* clampEnergyChange,
-                                     int* clampsApplied) {
-  const std::size_t n = s.tasks.size();
-  s.impulses.assign(n, 0);
-  s.clamps.assign(n, 0);
-  s.energyChange.assign(n, 0.0);
-  s.order.run([&](int k) {
-    thread_local std::vector<col::ContactPoint<d>> scratch;
-    const SweepTask& t = s.tasks[k];
-    // Results go to per-task slots, written only when not zero (most updates apply nothing, and
-    // neighbouring slots may belong to tasks running on the other core).
-    double energyChange = 0;
-    int clampCount = 0, impulseCount = 0;
-    struct Store {
-      IslandSchedule& s;
-      int k;
-      double& energy;
-      int &clamps, &impulses;
-      ~Store() {
-        if (energy != 0) s.energyChange[k] = energy;
-        if (clamps != 0) s.clamps[k] = clamps;
-        if (impulses != 0) s.impulses[k] = impulses;
+void ContactWorkspace<d>::runTask(IslandSchedule& s, int k, std::vector<col::ContactPoint<d>>& scratch) {
+  const SweepTask& t = s.tasks[k];
+  // Results go to per-task slots, written only when not zero (most updates apply nothing, and
+  // neighbouring slots may belong to tasks running on the other core).
+  double energyChange = 0;
+  int clampCount = 0, impulseCount = 0;
+  switch (t.kind) {
+    case SweepTask::Kind::Collision: {
+      ContactPairState& pair = pairs[t.index];
+      ContactBody<d>& A = bodies[pair.a];
+      ContactBody<d>& B = bodies[pair.b];
+      // Checked after both bodies last moved: nothing new to find (notes 1.4).
+      if (pair.checkedStamp > std::max(A.movedStamp, B.movedStamp)) return;
+      impulseCount = updatePair(pair, ImpulseMode::Collision, 0.0, t.iterations, 0.0, scratch, &energyChange,
+                                &clampCount);
+      if (impulseCount > 0) {
+        if (!A.infinite()) A.movedStamp = t.stamp;
+        if (!B.infinite()) B.movedStamp = t.stamp;
       }
-    } store{s, k, energyChange, clampCount, impulseCount};
-    double* energy = &energyChange;
-    int* clamps = &clampCount;
-    switch (t.kind) {
-      case SweepTask::Kind::Collision: {
-        ContactPairState& pair = pairs[t.index];
-        ContactBody<d>& A = bodies[pair.a];
-        ContactBody<d>& B = bodies[pair.b];
-        // Checked after both bodies last moved: nothing new to find (notes 1.4).
-        if (pair.checkedStamp > std::max(A.movedStamp, B.movedStamp)) return;
-        const int impulses = updatePair(pair, ImpulseMode::Collision, 0.0, t.iterations, 0.0, scratch, energy, clamps);
-        if (impulses > 0) {
-          if (!A.infinite()) A.movedStamp = t.stamp;
-          if (!B.infinite()) B.movedStamp = t.stamp;
-        }
-        pair.checkedStamp = t.stamp + 1;
-        impulseCount = impulses;
-        return;
-      }
-      case SweepTask::Kind::Pair:
-        impulseCount = updatePair(pairs[t.index], mode, t.epsilon, t.iterations, settings.thickness, scratch, energy,
-                                  clamps);
-        return;
-      case SweepTask::Kind::Joint:
-        impulseCount = updateBodyAgainstFrozen(t.index, s.jointPairs.data() + t.listBegin, t.listEnd - t.listBegin,
-                                               mode, t.epsilon, t.iterations, settings.thickness, scratch, energy,
-                                               clamps);
-        return;
-      case SweepTask::Kind::Freeze:
-        bodies[t.index].frozen = true;
-        return;
+      pair.checkedStamp = t.stamp + 1;
+      break;
     }
+    case SweepTask::Kind::Pair:
+      impulseCount = updatePair(pairs[t.index], s.mode, t.epsilon, t.iterations, settings.thickness, scratch,
+                                &energyChange, &clampCount);
+      break;
+    case SweepTask::Kind::Joint:
+      impulseCount = updateBodyAgainstFrozen(t.index, s.jointPairs.data() + t.listBegin, t.listEnd - t.listBegin,
+                                             s.mode, t.epsilon, t.iterations, settings.thickness, scratch,
+                                             &energyChange, &clampCount);
+      break;
+    case SweepTask::Kind::Freeze:
+      bodies[t.index].frozen = true;
+      return;
+  }
+  if (!s.order.tracking()) {  // run in order: the results go straight to the sums
+    s.impulseSum += impulseCount;
+    if (s.clampsOut) *s.clampsOut += clampCount;
+    if (s.energyOut && (clampCount != 0 || energyChange != 0)) *s.energyOut += energyChange;
+    return;
+  }
+  if (energyChange != 0) s.energyChange[k] = energyChange;
+  if (clampCount != 0) s.clamps[k] = clampCount;
+  if (impulseCount != 0) s.impulses[k] = impulseCount;
+}
+
+template <int d>
+void ContactWorkspace<d>::addTask(IslandSchedule& s, const SweepTask& task, const int* touched, int count) {
+  if (!s.order.tracking()) {
+    // On one thread the task runs as soon as it is recorded: the order is the same, and nothing
+    // the recording decides depends on what the earlier tasks did (see contactSweeps).
+    s.tasks.resize(1);
+    s.tasks[0] = task;
+    runTask(s, 0, s.scratch);
+    return;
+  }
+  s.tasks.push_back(task);
+  s.impulses.push_back(0);
+  s.clamps.push_back(0);
+  s.energyChange.push_back(0.0);
+  addOrdered(s.order, s.frozen, touched, count);
+}
+
+template <int d>
+int ContactWorkspace<d>::runSchedule(IslandSchedule& s) {
+  if (!s.order.tracking()) return s.impulseSum;  // already run, as recorded
+  s.order.run([&](int k) {
+    thread_local std::vector<col::ContactPoint<d>> scratch;  // per worker thread
+    runTask(s, k, scratch);
   });
   // Diagnostics summed in the sequential order, so they too do not depend on the thread count.
   int impulses = 0;
-  for (std::size_t k = 0; k < n; ++k) {
+  for (std::size_t k = 0; k < s.tasks.size(); ++k) {
     impulses += s.impulses[k];
-    if (clampsApplied) *clampsApplied += s.clamps[k];
-    if (clampEnergyChange && (s.clamps[k] != 0 || s.energyChange[k] != 0)) *clampEnergyChange += s.energyChange[k];
+    if (s.clampsOut) *s.clampsOut += s.clamps[k];
+    if (s.energyOut && (s.clamps[k] != 0 || s.energyChange[k] != 0)) *s.energyOut += s.energyChange[k];
   }
   return impulses;
 }
 
 template <int d>
 int ContactWorkspace<d>::collisionSweep(int island, int sweep, double* clampEnergyChange, int* clampsApplied) {
-  IslandSchedule& s = startSchedule(island);
+  IslandSchedule& s = startSchedule(island, ImpulseMode::Collision, clampEnergyChange, clampsApplied);
   const auto& list = islands.pairs[island];
   for (std::size_t k = 0; k < list.size(); ++k) {
     SweepTask t;
@@ -597,13 +620,13 @@ int ContactWorkspace<d>::collisionSweep(int island, int sweep, double* clampEner
     const int touched[2] = {pairs[t.index].a, pairs[t.index].b};
     addTask(s, t, touched, 2);
   }
-  return runSchedule(s, ImpulseMode::Collision, clampEnergyChange, clampsApplied);
+  return runSchedule(s);
 }
 
 template <int d>
 int ContactWorkspace<d>::contactSweeps(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange,
                                        int* clampsApplied) {
-  IslandSchedule& s = startSchedule(island);
+  IslandSchedule& s = startSchedule(island, mode, clampEnergyChange, clampsApplied);
   const auto& list = islandPairsByLevel[island];
   const int iterations = settings.contactIterations, levelIterations = settings.contactLevelIterations;
   for (int it = 0; it < iterations; ++it) {
@@ -629,15 +652,15 @@ int ContactWorkspace<d>::contactSweeps(int island, ImpulseMode mode, bool onlyCo
       begin = end;
     }
   }
-  return runSchedule(s, mode, clampEnergyChange, clampsApplied);
+  return runSchedule(s);
 }
 
 template <int d>
 int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange,
                                         int* clampsApplied) {
-  IslandSchedule& s = startSchedule(island);
+  IslandSchedule& s = startSchedule(island, mode, clampEnergyChange, clampsApplied);
   const auto& list = islandPairsByLevel[island];
-  std::vector<int> own;
+  thread_local std::vector<int> own, touched;
   for (std::size_t begin = 0; begin < list.size();) {
     const int level = pairs[list[begin]].level;
     std::size_t end = begin;
@@ -677,7 +700,7 @@ int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyC
             t.kind = SweepTask::Kind::Joint;
             t.index = upper;
             t.listBegin = static_cast<int>(s.jointPairs.size());
-            std::vector<int> touched{upper};
+            touched.assign(1, upper);
             for (int p : own) {
               s.jointPairs.push_back(p);
               touched.push_back(pairs[p].a == upper ? pairs[p].b : pairs[p].a);
@@ -706,7 +729,7 @@ int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyC
     }
     begin = end;
   }
-  const int impulses = runSchedule(s, mode, clampEnergyChange, clampsApplied);
+  const int impulses = runSchedule(s);
   for (int m : islands.members[island]) bodies[m].frozen = false;
   return impulses;
 }

@@ -187,15 +187,21 @@ class ContactWorkspace {
     std::vector<int> impulses, clamps;
     std::vector<double> energyChange;
     int island = 0;
+    ImpulseMode mode = ImpulseMode::Contact;
+    double* energyOut = nullptr;  // the caller's clamp diagnostics, added to in task order
+    int* clampsOut = nullptr;
+    int impulseSum = 0;           // when the tasks run as they are recorded
+    std::vector<solvers::collision::ContactPoint<d>> scratch;  // narrow phase, when run in order
   };
-  IslandSchedule& startSchedule(int island);
+  IslandSchedule& startSchedule(int island, ImpulseMode mode, double* clampEnergyChange, int* clampsApplied);
   // Whether body i has infinite mass at the point of the sequence being recorded.
   bool infiniteIn(const IslandSchedule& s, int body) const;
-  void addTask(IslandSchedule& s, const SweepTask& task, const int* touched, int count) {
-    s.tasks.push_back(task);
-    addOrdered(s.order, s.frozen, touched, count);
-  }
-  int runSchedule(IslandSchedule& s, ImpulseMode mode, double* clampEnergyChange, int* clampsApplied);
+  // Appends a task touching the given bodies (see addOrdered); on one thread it runs at once.
+  void addTask(IslandSchedule& s, const SweepTask& task, const int* touched, int count);
+  void runTask(IslandSchedule& s, int k, std::vector<solvers::collision::ContactPoint<d>>& scratch);
+  // Runs the recorded tasks (if they did not run as they were recorded) and sums their results
+  // in order. Returns the impulses applied.
+  int runSchedule(IslandSchedule& s);
   std::vector<IslandSchedule> schedules_;  // per island (islands are recorded and run at once)
   std::vector<int> memberIndex_;           // per body: its position in its island's members
 

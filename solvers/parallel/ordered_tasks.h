@@ -54,7 +54,7 @@ class OrderedTasks {
 
   // Below this many blocks, or with less than this much average parallelism
   // (blocks() / criticalPath()), run() stays sequential.
-  static constexpr int kMinimumBlocks = 16;
+  static constexpr int kMinimumBlocks = 32;
   static constexpr double kMinimumParallelism = 1.25;
 
  private:
