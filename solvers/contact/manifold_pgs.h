@@ -10,6 +10,8 @@
 // I^{-1}(r x j) = sum_k j_k I^{-1}(r x u_k); only the rounding differs. The sweeps are the hot
 // loop of the contact stages (up to 10 per solve, ~56 solves per pair and step).
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross products
+#include <Eigen/LU>        // the 2x2 tangent mass inverse
 #include <algorithm>
 #include <cmath>
 #include <vector>
