@@ -660,7 +660,7 @@ int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyC
                                         int* clampsApplied) {
   IslandSchedule& s = startSchedule(island, mode, clampEnergyChange, clampsApplied);
   const auto& list = islandPairsByLevel[island];
-  thread_local std::vector<int> own, touched;
+  thread_local std::vector<int> own, jointBodies;
   for (std::size_t begin = 0; begin < list.size();) {
     const int level = pairs[list[begin]].level;
     std::size_t end = begin;
@@ -700,13 +700,13 @@ int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyC
             t.kind = SweepTask::Kind::Joint;
             t.index = upper;
             t.listBegin = static_cast<int>(s.jointPairs.size());
-            touched.assign(1, upper);
+            jointBodies.assign(1, upper);
             for (int p : own) {
               s.jointPairs.push_back(p);
-              touched.push_back(pairs[p].a == upper ? pairs[p].b : pairs[p].a);
+              jointBodies.push_back(pairs[p].a == upper ? pairs[p].b : pairs[p].a);
             }
             t.listEnd = static_cast<int>(s.jointPairs.size());
-            addTask(s, t, touched.data(), static_cast<int>(touched.size()));
+            addTask(s, t, jointBodies.data(), static_cast<int>(jointBodies.size()));
             continue;
           }
         }
