@@ -660,58 +660,81 @@ int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyC
                                         int* clampsApplied) {
   IslandSchedule& s = startSchedule(island, mode, clampEnergyChange, clampsApplied);
   const auto& list = islandPairsByLevel[island];
-  thread_local std::vector<int> own, jointBodies;
+  // Per level, what each of its pairs does in every level iteration (the level's pairs and which
+  // bodies are frozen do not change during them): a joint solve of the upper body against its
+  // partners of infinite mass, at the first of its pairs with such a partner; nothing, for the
+  // other pairs that joint solve covers; else a pair update. Found by grouping the pairs by
+  // upper body, so a large level (a cycle of many bodies in a pile) costs L log L, not L^2.
+  enum class Role : char { Pair, Joint, Covered };
+  struct Entry {
+    int pair = 0, upper = 0, other = 0, position = 0;
+    Role role = Role::Pair;
+    int ownBegin = 0, ownEnd = 0;  // Joint: its pairs in `own`
+  };
+  thread_local std::vector<Entry> entries;
+  thread_local std::vector<int> byUpper, own, jointBodies;
   for (std::size_t begin = 0; begin < list.size();) {
     const int level = pairs[list[begin]].level;
     std::size_t end = begin;
     while (end < list.size() && pairs[list[end]].level == level) ++end;
-    // Bodies of this level whose every pair here is with a body of infinite mass (lower levels
-    // are frozen) are solved jointly; pairs inside the level (a cycle) pairwise.
+    entries.clear();
+    own.clear();
+    byUpper.clear();
+    for (std::size_t k = begin; k < end; ++k) {
+      const ContactPairState& pair = pairs[list[k]];
+      if (onlyContacted && !pair.contacted) continue;
+      Entry e;
+      e.pair = list[k];
+      e.upper = levels.levelOf[pair.a] == level ? pair.a : pair.b;
+      e.other = e.upper == pair.a ? pair.b : pair.a;
+      e.position = static_cast<int>(entries.size());
+      if (infiniteIn(s, e.other) && !infiniteIn(s, e.upper)) byUpper.push_back(e.position);
+      entries.push_back(e);
+    }
+    // Each upper body's pairs with a partner of infinite mass, in level order.
+    std::stable_sort(byUpper.begin(), byUpper.end(),
+                     [&](int x, int y) { return entries[x].upper < entries[y].upper; });
+    for (std::size_t g = 0; g < byUpper.size();) {
+      std::size_t h = g;
+      while (h < byUpper.size() && entries[byUpper[h]].upper == entries[byUpper[g]].upper) ++h;
+      Entry& first = entries[byUpper[g]];
+      const int ownBegin = static_cast<int>(own.size());
+      for (std::size_t q = g; q < h; ++q)
+        if (!bodies[entries[byUpper[q]].other].kinematic) own.push_back(byUpper[q]);
+      if (static_cast<int>(own.size()) - ownBegin > 1 && !bodies[first.other].kinematic) {
+        first.role = Role::Joint;
+        first.ownBegin = ownBegin;
+        first.ownEnd = static_cast<int>(own.size());
+        for (int q = ownBegin; q < first.ownEnd; ++q)
+          if (own[q] != first.position) entries[own[q]].role = Role::Covered;
+      } else {
+        own.resize(ownBegin);  // a pair update each
+      }
+      g = h;
+    }
     for (int li = 0; li < settings.shockLevelIterations; ++li) {
       const double eps = double(li + 1) / double(settings.shockLevelIterations);
-      for (std::size_t k = begin; k < end; ++k) {
-        const ContactPairState& pair = pairs[list[k]];
-        if (onlyContacted && !pair.contacted) continue;
-        const int upper = levels.levelOf[pair.a] == level ? pair.a : pair.b;
-        const int other = upper == pair.a ? pair.b : pair.a;
+      for (const Entry& e : entries) {
+        if (e.role == Role::Covered) continue;
         SweepTask t;
         t.epsilon = eps;
         t.iterations = settings.shockPairIterations;
-        if (infiniteIn(s, other) && !infiniteIn(s, upper)) {
-          // Handled once per body, at its first such pair.
-          bool first = true;
-          for (std::size_t q = begin; q < k && first; ++q) {
-            const ContactPairState& earlier = pairs[list[q]];
-            if (onlyContacted && !earlier.contacted) continue;
-            const int u = levels.levelOf[earlier.a] == level ? earlier.a : earlier.b;
-            const int o = u == earlier.a ? earlier.b : earlier.a;
-            first = !(u == upper && infiniteIn(s, o));
+        if (e.role == Role::Joint) {
+          t.kind = SweepTask::Kind::Joint;
+          t.index = e.upper;
+          t.listBegin = static_cast<int>(s.jointPairs.size());
+          jointBodies.assign(1, e.upper);
+          for (int q = e.ownBegin; q < e.ownEnd; ++q) {
+            s.jointPairs.push_back(entries[own[q]].pair);
+            jointBodies.push_back(entries[own[q]].other);
           }
-          if (!first) continue;
-          own.clear();
-          for (std::size_t q = k; q < end; ++q) {
-            const ContactPairState& later = pairs[list[q]];
-            if (onlyContacted && !later.contacted) continue;
-            const int u = levels.levelOf[later.a] == level ? later.a : later.b;
-            const int o = u == later.a ? later.b : later.a;
-            if (u == upper && infiniteIn(s, o) && !bodies[o].kinematic) own.push_back(list[q]);
-          }
-          if (own.size() > 1 && !bodies[other].kinematic) {
-            t.kind = SweepTask::Kind::Joint;
-            t.index = upper;
-            t.listBegin = static_cast<int>(s.jointPairs.size());
-            jointBodies.assign(1, upper);
-            for (int p : own) {
-              s.jointPairs.push_back(p);
-              jointBodies.push_back(pairs[p].a == upper ? pairs[p].b : pairs[p].a);
-            }
-            t.listEnd = static_cast<int>(s.jointPairs.size());
-            addTask(s, t, jointBodies.data(), static_cast<int>(jointBodies.size()));
-            continue;
-          }
+          t.listEnd = static_cast<int>(s.jointPairs.size());
+          addTask(s, t, jointBodies.data(), static_cast<int>(jointBodies.size()));
+          continue;
         }
         t.kind = SweepTask::Kind::Pair;
-        t.index = list[k];
+        t.index = e.pair;
+        const ContactPairState& pair = pairs[e.pair];
         const int touched[2] = {pair.a, pair.b};
         addTask(s, t, touched, 2);
       }

@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <utility>
 
 #include "solvers/contact/push_out.h"
 #include "systems/rigid_contact.h"
@@ -55,34 +56,57 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
       struct PushTask {
         int central = -1;  // -1: freeze `frozenBody`
         int frozenBody = -1;
-        std::size_t begin = 0, end = 0;  // the level's pairs in islandPairsByLevel
+        int begin = 0, end = 0;  // the central body's pairs on its level, in `centralPairs`
         double fraction = 0;
       };
       std::vector<PushTask> tasks;
+      std::vector<int> centralPairs;  // per central body and level: its pairs there, in level order
       solvers::parallel::OrderedTasks order;
       ws.startOrder(order, island);
       const auto& members = ws.islands.members[island];
       std::vector<char> frozen(members.size(), 0);
       const auto& list = ws.islandPairsByLevel[island];
       std::vector<int> touched, levelMembers;
+      std::vector<std::pair<int, int>> bodyPair;  // (level member, pair), grouped by member
       for (std::size_t begin = 0; begin < list.size();) {
         const int level = ws.pairs[list[begin]].level;
         std::size_t end = begin;
         while (end < list.size() && ws.pairs[list[end]].level == level) ++end;
         // This island's bodies on the level, ascending (a level is one component of the contact
-        // graph; scanning all members per level instead made large piles quadratic).
+        // graph), and each one's pairs on the level in order: found by grouping, since scanning
+        // the level's pairs for every body made large piles (a cycle of many bodies) quadratic.
         levelMembers.clear();
         for (int c : ws.levels.nodes[level])
           if (ws.islands.islandOf[c] == island) levelMembers.push_back(c);
+        bodyPair.clear();
+        for (std::size_t k = begin; k < end; ++k) {
+          const ContactPairState& p = ws.pairs[list[k]];
+          bodyPair.emplace_back(p.a, list[k]);
+          if (p.b != p.a) bodyPair.emplace_back(p.b, list[k]);
+        }
+        std::stable_sort(bodyPair.begin(), bodyPair.end(),
+                         [](const auto& x, const auto& y) { return x.first < y.first; });
+        std::vector<std::pair<int, int>> range(levelMembers.size(), {0, 0});
+        {
+          std::size_t g = 0;
+          for (std::size_t m = 0; m < levelMembers.size(); ++m) {
+            while (g < bodyPair.size() && bodyPair[g].first < levelMembers[m]) ++g;
+            range[m].first = static_cast<int>(centralPairs.size());
+            for (; g < bodyPair.size() && bodyPair[g].first == levelMembers[m]; ++g)
+              centralPairs.push_back(bodyPair[g].second);
+            range[m].second = static_cast<int>(centralPairs.size());
+          }
+        }
         for (int li = 1; li <= s.pushOutLevelIterations; ++li) {
           const double fraction = double(li) / double(s.pushOutLevelIterations);
-          for (int c : levelMembers) {
+          for (std::size_t m = 0; m < levelMembers.size(); ++m) {
+            const int c = levelMembers[m];
             touched.assign(1, c);
-            for (std::size_t k = begin; k < end; ++k) {
-              const ContactPairState& p = ws.pairs[list[k]];
-              if (p.a == c || p.b == c) touched.push_back(p.a == c ? p.b : p.a);
+            for (int q = range[m].first; q < range[m].second; ++q) {
+              const ContactPairState& p = ws.pairs[centralPairs[q]];
+              touched.push_back(p.a == c ? p.b : p.a);
             }
-            tasks.push_back({c, -1, begin, end, fraction});
+            tasks.push_back({c, -1, range[m].first, range[m].second, fraction});
             ws.addOrdered(order, frozen, touched.data(), static_cast<int>(touched.size()));
           }
         }
@@ -111,9 +135,8 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
         for (int iteration = 0; iteration < s.pushOutBodyIterations; ++iteration) {
           outers.clear();
           outerIndex.clear();
-          for (std::size_t k = task.begin; k < task.end; ++k) {
-            const ContactPairState& p = ws.pairs[list[k]];
-            if (p.a != c && p.b != c) continue;
+          for (int q = task.begin; q < task.end; ++q) {
+            const ContactPairState& p = ws.pairs[centralPairs[q]];
             const int o = p.a == c ? p.b : p.a;
             ContactBody<d>& O = ws.bodies[o];
             scratch.clear();
