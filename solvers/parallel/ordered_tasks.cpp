@@ -1,13 +1,11 @@
 #include "solvers/parallel/ordered_tasks.h"
 
-#include <tbb/concurrent_queue.h>
-#include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
+#include <atomic>
 #include <memory>
 #include <stdexcept>
-#include <thread>
 
 namespace monolith::solvers::parallel {
 
@@ -97,10 +95,10 @@ void OrderedTasks::run(const std::function<void(int)>& task) {
     for (int k = 0; k < n; ++k) task(k);
     return;
   }
-  runParallel(task, threads);
+  runParallel(task);
 }
 
-void OrderedTasks::runParallel(const std::function<void(int)>& task, int threads) {
+void OrderedTasks::runParallel(const std::function<void(int)>& task) {
   const int n = blocks();
   // Successors in compressed rows, in the order the edges were added (ascending successor).
   std::vector<int> start(static_cast<std::size_t>(n) + 1, 0), successors(edges_.size());
@@ -111,57 +109,33 @@ void OrderedTasks::runParallel(const std::function<void(int)>& task, int threads
     for (const auto& e : edges_) successors[fill[e.first]++] = e.second;
   }
   std::unique_ptr<std::atomic<int>[]> pending(new std::atomic<int>[n]);
-  tbb::concurrent_queue<int> ready;
-  for (int k = 0; k < n; ++k) {
-    pending[k].store(predecessorCount_[k], std::memory_order_relaxed);
-    if (predecessorCount_[k] == 0) ready.push(k);
-  }
-  std::atomic<int> done{0};
-  std::atomic<bool> failed{false};
-  std::exception_ptr error;
-  std::atomic_flag errorTaken = ATOMIC_FLAG_INIT;
+  for (int k = 0; k < n; ++k) pending[k].store(predecessorCount_[k], std::memory_order_relaxed);
 
-  // Each worker takes a ready task, runs it, and releases its successors: the first one that
-  // becomes ready it runs next itself (a chain stays on one thread, no queue traffic), the
-  // others go to the queue. A worker with nothing ready waits for the tasks under way; it is
-  // never waiting on itself, since the earliest unfinished task always has its predecessors
-  // done. A single worker therefore finishes the whole run if the other thread never joins.
-  // Finished tasks are counted per worker and added to the shared count only when the worker
-  // runs out of ready tasks: one shared counter touched by every task would bounce its cache
-  // line between the cores at each step.
-  auto worker = [&] {
-    int next = -1, idle = 0, finished = 0;
-    while (!failed.load(std::memory_order_relaxed)) {
-      if (next < 0 && !ready.try_pop(next)) {
-        if (finished > 0) done.fetch_add(finished, std::memory_order_acq_rel), finished = 0;
-        if (done.load(std::memory_order_acquire) == n) return;
-        if (++idle > 64) std::this_thread::yield();
-        continue;
+  // A block runs as a TBB task once its last predecessor has finished (the acquire-release
+  // count hands that predecessor's writes to it). Of the successors it releases, it runs the
+  // first itself, next (a chain stays on one thread and in its cache); the others are spawned,
+  // and oneTBB's work stealing runs them where a thread is free, newest first on the thread that
+  // spawned them. No thread ever waits on a flag: a blocked thread steals work instead. (A
+  // shared ready queue with spinning workers was measured 2-4 % slower on the pyramid and the
+  // pours, docs/benchmarks.md.) An exception cancels the group and is rethrown by wait().
+  tbb::task_group group;
+  std::function<void(int)> runFrom = [&](int block) {
+    while (block >= 0) {
+      const int end = std::min(size_, (block + 1) * grain_);
+      for (int k = block * grain_; k < end; ++k) task(k);
+      int next = -1;
+      for (int s = start[block]; s < start[block + 1]; ++s) {
+        const int successor = successors[s];
+        if (pending[successor].fetch_sub(1, std::memory_order_acq_rel) != 1) continue;
+        if (next < 0) next = successor;
+        else group.run([&runFrom, successor] { runFrom(successor); });
       }
-      idle = 0;
-      try {
-        const int end = std::min(size_, (next + 1) * grain_);
-        for (int k = next * grain_; k < end; ++k) task(k);
-      } catch (...) {
-        if (!errorTaken.test_and_set()) error = std::current_exception();
-        failed.store(true);
-        return;
-      }
-      int follow = -1;
-      for (int s = start[next]; s < start[next + 1]; ++s) {
-        const int succ = successors[s];
-        if (pending[succ].fetch_sub(1, std::memory_order_acq_rel) == 1) {
-          if (follow < 0) follow = succ;
-          else ready.push(succ);
-        }
-      }
-      ++finished;
-      next = follow;
+      block = next;
     }
   };
-  tbb::parallel_for(
-      0, threads, 1, [&](int) { worker(); }, tbb::simple_partitioner());
-  if (error) std::rethrow_exception(error);
+  for (int k = 0; k < n; ++k)
+    if (predecessorCount_[k] == 0) group.run([&runFrom, k] { runFrom(k); });
+  group.wait();
 }
 
 }  // namespace monolith::solvers::parallel

@@ -16,8 +16,6 @@
 // need not be declared.
 #include <tbb/task_arena.h>
 
-#include <atomic>
-#include <exception>
 #include <functional>
 #include <initializer_list>
 #include <vector>
@@ -59,7 +57,7 @@ class OrderedTasks {
 
  private:
   void depend(int block);
-  void runParallel(const std::function<void(int)>& task, int threads);
+  void runParallel(const std::function<void(int)>& task);
 
   std::vector<int> lastWriter_;            // per object: last block that writes it, or -1
   std::vector<std::vector<int>> readers_;  // per object: blocks reading it since that write
