@@ -1,5 +1,6 @@
 #include "solvers/parallel/ordered_tasks.h"
 
+#include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
 #include <algorithm>

@@ -14,10 +14,9 @@
 //
 // Tasks must not touch undeclared shared state; objects that no task writes (static bodies)
 // need not be declared.
-#include <tbb/task_arena.h>
-
 #include <functional>
 #include <initializer_list>
+#include <utility>
 #include <vector>
 
 namespace monolith::solvers::parallel {
