@@ -502,7 +502,6 @@ typename ContactWorkspace<d>::IslandSchedule& ContactWorkspace<d>::startSchedule
                                                                                   double* clampEnergyChange,
                                                                                   int* clampsApplied) {
   IslandSchedule& s = schedules_[island];
-  s.island = island;
   s.mode = mode;
   s.energyOut = clampEnergyChange;
   s.clampsOut = clampsApplied;
@@ -524,8 +523,8 @@ bool ContactWorkspace<d>::infiniteIn(const IslandSchedule& s, int body) const {
 }
 
 template <int d>
-void ContactWorkspace<d>::runTask(IslandSchedule& s, int k, std::vector<col::ContactPoint<d>>& scratch) {
-  const SweepTask& t = s.tasks[k];
+void ContactWorkspace<d>::runTask(IslandSchedule& s, const SweepTask& t, int k,
+                                  std::vector<col::ContactPoint<d>>& scratch) {
   // Results go to per-task slots, written only when not zero (most updates apply nothing, and
   // neighbouring slots may belong to tasks running on the other core).
   double energyChange = 0;
@@ -575,9 +574,7 @@ void ContactWorkspace<d>::addTask(IslandSchedule& s, const SweepTask& task, cons
   if (!s.order.tracking()) {
     // On one thread the task runs as soon as it is recorded: the order is the same, and nothing
     // the recording decides depends on what the earlier tasks did (see contactSweeps).
-    s.tasks.resize(1);
-    s.tasks[0] = task;
-    runTask(s, 0, s.scratch);
+    runTask(s, task, -1, s.scratch);
     return;
   }
   s.tasks.push_back(task);
@@ -592,7 +589,7 @@ int ContactWorkspace<d>::runSchedule(IslandSchedule& s) {
   if (!s.order.tracking()) return s.impulseSum;  // already run, as recorded
   s.order.run([&](int k) {
     thread_local std::vector<col::ContactPoint<d>> scratch;  // per worker thread
-    runTask(s, k, scratch);
+    runTask(s, s.tasks[k], k, scratch);
   });
   // Diagnostics summed in the sequential order, so they too do not depend on the thread count.
   int impulses = 0;

@@ -186,7 +186,6 @@ class ContactWorkspace {
     std::vector<char> frozen;  // per island member: frozen by the Freeze tasks recorded so far
     std::vector<int> impulses, clamps;
     std::vector<double> energyChange;
-    int island = 0;
     ImpulseMode mode = ImpulseMode::Contact;
     double* energyOut = nullptr;  // the caller's clamp diagnostics, added to in task order
     int* clampsOut = nullptr;
@@ -198,7 +197,8 @@ class ContactWorkspace {
   bool infiniteIn(const IslandSchedule& s, int body) const;
   // Appends a task touching the given bodies (see addOrdered); on one thread it runs at once.
   void addTask(IslandSchedule& s, const SweepTask& task, const int* touched, int count);
-  void runTask(IslandSchedule& s, int k, std::vector<solvers::collision::ContactPoint<d>>& scratch);
+  // Runs task t; k is its slot for the results when the schedule is run later (tracking).
+  void runTask(IslandSchedule& s, const SweepTask& t, int k, std::vector<solvers::collision::ContactPoint<d>>& scratch);
   // Runs the recorded tasks (if they did not run as they were recorded) and sums their results
   // in order. Returns the impulses applied.
   int runSchedule(IslandSchedule& s);

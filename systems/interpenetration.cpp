@@ -68,6 +68,7 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
       const auto& list = ws.islandPairsByLevel[island];
       std::vector<int> touched, levelMembers;
       std::vector<std::pair<int, int>> bodyPair;  // (level member, pair), grouped by member
+      std::vector<std::pair<int, int>> range;     // per level member: its pairs in centralPairs
       for (std::size_t begin = 0; begin < list.size();) {
         const int level = ws.pairs[list[begin]].level;
         std::size_t end = begin;
@@ -86,7 +87,7 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
         }
         std::stable_sort(bodyPair.begin(), bodyPair.end(),
                          [](const auto& x, const auto& y) { return x.first < y.first; });
-        std::vector<std::pair<int, int>> range(levelMembers.size(), {0, 0});
+        range.assign(levelMembers.size(), {0, 0});
         {
           std::size_t g = 0;
           for (std::size_t m = 0; m < levelMembers.size(); ++m) {
