@@ -11,6 +11,16 @@ namespace monolith::solvers::collision {
 // half-space projects onto the whole line).
 Eigen::Vector2d projection(const PreparedGeometry<3>& g, const Pose<3>& pose, const Eigen::Vector3d& n, int triangle);
 
+// A point of the posed shape extreme along `dir` (world frame, any length): its support point.
+Eigen::Vector3d supportPoint(const PreparedGeometry<3>& g, const Pose<3>& pose, const Eigen::Vector3d& dir);
+
+// The axis (unit, A leaves along it) on which libccd's GJK + EPA finds the pair's penetration,
+// from our exact support points (penetration_axis.cpp): a start for the local search in the basin
+// of the global minimum. False when GJK finds the shapes apart or EPA fails. `scale`: the pair's
+// length scale, for EPA's tolerance.
+bool epaAxis(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b, const Pose<3>& poseB,
+             double scale, Eigen::Vector3d& axis);
+
 // Closest points c1 on segment p1-q1 and c2 on p2-q2 (either may be a point; Ericson, Real-Time
 // Collision Detection, 5.1.9).
 void closestSegmentPoints(const Eigen::Vector3d& p1, const Eigen::Vector3d& q1, const Eigen::Vector3d& p2,

@@ -34,6 +34,13 @@ constexpr double kRedundantDepth = 1e-6;  // times the pair's length scale
 // Contacts closer than this (times the length scale) are duplicates, e.g. a corner found both by
 // FCL's box-box clipping and by the vertex test.
 constexpr double kMergeDistance = 1e-6;
+// Pairs with a cylinder keep a feature contact only if its normal is within 70 degrees of the
+// pair's minimum-translation normal (exact for them, penetration_axis.cpp). A rim point near the
+// other cylinder's rim takes the nearest face's normal, which can be the side at 90 degrees to
+// the cap the pair actually touches on; pushed along it, the body would slide sideways further
+// in (seen in the shallow random contacts of test_narrow_phase). Other pairs keep the thesis's
+// vertex-in-level-set rule as it is: only normals opposing the main one are dropped.
+constexpr double kCylinderFeatureAgreement = 0.34;  // cos 70 degrees
 
 struct Scratch {
   std::vector<CP> main, extra, result;
@@ -155,9 +162,11 @@ void generalPair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
       // A vertex that went more than half way through picks the far face: its normal opposes
       // the pair's minimum-translation direction and would push the wrong way.
       const Vec3 n = s.main[0].normal;
+      const bool cylinder = typeOf(a) == GeometryType::Cylinder || typeOf(b) == GeometryType::Cylinder;
+      const double agreement = cylinder ? kCylinderFeatureAgreement : 0.0;
       std::size_t kept = 0;
       for (const CP& c : s.extra)
-        if (c.normal.dot(n) > 0) s.extra[kept++] = c;
+        if (c.normal.dot(n) > agreement) s.extra[kept++] = c;
       s.extra.resize(kept);
     }
   }
