@@ -69,6 +69,7 @@ constexpr double kFlatSupport = 1e-2;
 // extreme, one (a point), two (an edge), or more (a face: `ref` moved onto its plane).
 struct Support {
   Vec3 p, q;
+  bool face = false;  // a face: p == q is only its point nearest to the reference
 };
 
 Support extremeSet(const PreparedGeometry<3>& g, const Pose<3>& pose, const Vec3& dir, const Vec3& ref, int triangle) {
@@ -77,6 +78,7 @@ Support extremeSet(const PreparedGeometry<3>& g, const Pose<3>& pose, const Vec3
   const Vec3 r = pose.R.transpose() * (ref - pose.x);
   auto sign = [](double v) { return v > 0 ? 1.0 : -1.0; };
   Vec3 p = Vec3::Zero(), q = Vec3::Zero();
+  bool face = false;
   switch (geo.type) {
     case GeometryType::Box: {
       int flat = 0, edgeAxis = -1;
@@ -90,6 +92,7 @@ Support extremeSet(const PreparedGeometry<3>& g, const Pose<3>& pose, const Vec3
         }
       }
       q = p;
+      face = flat >= 2;
       if (flat == 1) {  // an edge: its whole length
         p[edgeAxis] = -geo.halfExtents[edgeAxis];
         q[edgeAxis] = geo.halfExtents[edgeAxis];
@@ -107,6 +110,7 @@ Support extremeSet(const PreparedGeometry<3>& g, const Pose<3>& pose, const Vec3
       } else if (radial.norm() > kFlatSupport) {
         side.head<2>() = geo.radius * radial.normalized();
       } else {  // a cap face: the reference's place on it
+        face = std::abs(d.z()) > kFlatSupport;
         const Eigen::Vector2d onCap = r.head<2>();
         side.head<2>() = onCap.norm() > geo.radius ? Eigen::Vector2d(geo.radius * onCap.normalized()) : onCap;
       }
@@ -118,7 +122,7 @@ Support extremeSet(const PreparedGeometry<3>& g, const Pose<3>& pose, const Vec3
       }
       break;
     }
-    case GeometryType::HalfSpace: return {ref, ref};
+    case GeometryType::HalfSpace: return {ref, ref, true};
     case GeometryType::Convex:
     case GeometryType::Mesh: {
       const bool oneTriangle = geo.type == GeometryType::Mesh && triangle >= 0;
@@ -137,11 +141,18 @@ Support extremeSet(const PreparedGeometry<3>& g, const Pose<3>& pose, const Vec3
         ++found;
       }
       if (found == 1) q = p;
-      if (found > 2) p = q = r + (top - d.dot(r)) * d;
+      if (found > 2) p = q = r + (top - d.dot(r)) * d, face = true;
       break;
     }
   }
-  return {pose.R * p + pose.x, pose.R * q + pose.x};
+  return {pose.R * p + pose.x, pose.R * q + pose.x, face};
+}
+
+// The point of segment [p, q] nearest to x.
+Vec3 nearestOnSegment(const Vec3& p, const Vec3& q, const Vec3& x) {
+  const Vec3 e = q - p;
+  const double len2 = e.squaredNorm();
+  return len2 > 0 ? Vec3(p + std::clamp((x - p).dot(e) / len2, 0.0, 1.0) * e) : p;
 }
 
 }  // namespace
@@ -190,8 +201,13 @@ bool contactOnAxis(const PreparedGeometry<3>& a, const Pose<3>& poseA, int trian
   out.depth = plus ? depthPlus : depthMinus;
   const double middle = plus ? 0.5 * (pa[0] + pb[1]) : -0.5 * (pa[1] + pb[0]);  // along out.normal
   // The touching features: A's extreme set against -normal, B's along it; their closest points.
-  const Support sa = extremeSet(a, poseA, -out.normal, near, triangleA);
-  const Support sb = extremeSet(b, poseB, out.normal, near, triangleB);
+  Support sa = extremeSet(a, poseA, -out.normal, near, triangleA);
+  Support sb = extremeSet(b, poseB, out.normal, near, triangleB);
+  // A face against a vertex, rim point or edge: the face's point is taken under that feature,
+  // not under `near` (the contact's place before its axis moved), which can lie centimetres
+  // aside and would put the point off both surfaces.
+  if (sa.face && !sb.face) sa = extremeSet(a, poseA, -out.normal, nearestOnSegment(sb.p, sb.q, near), triangleA);
+  else if (sb.face && !sa.face) sb = extremeSet(b, poseB, out.normal, nearestOnSegment(sa.p, sa.q, near), triangleB);
   Vec3 ca, cb;
   closestSegmentPoints(sa.p, sa.q, sb.p, sb.q, ca, cb);
   const Vec3 witness = 0.5 * (ca + cb);
