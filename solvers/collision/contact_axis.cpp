@@ -277,12 +277,12 @@ void descendToMinimumOverlap(const PreparedGeometry<3>& a, const Pose<3>& poseA,
   std::vector<Vec3> starts = {c.normal};
   extraStarts(a, poseA, poseB.x, starts);
   extraStarts(b, poseB, poseA.x, starts);
-  // Cylinders: their rims against edges and faces give local minima a few degrees apart, which
-  // the starts above do not tell apart; EPA's axis lies in the global one (penetration_axis.cpp).
-  if (a.geometry().type == GeometryType::Cylinder || b.geometry().type == GeometryType::Cylinder) {
-    Vec3 axis;
-    if (epaAxis(a, poseA, b, poseB, pairLengthScale<3>(a, b), axis)) starts.push_back(axis);
-  }
+  // Local minima a few degrees apart (a cylinder's rim against an edge or a face, a hull's edges)
+  // are not told apart by the starts above; EPA's axis lies in the global one
+  // (penetration_axis.cpp). Only contacts no feature point represents get here (edge and rim
+  // contacts, not a body resting on a face), and box pairs never (their SAT is exact).
+  Vec3 axis;
+  if (epaAxis(a, poseA, b, poseB, pairLengthScale<3>(a, b), axis)) starts.push_back(axis);
   Vec3 bestAxis = c.normal;
   double best = c.depth;
   for (std::size_t k = 0; k < starts.size(); ++k) {

@@ -6,7 +6,8 @@
 // difference has a ridge near the origin (a box edge against a cylinder's side, a cap's rim
 // against a face). The local search of descendToMinimumOverlap, started from MPR's axis and the
 // shapes' face/cap/side axes, then stops in the wrong one: with cylinders, 1-9 % of shallow
-// contacts (1 cm deep) reported 1.2-2.9 cm (docs/benchmarks.md, narrow phase). EPA expands a
+// contacts (1 cm deep) reported 1.2-2.9 cm, with hulls about 0.5 % up to 1.4 cm
+// (docs/benchmarks.md, narrow phase). EPA expands a
 // polytope inside the Minkowski difference towards the origin, so the face it ends on lies in
 // the basin of the global minimum; the local search then polishes that axis on the exact
 // overlap. EPA itself stops at an absolute tolerance and under-estimates the depth (its

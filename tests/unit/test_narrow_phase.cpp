@@ -620,7 +620,9 @@ TEST(NarrowPhase3, ShallowRandomContactsAreConsistent) {
     tooDeep += deepest > push + 2e-3;
     offSurface += off;
   }
-  EXPECT_LE(tooDeep, cases / 100);
+  // None (also before the EPA start of penetration_axis.cpp on these cases; on 200 other cases
+  // per pair, two hull-box and one hull-hull case were 3-4 mm too deep before it).
+  EXPECT_EQ(tooDeep, 0);
   EXPECT_LE(offSurface, cases * 4 / 100);
 }
 
