@@ -104,39 +104,48 @@ bool ContactWorkspace<d>::pack(World<d>& world, double stepDt, bool subtractKick
   settings = world.settings().contact;
   gravity = world.settings().gravity;
   bodies.resize(entities_.size());
-  for (std::size_t i = 0; i < entities_.size(); ++i) {
-    const Entity e = entities_[i];
-    RigidBody<d>* rb = world.template get<RigidBody<d>>(e);
-    const Collider<d>* c = world.template get<Collider<d>>(e);
-    ContactBody<d>& b = bodies[i];
-    b.body = rb;
-    b.geometry = geometries_[i].get();
-    b.isStatic = rb->isStatic;
-    b.kinematic = world.template has<KinematicMotion<d>>(e);
-    b.frozen = false;
-    b.mass = rb->mass;
-    b.restitution = c->restitution;
-    b.friction = c->friction;
-    b.x0 = rb->x;
-    b.q0 = rb->orientation;
-    b.R0 = rotationOf<d>(rb->orientation);
-    b.inverseInertia0 = rb->worldInverseInertia();
-    b.inertia0 = rb->worldInertia();
-    b.v = rb->v;
-    b.L = rb->L;
-    b.dv.setZero();
-    b.dL.setZero();
-    if (subtractKick && !b.infinite()) {
-      if (const RigidForces<d>* f = world.template get<RigidForces<d>>(e)) {
-        b.dv = (0.5 * dt / b.mass) * f->force;
-        b.dL = 0.5 * dt * f->torque;
+  // The pools once (World::get looks each up by name), then the bodies in parallel: each writes
+  // only its own slot, so the result does not depend on the thread count.
+  auto& rigidBodies = world.template pool<RigidBody<d>>();
+  const auto& colliders = world.template pool<Collider<d>>();
+  const auto* kinematics = world.template findPool<KinematicMotion<d>>();
+  const auto* forces = world.template findPool<RigidForces<d>>();
+  auto packRange = [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const Entity e = entities_[i];
+      RigidBody<d>* rb = rigidBodies.get(e);
+      const Collider<d>* c = colliders.get(e);
+      ContactBody<d>& b = bodies[i];
+      b.body = rb;
+      b.geometry = geometries_[i].get();
+      b.isStatic = rb->isStatic;
+      b.kinematic = kinematics && kinematics->get(e);
+      b.frozen = false;
+      b.mass = rb->mass;
+      b.restitution = c->restitution;
+      b.friction = c->friction;
+      b.x0 = rb->x;
+      b.q0 = rb->orientation;
+      b.R0 = rotationOf<d>(rb->orientation);
+      b.inverseInertia0 = rb->worldInverseInertia();
+      b.inertia0 = rb->worldInertia();
+      b.v = rb->v;
+      b.L = rb->L;
+      b.dv.setZero();
+      b.dL.setZero();
+      if (subtractKick && !b.infinite()) {
+        if (const RigidForces<d>* f = forces ? forces->get(e) : nullptr) {
+          b.dv = (0.5 * dt / b.mass) * f->force;
+          b.dL = 0.5 * dt * f->torque;
+        }
+        b.v -= b.dv;
+        b.L -= b.dL;
       }
-      b.v -= b.dv;
-      b.L -= b.dL;
+      b.movedStamp = 0;
+      updateCandidate(b);
     }
-    b.movedStamp = 0;
-  }
-  updateAllCandidates();
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, entities_.size(), 256), packRange);
   return !bodies.empty();
 }
 
@@ -171,7 +180,9 @@ void ContactWorkspace<d>::updateCandidate(ContactBody<d>& b) const {
 
 template <int d>
 void ContactWorkspace<d>::updateAllCandidates() {
-  for (auto& b : bodies) updateCandidate(b);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bodies.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) updateCandidate(bodies[i]);
+  });
 }
 
 template <int d>
