@@ -163,6 +163,28 @@ void ContactWorkspace<d>::unpack(bool positions) {
 }
 
 template <int d>
+double ContactWorkspace<d>::kineticEnergyIn(const VecD& frame) const {
+  double energy = 0;
+  for (const auto& b : bodies)
+    if (!b.infinite()) energy += 0.5 * b.mass * (b.v - frame).squaredNorm() + 0.5 * b.L.dot(b.omega());
+  return energy;
+}
+
+template <int d>
+bool ContactWorkspace<d>::singleKinematicFrame(VecD& frame) const {
+  const ContactBody<d>* found = nullptr;
+  for (const auto& b : bodies) {
+    if (!b.kinematic) continue;
+    if (found) return false;
+    found = &b;
+  }
+  if (!found) return false;
+  if (found->omega().squaredNorm() > 0) return false;  // a scripted spin is in its L
+  frame = found->v;
+  return true;
+}
+
+template <int d>
 void ContactWorkspace<d>::updateCandidate(ContactBody<d>& b) const {
   if (b.isStatic) {
     b.candidate.x = b.x0;

@@ -106,6 +106,14 @@ class ContactWorkspace {
   // Writes the working velocities (and positions, if `positions`) back to the components.
   void unpack(bool positions);
 
+  // Kinetic energy of the bodies of finite mass, measured in a frame moving at `frame` (no
+  // rotation): what the energy clamp of Sec. 2.3.2 bounds against a moving partner.
+  double kineticEnergyIn(const VecD& frame) const;
+  // The velocity of the scene's kinematic body when there is exactly one and it does not spin
+  // (the elevator): the one frame in which a whole step's energy change can be checked against
+  // the clamp's rule. False otherwise (no kinematic body, several, or a spinning one).
+  bool singleKinematicFrame(VecD& frame) const;
+
   // Candidate pose x0 + dt (v + kick*dv), rotated by dt * I^{-1}(L + kick*dL) (first order:
   // candidates only decide which pairs touch).
   void updateCandidate(ContactBody<d>& b) const;

@@ -19,6 +19,9 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
   const ContactSettings& s = ws.settings;
   double energyBefore = 0;
   for (const auto& b : ws.bodies) energyBefore += b.kineticEnergy();
+  Eigen::Matrix<double, d, 1> frame;
+  const bool moving = ws.singleKinematicFrame(frame);
+  const double frameEnergyBefore = moving ? ws.kineticEnergyIn(frame) : 0.0;
   std::vector<int> impulses(ws.islands.members.size(), 0), clamps(ws.islands.members.size(), 0);
   std::vector<double> change(ws.islands.members.size(), 0.0);
   ws.forEachIsland([&](int island) {
@@ -33,6 +36,7 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
   });
   double energyAfter = 0;
   for (const auto& b : ws.bodies) energyAfter += b.kineticEnergy();
+  const double frameEnergyAfter = moving ? ws.kineticEnergyIn(frame) : 0.0;
   ws.unpack(false);
   int total = 0, clampCount = 0;
   for (int n : impulses) total += n;
@@ -41,6 +45,9 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
   ctx.diagnostics.set("velocity_contact_energy_clamps", clampCount);
   ctx.diagnostics.set("velocity_contact_energy_change", (energyAfter - energyBefore) / std::max(energyBefore, 1e-12));
   ctx.diagnostics.set("velocity_contact_energy_change_absolute", energyAfter - energyBefore);
+  if (moving)  // as in Collisions: the frame of the one translating kinematic body
+    ctx.diagnostics.set("velocity_contact_energy_change_kinematic_frame",
+                        (frameEnergyAfter - frameEnergyBefore) / std::max(frameEnergyBefore, 1e-12));
 }
 
 template <int d>
