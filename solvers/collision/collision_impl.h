@@ -97,6 +97,9 @@ template <int d>
 struct FeaturePoint {
   Eigen::Matrix<double, d, 1> x;  // in the frame `pose` maps into (featurePoints)
   double radius = 0;
+  // A capsule end: its axis pointing out of that end (unit); zero for other points. Only the
+  // outer half of the end's sphere is the capsule's surface.
+  Eigen::Matrix<double, d, 1> axis = Eigen::Matrix<double, d, 1>::Zero();
 };
 
 // Feature points of a posed shape. `deepest` (same frame, any length) is the direction in which

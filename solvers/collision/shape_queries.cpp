@@ -205,7 +205,8 @@ void featurePoints(const PreparedGeometry<d>& g, const Pose<d>& pose, const Vec<
       return;
     case GeometryType::Sphere: out.push_back({pose.x, geo.radius}); return;
     case GeometryType::Capsule:
-      for (double s : {-1.0, 1.0}) out.push_back({pose.x + s * geo.halfHeight * pose.R.col(d - 1), geo.radius});
+      for (double s : {-1.0, 1.0})
+        out.push_back({pose.x + s * geo.halfHeight * pose.R.col(d - 1), geo.radius, Vec<d>(s * pose.R.col(d - 1))});
       return;
     case GeometryType::Cylinder:
       if constexpr (d == 3) {
@@ -243,12 +244,26 @@ void featureContacts(const PreparedGeometry<d>& f, const Pose<d>& poseF, const V
     // hulls have many vertices and many faces). Squared: no root for the many rejected points.
     const double reach = margin + p.radius;
     if (bounds.squaredExteriorDistance(p.x) > reach * reach) continue;
-    const SurfaceDistance<d> sd = signedDistance<d>(s, p.x, margin + p.radius);
-    const double depth = p.radius - sd.distance;
+    SurfaceDistance<d> sd = signedDistance<d>(s, p.x, margin + p.radius);
+    double depth = p.radius - sd.distance;
     if (!(depth >= -margin)) continue;
+    Vec<d> onF = p.x - p.radius * sd.normal;
+    const double inward = -sd.normal.dot(p.axis);
+    if (inward < 0) {
+      // A capsule end whose nearest point to S lies on the inner half of its sphere, inside the
+      // capsule: what touches S there is the rim where the side meets the end. The contact is
+      // that rim point's, with its own depth and S's normal there, so that its point lies on
+      // both surfaces (the capsule's side itself is the pair's main contact).
+      Vec<d> towards = -sd.normal - inward * p.axis;  // -normal without its axial part
+      const double len = towards.norm();
+      if (!(len > 1e-12)) continue;  // the end faces straight away from S: the side touches
+      onF = p.x + (p.radius / len) * towards;
+      sd = signedDistance<d>(s, onF, margin);
+      depth = -sd.distance;
+      if (!(depth >= -margin)) continue;
+    }
     const Vec<d> n = poseS.R * sd.normal;
     const Vec<d> onS = sd.surfacePoint;
-    const Vec<d> onF = p.x - p.radius * sd.normal;
     ContactPoint<d> c;
     c.point = poseS.R * (0.5 * (onS + onF)) + poseS.x;
     c.normal = shapeIsA ? Vec<d>(-n) : n;

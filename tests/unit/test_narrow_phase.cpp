@@ -623,7 +623,10 @@ TEST(NarrowPhase3, ShallowRandomContactsAreConsistent) {
   // None (also before the EPA start of penetration_axis.cpp on these cases; on 200 other cases
   // per pair, two hull-box and one hull-hull case were 3-4 mm too deep before it).
   EXPECT_EQ(tooDeep, 0);
-  EXPECT_LE(offSurface, cases * 4 / 100);
+  // One case (of 1000) keeps a point 1.6 mm off: cube hull on the 30-vertex ball, whose vertices
+  // within kFlatSupport of its extreme along the axis count as one face. Twelve did before capsule ends near a rim took the
+  // rim point (shape_queries.cpp, featureContacts): the end sphere's point lay inside the capsule.
+  EXPECT_LE(offSurface, 1);
 }
 
 // --- general behaviour ---------------------------------------------------------------------------
