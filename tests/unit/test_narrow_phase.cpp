@@ -568,6 +568,28 @@ TEST(NarrowPhase3, MeshPeakPokingIntoABox) {
   EXPECT_NEAR(deepest, 0.03, 1e-9);
 }
 
+// A shallow contact at random: B at a random orientation at the origin, A at another, moved
+// towards B along a random direction d until they just touch (bisection on overlaps()), then
+// `push` further along d. The true penetration depth is then at most about `push`.
+struct ShallowCase {
+  Pose<3> pa, pb;
+  Vec3 d;
+};
+ShallowCase shallowCase(const PreparedGeometry<3>& A, const PreparedGeometry<3>& B, double push, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  ShallowCase c;
+  c.pb = at(Vec3::Zero(), rot(3 * u(rng), Vec3(u(rng), u(rng), u(rng) + 2)));
+  c.pa = at(Vec3::Zero(), rot(3 * u(rng), Vec3(u(rng) + 2, u(rng), u(rng))));
+  c.d = Vec3(u(rng), u(rng), u(rng)).normalized();
+  double in = 0, out = 3;
+  for (int k = 0; k < 50; ++k) {
+    c.pa.x = 0.5 * (in + out) * c.d;
+    (overlaps<3>(A, c.pa, B, c.pb) ? in : out) = 0.5 * (in + out);
+  }
+  c.pa.x = (out - push) * c.d;
+  return c;
+}
+
 TEST(NarrowPhase3, ShallowRandomContactsAreConsistent) {
   // A shape moved towards another along a random direction until they just touch (bisection on
   // overlaps), then 0.01 further: every contact must push A back against that direction, no
@@ -586,22 +608,15 @@ TEST(NarrowPhase3, ShallowRandomContactsAreConsistent) {
   std::vector<std::unique_ptr<PreparedGeometry<3>>> prepared;
   for (const auto& g : shapes) prepared.push_back(std::make_unique<PreparedGeometry<3>>(g));
   std::mt19937 rng(2);
-  std::uniform_real_distribution<double> u(-1, 1);
   const double push = 0.01;
   int cases = 0, tooDeep = 0, offSurface = 0;
   for (int it = 0; it < 1000; ++it) {
     const int ia = it % 5, ib = (it / 5) % 5;
     const PreparedGeometry<3>& A = *prepared[ia];
     const PreparedGeometry<3>& B = *prepared[ib];
-    const Pose<3> pb = at(Vec3::Zero(), rot(3 * u(rng), Vec3(u(rng), u(rng), u(rng) + 2)));
-    Pose<3> pa = at(Vec3::Zero(), rot(3 * u(rng), Vec3(u(rng) + 2, u(rng), u(rng))));
-    const Vec3 d = Vec3(u(rng), u(rng), u(rng)).normalized();
-    double in = 0, out = 3;
-    for (int k = 0; k < 50; ++k) {
-      pa.x = 0.5 * (in + out) * d;
-      (overlaps<3>(A, pa, B, pb) ? in : out) = 0.5 * (in + out);
-    }
-    pa.x = (out - push) * d;
+    const ShallowCase sc = shallowCase(A, B, push, rng);
+    const Pose<3>&pa = sc.pa, &pb = sc.pb;
+    const Vec3& d = sc.d;
     std::vector<ContactPoint<3>> got;
     findContacts<3>(A, pa, B, pb, ContactQuery{}, got);
     ASSERT_FALSE(got.empty()) << ia << "-" << ib;
@@ -901,7 +916,6 @@ TEST(NarrowPhase3, ShallowRandomCylinderContactsHaveThePenetrationDepth) {
   std::vector<std::unique_ptr<PreparedGeometry<3>>> prepared;
   for (const auto& g : shapes) prepared.push_back(std::make_unique<PreparedGeometry<3>>(g));
   std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-1, 1);
   const double push = 0.01;
   int cases = 0, wrongDepth = 0, points = 0, offSurface = 0;
   double worstError = 0, worstOff = 0;
@@ -910,15 +924,9 @@ TEST(NarrowPhase3, ShallowRandomCylinderContactsHaveThePenetrationDepth) {
     const bool swap = (it / 12) % 2 == 1;
     const PreparedGeometry<3>& A = *prepared[swap ? ib : ia];
     const PreparedGeometry<3>& B = *prepared[swap ? ia : ib];
-    const Pose<3> pb = at(Vec3::Zero(), rot(3 * u(rng), Vec3(u(rng), u(rng), u(rng) + 2)));
-    Pose<3> pa = at(Vec3::Zero(), rot(3 * u(rng), Vec3(u(rng) + 2, u(rng), u(rng))));
-    const Vec3 d = Vec3(u(rng), u(rng), u(rng)).normalized();
-    double in = 0, out = 3;
-    for (int k = 0; k < 50; ++k) {
-      pa.x = 0.5 * (in + out) * d;
-      (overlaps<3>(A, pa, B, pb) ? in : out) = 0.5 * (in + out);
-    }
-    pa.x = (out - push) * d;
+    const ShallowCase sc = shallowCase(A, B, push, rng);
+    const Pose<3>&pa = sc.pa, &pb = sc.pb;
+    const Vec3& d = sc.d;
     std::vector<ContactPoint<3>> got;
     findContacts<3>(A, pa, B, pb, ContactQuery{}, got);
     ASSERT_FALSE(got.empty()) << it;
