@@ -7,6 +7,7 @@ pyramid_10/20: boxes of edge 1 in layers of n, n-1, ..., 1 with horizontal spaci
 resting on a plane, one step per frame (dt = 1/30). sliver_shards: thin boxes dropped with spin at
 frame rate (the energy-clamp comparison of Sec. 2.3). box_stack_scatter: Fig. 2.2, boxes dropped
 into a stack, then a large box scatters it. pour_spheres_N: N spheres poured into a box.
+mixed_pile: boxes, spheres, capsules, cylinders and convex octahedra dropped into a walled box.
 """
 import json
 import math
@@ -110,6 +111,47 @@ def pour_spheres(directory, n):
     write(directory, "pour_spheres_%d" % n, "%d spheres poured into a box" % n, 1 / 60, 2.0, entities, 30)
 
 
+def mixed_pile(directory):
+    """Boxes, spheres, capsules, cylinders and convex hulls (octahedra) dropped with random
+    orientations and spins into a walled box: every 3-D shape pair of the narrow phase in a
+    settling pile (cylinder rims, capsule ends, hull edges)."""
+    rng = random.Random(11)
+    half = 1.2
+    entities = [ground(friction=0.5)]
+    wall = {"type": "box", "half_extents": [half + 0.1, 1.5, 0.1]}
+    side_wall = {"type": "box", "half_extents": [0.1, 1.5, half + 0.1]}
+    entities.append(body("wall_n", wall, static=True, position=(0, 1.5, half + 0.1)))
+    entities.append(body("wall_s", wall, static=True, position=(0, 1.5, -half - 0.1)))
+    entities.append(body("wall_e", side_wall, static=True, position=(half + 0.1, 1.5, 0)))
+    entities.append(body("wall_w", side_wall, static=True, position=(-half - 0.1, 1.5, 0)))
+    shapes = [
+        {"type": "box", "half_extents": [0.25, 0.15, 0.2]},
+        {"type": "sphere", "radius": 0.2},
+        {"type": "capsule", "radius": 0.12, "half_height": 0.2},
+        {"type": "cylinder", "radius": 0.2, "half_height": 0.15},
+        {"type": "convex", "vertices": [[0.25, 0, 0], [-0.25, 0, 0], [0, 0.25, 0], [0, -0.25, 0],
+                                        [0, 0, 0.25], [0, 0, -0.25]]},
+    ]
+    names = ["box", "sphere", "capsule", "cylinder", "octahedron"]
+    for i in range(40):
+        k = i % len(shapes)
+        axis = [rng.uniform(-1, 1) for _ in range(3)]
+        norm = math.sqrt(sum(a * a for a in axis))
+        angle = rng.uniform(0, math.pi)
+        q = [math.cos(angle / 2)] + [math.sin(angle / 2) * a / norm for a in axis]
+        layer, slot = divmod(i, 9)
+        row, col = divmod(slot, 3)
+        position = ((col - 1) * 0.7 + rng.uniform(-0.05, 0.05), 0.4 + 0.6 * layer,
+                    (row - 1) * 0.7 + rng.uniform(-0.05, 0.05))
+        spin = [rng.uniform(-3, 3) for _ in range(3)]
+        # A solid regular octahedron of vertex distance a has principal moments m a^2 / 5.
+        extra = {"inertia": [0.5 * 0.25 ** 2 / 5] * 3} if names[k] == "octahedron" else {}
+        entities.append(body("%s_%d" % (names[k], i), shapes[k], mass=0.5, position=position, orientation=q,
+                             angular_velocity=spin, friction=0.5, restitution=0.2, **extra))
+    write(directory, "mixed_pile",
+          "boxes, spheres, capsules, cylinders and octahedra dropped into a walled box", 1 / 60, 4.0, entities)
+
+
 def main(argv):
     directory = argv[1] if len(argv) > 1 and not argv[1].startswith("--") else os.path.dirname(os.path.abspath(__file__))
     if "--pour" in argv:
@@ -121,6 +163,7 @@ def main(argv):
     sliver_shards(directory)
     box_stack_scatter(directory)
     pour_spheres(directory, 250)
+    mixed_pile(directory)
 
 
 if __name__ == "__main__":
