@@ -284,7 +284,7 @@ TEST(MixedPile, EveryShapeSettlesWithoutEnergyGainOrDeepOverlap) {
   double ke = 0;
   for (const auto& b : sim.world().pool<RigidBody<3>>().components())
     ke += b.translationalKineticEnergy() + b.rotationalKineticEnergy();
-  EXPECT_LT(ke, 0.02) << "the pile should have settled (about 286 J of potential energy fell)";
+  EXPECT_LT(ke, 0.02) << "the pile should have settled (it starts with 286 J of total energy)";
   watch.expectNoGain(std::abs(watch.initialTotal));
 }
 
