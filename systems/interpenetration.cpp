@@ -49,26 +49,26 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
   std::vector<int> pushes(ws.islands.members.size(), 0);
 
   if (s.pushOut) {
+    if (plans_.size() < ws.islands.members.size()) plans_.resize(ws.islands.members.size());
     ws.forEachIsland([&](int island) {
       // Recorded first as ordered tasks (one per central body and level iteration, then the
       // level's freezes) and run on the arena's threads with the sequential result, as the
-      // contact sweeps are (systems/contact_workspace.h).
-      struct PushTask {
-        int central = -1;  // -1: freeze `frozenBody`
-        int frozenBody = -1;
-        int begin = 0, end = 0;  // the central body's pairs on its level, in `centralPairs`
-        double fraction = 0;
-      };
-      std::vector<PushTask> tasks;
-      std::vector<int> centralPairs;  // per central body and level: its pairs there, in level order
-      solvers::parallel::OrderedTasks order;
+      // contact sweeps are (systems/contact_workspace.h). Each island has its own plan slot.
+      IslandPlan& plan = plans_[island];
+      auto& tasks = plan.tasks;
+      auto& centralPairs = plan.centralPairs;
+      auto& order = plan.order;
+      auto& touched = plan.touched;
+      auto& levelMembers = plan.levelMembers;
+      auto& bodyPair = plan.bodyPair;
+      auto& range = plan.range;
+      tasks.clear();
+      centralPairs.clear();
       ws.startOrder(order, island);
       const auto& members = ws.islands.members[island];
-      std::vector<char> frozen(members.size(), 0);
+      auto& frozen = plan.frozen;
+      frozen.assign(members.size(), 0);
       const auto& list = ws.islandPairsByLevel[island];
-      std::vector<int> touched, levelMembers;
-      std::vector<std::pair<int, int>> bodyPair;  // (level member, pair), grouped by member
-      std::vector<std::pair<int, int>> range;     // per level member: its pairs in centralPairs
       for (std::size_t begin = 0; begin < list.size();) {
         const int level = ws.pairs[list[begin]].level;
         std::size_t end = begin;
@@ -118,7 +118,8 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
         }
         begin = end;
       }
-      std::vector<int> solves(tasks.size(), 0);
+      auto& solves = plan.solves;
+      solves.assign(tasks.size(), 0);
       order.run([&](int t) {
         const PushTask& task = tasks[t];
         if (task.central < 0) {

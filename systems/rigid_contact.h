@@ -12,6 +12,7 @@
 //   velocity_contact         Step V   (Sec. 2.3.2 "Contact Clamping"): contact again on the pairs
 //                                     contact touched, clamped against (x^{n+1}, v^{n+1})
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "ecs/system.h"
@@ -70,6 +71,28 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   std::string name() const override { return "resolve_interpenetration"; }
   Stage stage() const override { return Stage::AdvancePositions; }
   void run(World<d>& world, StepContext& ctx) override;
+
+  // One island's push-out plan: its tasks (one per central body and level iteration, then the
+  // level's freezes) and the buffers that build them. Kept per island slot across steps, so a
+  // pile of thousands of small islands does not allocate them anew every step.
+  struct PushTask {
+    int central = -1;  // -1: freeze `frozenBody`
+    int frozenBody = -1;
+    int begin = 0, end = 0;  // the central body's pairs on its level, in `centralPairs`
+    double fraction = 0;
+  };
+  struct IslandPlan {
+    std::vector<PushTask> tasks;
+    std::vector<int> centralPairs;  // per central body and level: its pairs there, in level order
+    std::vector<char> frozen;
+    std::vector<int> touched, levelMembers, solves;
+    std::vector<std::pair<int, int>> bodyPair;  // (level member, pair), grouped by member
+    std::vector<std::pair<int, int>> range;     // per level member: its pairs in centralPairs
+    solvers::parallel::OrderedTasks order;
+  };
+
+ private:
+  std::vector<IslandPlan> plans_;
 };
 
 template <int d>
