@@ -5,8 +5,10 @@
 //  * pour_spheres_N, N = 250, 1000, 4000 (generated with scenarios/scenes/generate_contact_scenes.py):
 //    us/step on 1 and 2 threads, deepest penetration relative to the sphere size, and whether the
 //    1- and 2-thread states are bitwise equal.
+//  * mixed_pile (boxes, spheres, capsules, cylinders, octahedra): us/step on 1 and 2 threads,
+//    deepest overlap, final kinetic energy, 1T == 2T.
 //
-// usage: bench_rigid_contact [pyramid|pour|all, default all] [seconds] [pyramid scene, e.g. pyramid_20]
+// usage: bench_rigid_contact [pyramid|pour|mixed|all, default all] [seconds] [pyramid scene, e.g. pyramid_20]
 //                            [key=value scene overrides for the pyramids, e.g. solvers.contact.contact_iterations=4]
 //   seconds: simulated time per run; pour default 1.0, pyramids default the scenes' 10 s (a
 //   shorter run is for quick comparisons while profiling; report the 10 s numbers).
@@ -117,6 +119,43 @@ void pour(const Registry& registry, double seconds) {
   }
 }
 
+// mixed_pile (every 3-D shape in one settling pile): us/step on 1 and 2 threads, deepest
+// overlap over the smaller body's size, kinetic energy at the end (settling), bitwise 1T == 2T.
+void mixedPile(const Registry& registry) {
+  const SceneSpec scene = loadScene(kScenes + "mixed_pile.json");
+  std::printf("\n| scene | bodies | threads | steps | us/step | speed-up | max penetration / size | final KE | 1T == 2T |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|\n");
+  double oneThread = 0;
+  std::vector<RigidBody<3>> reference;
+  for (int threads : {1, 2}) {
+    Simulation<3> sim(scene, registry, threads);
+    double penetration = 0;
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!sim.finished()) penetration = std::max(penetration, sim.step().at("max_penetration_ratio"));
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const auto& bodies = sim.world().pool<RigidBody<3>>().components();
+    double ke = 0;
+    int dynamic = 0;
+    bool equal = true;
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      if (threads == 2)
+        equal = equal && std::memcmp(bodies[i].x.data(), reference[i].x.data(), 3 * sizeof(double)) == 0 &&
+                std::memcmp(bodies[i].v.data(), reference[i].v.data(), 3 * sizeof(double)) == 0;
+      if (bodies[i].isStatic) continue;
+      ++dynamic;
+      ke += bodies[i].translationalKineticEnergy() + bodies[i].rotationalKineticEnergy();
+    }
+    if (threads == 1) {
+      oneThread = wall;
+      reference.assign(bodies.begin(), bodies.end());
+    }
+    std::printf("| mixed_pile | %d | %d | %ld | %.0f | %.2f | %.2e | %.2e | %s |\n", dynamic, threads, sim.stepsDone(),
+                1e6 * wall / sim.stepsDone(), oneThread / wall, penetration, ke,
+                threads == 1 ? "-" : (equal ? "yes" : "NO"));
+    std::fflush(stdout);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -136,5 +175,6 @@ int main(int argc, char** argv) {
   }
   if (what == "pyramid" || what == "all") pyramids(registry, seconds, argc > 3 ? argv[3] : "", extra);
   if (what == "pour" || what == "all") pour(registry, seconds > 0 ? seconds : 1.0);
+  if (what == "mixed" || what == "all") mixedPile(registry);
   return 0;
 }
