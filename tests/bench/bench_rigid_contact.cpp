@@ -29,6 +29,58 @@ namespace {
 
 const std::string kScenes = std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/";
 
+// One scene run to its end on `threads` threads, timed; the rigid bodies before and after.
+struct TimedRun {
+  long steps = 0;
+  double wall = 0;         // seconds of stepping
+  double penetration = 0;  // deepest overlap over the smaller body's size, worst step
+  std::vector<RigidBody<3>> start, end;
+};
+
+TimedRun runTimed(const SceneSpec& scene, const Registry& registry, int threads) {
+  Simulation<3> sim(scene, registry, threads);
+  const auto& bodies = sim.world().pool<RigidBody<3>>().components();
+  TimedRun run;
+  run.start.assign(bodies.begin(), bodies.end());
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!sim.finished()) run.penetration = std::max(run.penetration, sim.step().at("max_penetration_ratio"));
+  run.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  run.steps = sim.stepsDone();
+  run.end.assign(bodies.begin(), bodies.end());
+  return run;
+}
+
+// Positions and velocities bitwise equal.
+bool bitwiseSame(const std::vector<RigidBody<3>>& a, const std::vector<RigidBody<3>>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (std::memcmp(a[i].x.data(), b[i].x.data(), 3 * sizeof(double)) != 0 ||
+        std::memcmp(a[i].v.data(), b[i].v.data(), 3 * sizeof(double)) != 0)
+      return false;
+  return true;
+}
+
+// Kinetic energy, largest distance from the start and count of the dynamic bodies.
+struct DynamicSummary {
+  int count = 0;
+  double kineticEnergy = 0, drift = 0;
+};
+DynamicSummary summarize(const TimedRun& run) {
+  DynamicSummary s;
+  for (std::size_t i = 0; i < run.end.size(); ++i) {
+    const RigidBody<3>& b = run.end[i];
+    if (b.isStatic) continue;
+    ++s.count;
+    s.kineticEnergy += b.translationalKineticEnergy() + b.rotationalKineticEnergy();
+    s.drift = std::max(s.drift, (b.x - run.start[i].x).norm());
+  }
+  return s;
+}
+
+const char* sameText(int threads, const TimedRun& run, const TimedRun& oneThread) {
+  return threads == 1 ? "-" : (bitwiseSame(run.end, oneThread.end) ? "yes" : "NO");
+}
+
 void pyramids(const Registry& registry, double seconds, const std::string& only, const std::vector<Override>& extra) {
   std::printf("| scene | boxes | dt | steps | threads | us/step | speed-up | max drift | final KE | max penetration / size | 1T == 2T |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
@@ -43,36 +95,14 @@ void pyramids(const Registry& registry, double seconds, const std::string& only,
       overrides.push_back({"time.dt", dtText});
       if (seconds > 0) overrides.push_back({"time.end", end});
       const SceneSpec scene = loadScene(kScenes + name + ".json", overrides);
-      double oneThread = 0;
-      std::vector<RigidBody<3>> reference;
+      TimedRun oneThread;
       for (int threads : {1, 2}) {
-        Simulation<3> sim(scene, registry, threads);
-        auto& bodies = sim.world().pool<RigidBody<3>>().components();
-        std::vector<Eigen::Vector3d> start;
-        for (const auto& b : bodies) start.push_back(b.x);
-        double penetration = 0;
-        const auto t0 = std::chrono::steady_clock::now();
-        while (!sim.finished()) penetration = std::max(penetration, sim.step().at("max_penetration_ratio"));
-        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        double drift = 0, ke = 0;
-        int dynamic = 0;
-        bool equal = true;
-        for (std::size_t i = 0; i < bodies.size(); ++i) {
-          if (threads == 2)
-            equal = equal && std::memcmp(bodies[i].x.data(), reference[i].x.data(), 3 * sizeof(double)) == 0 &&
-                    std::memcmp(bodies[i].v.data(), reference[i].v.data(), 3 * sizeof(double)) == 0;
-          if (bodies[i].isStatic) continue;
-          ++dynamic;
-          drift = std::max(drift, (bodies[i].x - start[i]).norm());
-          ke += bodies[i].translationalKineticEnergy() + bodies[i].rotationalKineticEnergy();
-        }
-        if (threads == 1) {
-          oneThread = wall;
-          reference.assign(bodies.begin(), bodies.end());
-        }
-        std::printf("| %s | %d | 1/%.0f | %ld | %d | %.1f | %.2f | %.2e | %.2e | %.2e | %s |\n", name, dynamic, 1 / dt,
-                    sim.stepsDone(), threads, 1e6 * wall / sim.stepsDone(), oneThread / wall, drift, ke, penetration,
-                    threads == 1 ? "-" : (equal ? "yes" : "NO"));
+        const TimedRun run = runTimed(scene, registry, threads);
+        if (threads == 1) oneThread = run;
+        const DynamicSummary d = summarize(run);
+        std::printf("| %s | %d | 1/%.0f | %ld | %d | %.1f | %.2f | %.2e | %.2e | %.2e | %s |\n", name, d.count, 1 / dt,
+                    run.steps, threads, 1e6 * run.wall / run.steps, oneThread.wall / run.wall, d.drift, d.kineticEnergy,
+                    run.penetration, sameText(threads, run, oneThread));
         std::fflush(stdout);
       }
     }
@@ -93,27 +123,13 @@ void pour(const Registry& registry, double seconds) {
     char end[64];
     std::snprintf(end, sizeof end, "%.17g", seconds);
     const SceneSpec scene = loadScene(dir + "/pour_spheres_" + std::to_string(n) + ".json", {{"time.end", end}});
-    double oneThread = 0;
-    std::vector<RigidBody<3>> reference;
+    TimedRun oneThread;
     for (int threads : {1, 2}) {
-      Simulation<3> sim(scene, registry, threads);
-      double penetration = 0;
-      const auto t0 = std::chrono::steady_clock::now();
-      while (!sim.finished()) penetration = std::max(penetration, sim.step().at("max_penetration_ratio"));
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      const auto& bodies = sim.world().pool<RigidBody<3>>().components();
-      bool equal = true;
-      if (threads == 1) {
-        oneThread = wall;
-        reference.assign(bodies.begin(), bodies.end());
-      } else {
-        for (std::size_t i = 0; i < bodies.size(); ++i)
-          equal = equal && std::memcmp(bodies[i].x.data(), reference[i].x.data(), 3 * sizeof(double)) == 0 &&
-                  std::memcmp(bodies[i].v.data(), reference[i].v.data(), 3 * sizeof(double)) == 0;
-      }
-      const double us = 1e6 * wall / sim.stepsDone();
-      std::printf("| %d | %d | %ld | %.0f | %.3f | %.2f | %.2e | %s |\n", n, threads, sim.stepsDone(), us, us / n,
-                  oneThread / wall, penetration, threads == 1 ? "-" : (equal ? "yes" : "NO"));
+      const TimedRun run = runTimed(scene, registry, threads);
+      if (threads == 1) oneThread = run;
+      const double us = 1e6 * run.wall / run.steps;
+      std::printf("| %d | %d | %ld | %.0f | %.3f | %.2f | %.2e | %s |\n", n, threads, run.steps, us, us / n,
+                  oneThread.wall / run.wall, run.penetration, sameText(threads, run, oneThread));
       std::fflush(stdout);
     }
   }
@@ -125,33 +141,14 @@ void mixedPile(const Registry& registry) {
   const SceneSpec scene = loadScene(kScenes + "mixed_pile.json");
   std::printf("\n| scene | bodies | threads | steps | us/step | speed-up | max penetration / size | final KE | 1T == 2T |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
-  double oneThread = 0;
-  std::vector<RigidBody<3>> reference;
+  TimedRun oneThread;
   for (int threads : {1, 2}) {
-    Simulation<3> sim(scene, registry, threads);
-    double penetration = 0;
-    const auto t0 = std::chrono::steady_clock::now();
-    while (!sim.finished()) penetration = std::max(penetration, sim.step().at("max_penetration_ratio"));
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const auto& bodies = sim.world().pool<RigidBody<3>>().components();
-    double ke = 0;
-    int dynamic = 0;
-    bool equal = true;
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      if (threads == 2)
-        equal = equal && std::memcmp(bodies[i].x.data(), reference[i].x.data(), 3 * sizeof(double)) == 0 &&
-                std::memcmp(bodies[i].v.data(), reference[i].v.data(), 3 * sizeof(double)) == 0;
-      if (bodies[i].isStatic) continue;
-      ++dynamic;
-      ke += bodies[i].translationalKineticEnergy() + bodies[i].rotationalKineticEnergy();
-    }
-    if (threads == 1) {
-      oneThread = wall;
-      reference.assign(bodies.begin(), bodies.end());
-    }
-    std::printf("| mixed_pile | %d | %d | %ld | %.0f | %.2f | %.2e | %.2e | %s |\n", dynamic, threads, sim.stepsDone(),
-                1e6 * wall / sim.stepsDone(), oneThread / wall, penetration, ke,
-                threads == 1 ? "-" : (equal ? "yes" : "NO"));
+    const TimedRun run = runTimed(scene, registry, threads);
+    if (threads == 1) oneThread = run;
+    const DynamicSummary d = summarize(run);
+    std::printf("| mixed_pile | %d | %d | %ld | %.0f | %.2f | %.2e | %.2e | %s |\n", d.count, threads, run.steps,
+                1e6 * run.wall / run.steps, oneThread.wall / run.wall, run.penetration, d.kineticEnergy,
+                sameText(threads, run, oneThread));
     std::fflush(stdout);
   }
 }
