@@ -12,11 +12,7 @@ void Collisions<d>::run(World<d>& world, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (!ws.pack(world, ctx.dt, /*subtractKick=*/true)) return;
   ws.findPairs();
-  double energyBefore = 0;
-  for (const auto& b : ws.bodies) energyBefore += b.kineticEnergy();
-  Eigen::Matrix<double, d, 1> frame;
-  const bool moving = ws.singleKinematicFrame(frame);
-  const double frameEnergyBefore = moving ? ws.kineticEnergyIn(frame) : 0.0;
+  const auto energyBefore = ws.readEnergy();
 
   std::vector<int> impulses(ws.islands.members.size(), 0), clamps(ws.islands.members.size(), 0);
   std::vector<double> clampChange(ws.islands.members.size(), 0.0);
@@ -28,10 +24,8 @@ void Collisions<d>::run(World<d>& world, StepContext& ctx) {
     }
   });
 
-  double energyAfter = 0;
-  const double frameEnergyAfter = moving ? ws.kineticEnergyIn(frame) : 0.0;
+  const auto energyAfter = ws.readEnergy();
   for (auto& b : ws.bodies) {
-    energyAfter += b.kineticEnergy();
     b.vCollided = b.v;
     b.LCollided = b.L;
   }
@@ -57,15 +51,8 @@ void Collisions<d>::run(World<d>& world, StepContext& ctx) {
   out.set("contact_islands", static_cast<double>(ws.islands.members.size()));
   out.set("contact_levels", ws.levels.count());
   // Kinetic energy of the time-n state before and after the collision impulses (Sec. 2.3.2:
-  // the clamp keeps it from rising). Relative to the energy before (absolute if that is ~0).
-  out.set("collision_energy_change", (energyAfter - energyBefore) / std::max(energyBefore, 1e-12));
-  out.set("collision_energy_change_absolute", energyAfter - energyBefore);
-  // With one kinematic body that translates (the elevator), the same change in its frame,
-  // where the clamp bounds the impulses against it (Sec. 2.3.2); the world-frame figure can rise
-  // there because the platform lifts what it carries.
-  if (moving)
-    out.set("collision_energy_change_kinematic_frame",
-            (frameEnergyAfter - frameEnergyBefore) / std::max(frameEnergyBefore, 1e-12));
+  // the clamp keeps it from rising; in the elevator's frame when a kinematic body lifts the others).
+  ContactWorkspace<d>::reportEnergyChange(out, "collision_energy_change", energyBefore, energyAfter);
 }
 
 template class Collisions<2>;

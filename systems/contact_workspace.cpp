@@ -163,25 +163,32 @@ void ContactWorkspace<d>::unpack(bool positions) {
 }
 
 template <int d>
-double ContactWorkspace<d>::kineticEnergyIn(const VecD& frame) const {
-  double energy = 0;
-  for (const auto& b : bodies)
-    if (!b.infinite()) energy += 0.5 * b.mass * (b.v - frame).squaredNorm() + 0.5 * b.L.dot(b.omega());
-  return energy;
+typename ContactWorkspace<d>::EnergyReading ContactWorkspace<d>::readEnergy() const {
+  EnergyReading r;
+  const ContactBody<d>* kinematic = nullptr;
+  int kinematicCount = 0;
+  for (const auto& b : bodies) {
+    r.world += b.kineticEnergy();
+    if (b.kinematic) kinematic = &b, ++kinematicCount;
+  }
+  // Only a translating kinematic body gives a frame without rotation (a scripted spin is in its L).
+  r.hasKinematicFrame = kinematicCount == 1 && kinematic->omega().squaredNorm() == 0;
+  if (r.hasKinematicFrame)
+    for (const auto& b : bodies)
+      if (!b.infinite())
+        r.kinematicFrame += 0.5 * b.mass * (b.v - kinematic->v).squaredNorm() + 0.5 * b.L.dot(b.omega());
+  return r;
 }
 
 template <int d>
-bool ContactWorkspace<d>::singleKinematicFrame(VecD& frame) const {
-  const ContactBody<d>* found = nullptr;
-  for (const auto& b : bodies) {
-    if (!b.kinematic) continue;
-    if (found) return false;
-    found = &b;
-  }
-  if (!found) return false;
-  if (found->omega().squaredNorm() > 0) return false;  // a scripted spin is in its L
-  frame = found->v;
-  return true;
+void ContactWorkspace<d>::reportEnergyChange(DiagnosticsSink& out, const std::string& name, const EnergyReading& before,
+                                             const EnergyReading& after) {
+  // Relative to the energy before (absolute when that is ~0).
+  out.set(name, (after.world - before.world) / std::max(before.world, 1e-12));
+  out.set(name + "_absolute", after.world - before.world);
+  if (before.hasKinematicFrame && after.hasKinematicFrame)
+    out.set(name + "_kinematic_frame",
+            (after.kinematicFrame - before.kinematicFrame) / std::max(before.kinematicFrame, 1e-12));
 }
 
 template <int d>

@@ -8,6 +8,7 @@
 // Conventions (notes 7.2): in a pair (a, b) the normal points out of b towards a, a receives
 // +j and b receives -j, the relative velocity is v_a - v_b at the point.
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "components/collider.h"
@@ -106,13 +107,19 @@ class ContactWorkspace {
   // Writes the working velocities (and positions, if `positions`) back to the components.
   void unpack(bool positions);
 
-  // Kinetic energy of the bodies of finite mass, measured in a frame moving at `frame` (no
-  // rotation): what the energy clamp of Sec. 2.3.2 bounds against a moving partner.
-  double kineticEnergyIn(const VecD& frame) const;
-  // The velocity of the scene's kinematic body when there is exactly one and it does not spin
-  // (the elevator): the one frame in which a whole step's energy change can be checked against
-  // the clamp's rule. False otherwise (no kinematic body, several, or a spinning one).
-  bool singleKinematicFrame(VecD& frame) const;
+  // Kinetic energy of the bodies of finite mass (the reference state of the energy clamp,
+  // Sec. 2.3.2), in the world frame and, when the scene has exactly one kinematic body and it
+  // does not spin (the elevator), in that body's moving frame: the frame in which the clamp
+  // bounds impulses against it, and so the one in which a whole stage's change can be checked.
+  struct EnergyReading {
+    double world = 0, kinematicFrame = 0;
+    bool hasKinematicFrame = false;
+  };
+  EnergyReading readEnergy() const;
+  // Sets `<name>` (relative change), `<name>_absolute` and, with a kinematic frame,
+  // `<name>_kinematic_frame` (relative change in that frame).
+  static void reportEnergyChange(DiagnosticsSink& out, const std::string& name, const EnergyReading& before,
+                                 const EnergyReading& after);
 
   // Candidate pose x0 + dt (v + kick*dv), rotated by dt * I^{-1}(L + kick*dL) (first order:
   // candidates only decide which pairs touch).

@@ -17,11 +17,7 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
   if (!ws.pack(world, ctx.dt, /*subtractKick=*/false)) return;
   ws.pairs = std::move(pairs);
   const ContactSettings& s = ws.settings;
-  double energyBefore = 0;
-  for (const auto& b : ws.bodies) energyBefore += b.kineticEnergy();
-  Eigen::Matrix<double, d, 1> frame;
-  const bool moving = ws.singleKinematicFrame(frame);
-  const double frameEnergyBefore = moving ? ws.kineticEnergyIn(frame) : 0.0;
+  const auto energyBefore = ws.readEnergy();
   std::vector<int> impulses(ws.islands.members.size(), 0), clamps(ws.islands.members.size(), 0);
   std::vector<double> change(ws.islands.members.size(), 0.0);
   ws.forEachIsland([&](int island) {
@@ -34,20 +30,15 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
     if (s.shockPropagation)
       impulses[island] += ws.propagateShock(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
   });
-  double energyAfter = 0;
-  for (const auto& b : ws.bodies) energyAfter += b.kineticEnergy();
-  const double frameEnergyAfter = moving ? ws.kineticEnergyIn(frame) : 0.0;
+  const auto energyAfter = ws.readEnergy();
   ws.unpack(false);
   int total = 0, clampCount = 0;
   for (int n : impulses) total += n;
   for (int n : clamps) clampCount += n;
   ctx.diagnostics.set("velocity_contact_impulses", total);
   ctx.diagnostics.set("velocity_contact_energy_clamps", clampCount);
-  ctx.diagnostics.set("velocity_contact_energy_change", (energyAfter - energyBefore) / std::max(energyBefore, 1e-12));
-  ctx.diagnostics.set("velocity_contact_energy_change_absolute", energyAfter - energyBefore);
-  if (moving)  // as in Collisions: the frame of the one translating kinematic body
-    ctx.diagnostics.set("velocity_contact_energy_change_kinematic_frame",
-                        (frameEnergyAfter - frameEnergyBefore) / std::max(frameEnergyBefore, 1e-12));
+  ContactWorkspace<d>::reportEnergyChange(ctx.diagnostics, "velocity_contact_energy_change", energyBefore,
+                                          energyAfter);
 }
 
 template <int d>
