@@ -41,16 +41,21 @@ struct FluidSolverSettings {
   bool coupledCutCorrection = true;
   double tolerance = 1e-8;   // relative residual of the Krylov solve
   int maxIterations = 5000;
-  // Where the viscous operator puts an obstacle's no-slip wall: false (scene "obstacle_wall":
-  // "face", default): at the obstacle face's centre, the thesis's first-order treatment (Sec.
-  // 5.4.1, 5.7), up to a cell inside the body; true ("surface"): at the body's true surface,
-  // found along each pair's direction (docs/architecture.md, measured in docs/benchmarks.md).
-  bool obstacleWallAtSurface = false;
+  // Where the viscous operator puts an obstacle's no-slip wall (scene "obstacle_wall"):
+  //  * Face ("face", default): at the obstacle face's centre, the thesis's first-order treatment
+  //    (Sec. 5.4.1, 5.7), up to a cell inside the body;
+  //  * Surface ("surface"): at the body's true surface, found along each pair's direction;
+  //  * CellBoundary ("cell_boundary", staircase only): at the boundary of the solid cells, half a
+  //    cell from the first fluid face, where a finite-volume code on the same staircase puts it.
+  // The last two store wall distances (docs/architecture.md, measured in docs/benchmarks.md).
+  enum class ObstacleWall { Face, Surface, CellBoundary };
+  ObstacleWall obstacleWall = ObstacleWall::Face;
+  bool obstacleWallDistances() const { return obstacleWall != ObstacleWall::Face; }
   // Where the advection's samples see that wall: false ("advection_wall": "face", default): behind
   // the first fluid faces they read the obstacle faces' own velocity or, inside the body, extend
   // the fluid's (velocity_sampling.h rules 3-4, the thesis's clipping of Sec. 5.2); true
-  // ("surface", needs obstacleWallAtSurface): ghost values continue the velocity linearly through
-  // the wall at the true surface (solvers/advection/wall_ghosts.h).
+  // ("surface", needs obstacle wall distances): ghost values continue the velocity linearly through
+  // the wall at the distance the viscous operator uses (solvers/advection/wall_ghosts.h).
   bool advectionWallAtSurface = false;
   // How obstacles meet the pressure: false (scene "obstacle_cells": "staircase", default): cells
   // with the centre inside are solid, their faces carry the body's velocity (Sec. 5.4.1); true

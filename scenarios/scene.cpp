@@ -372,12 +372,19 @@ void parseFluidSolverSettings(const Config& c, FluidSolverSettings& f) {
                 : advection == "maccormack" ? S::Advection::MacCormack
                 : advection == "none"       ? S::Advection::None
                                             : S::Advection::SemiLagrangian;
-  f.obstacleWallAtSurface = c.oneOf("obstacle_wall", {"face", "surface"}, "face") == "surface";
+  const std::string wall = c.oneOf("obstacle_wall", {"face", "surface", "cell_boundary"}, "face");
+  f.obstacleWall = wall == "surface"         ? S::ObstacleWall::Surface
+                   : wall == "cell_boundary" ? S::ObstacleWall::CellBoundary
+                                             : S::ObstacleWall::Face;
   f.advectionWallAtSurface = c.oneOf("advection_wall", {"face", "surface"}, "face") == "surface";
-  if (f.advectionWallAtSurface && !f.obstacleWallAtSurface)
-    c.failAt("advection_wall", "\"face\" unless \"obstacle_wall\" is \"surface\" (the ghost values need its wall distances)",
+  if (f.advectionWallAtSurface && !f.obstacleWallDistances())
+    c.failAt("advection_wall",
+             "\"face\" unless \"obstacle_wall\" is \"surface\" or \"cell_boundary\" (the ghost values need its wall distances)",
              "\"surface\"");
   f.cutCells = c.oneOf("obstacle_cells", {"staircase", "cut"}, "staircase") == "cut";
+  if (f.cutCells && f.obstacleWall == S::ObstacleWall::CellBoundary)
+    c.failAt("obstacle_wall", "\"face\" or \"surface\" with \"obstacle_cells\": \"cut\" (cut faces have no cell boundary to put the wall on)",
+             "\"cell_boundary\"");
   f.projection = c.oneOf("projection", {"coupled", "chorin"}, "coupled") == "chorin" ? S::Projection::Chorin : S::Projection::Coupled;
   const std::string pc = c.oneOf("preconditioner", {"none", "jacobi", "ic0", "mic0", "multigrid"}, "multigrid");
   f.preconditioner = pc == "none"     ? S::Preconditioner::None

@@ -198,7 +198,7 @@ std::vector<double> rasterizationKey(const World<d>& world, const MacGrid<d>& gr
   key.push_back(grid.dx);
   put(grid.origin);
   key.push_back(world.settings().fluid.cutCells);
-  key.push_back(world.settings().fluid.obstacleWallAtSurface);
+  key.push_back(static_cast<double>(world.settings().fluid.obstacleWall));
   forEachObstacle(world, [&](Entity e, const Shape<d>& shape, const RigidBody<d>& body) {
     key.push_back(e.index);
     key.push_back(static_cast<double>(shape.type));
@@ -269,7 +269,14 @@ std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d
   std::vector<double> distance(static_cast<std::size_t>(layout.totalFaces()) * 2 * d, 1.0);
   if (grid.solid.empty()) return distance;
   const auto isFree = [&](int g) { return gridFaceFree(layout, grid, g); };
+  const bool cellBoundary = world.settings().fluid.obstacleWall == FluidSolverSettings::ObstacleWall::CellBoundary;
   forEachPairIntoMarkedFaces(layout, isFree, obstacleFaces(layout, grid), [&](int g, int a, const Index& f, int b, int dir) {
+    if (cellBoundary) {
+      // The staircase's wall is the solid cells' boundary: half a cell across the face's control
+      // volume (b != a); along the face's own axis the obstacle face lies on that boundary.
+      distance[solvers::FluidDomain<d>::wallDistanceIndex(g, b, dir > 0)] = b == a ? 1.0 : 0.5;
+      return;
+    }
     Eigen::Matrix<double, d, 1> e = Eigen::Matrix<double, d, 1>::Zero();
     e[b] = dir;
     const auto x = layout.faceCenter(a, f);
@@ -398,7 +405,7 @@ void RasterizeObstacles<d>::run(World<d>& world, StepContext&) {
       grid.openFraction.clear();
     }
     if (mask != grid.solid) grid.solid = std::move(mask);  // unchanged: keep the projection's cache
-    if (world.settings().fluid.obstacleWallAtSurface) grid.obstacleWallDistance = obstacleWallDistances(world, grid);
+    if (world.settings().fluid.obstacleWallDistances()) grid.obstacleWallDistance = obstacleWallDistances(world, grid);
     else grid.obstacleWallDistance.clear();
   }
 }

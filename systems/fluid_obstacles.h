@@ -39,8 +39,10 @@ template <int d>
 std::vector<double> obstacleOpenFractions(const World<d>& world, const MacGrid<d>& grid);
 
 // Per face and direction 2b + (dir > 0), the distance in cells from each free face's centre to
-// the nearest obstacle surface along dir e_b when the next face that way is an obstacle face
-// (clamped to [FluidDomain::kMinWallDistance, 1]); 1 elsewhere. Layout of FluidDomain::wallDistance.
+// the obstacle's wall along dir e_b when the next face that way is an obstacle face; 1 elsewhere.
+// Layout of FluidDomain::wallDistance. "obstacle_wall": "surface": the nearest true surface
+// (clamped to [FluidDomain::kMinWallDistance, 1]); "cell_boundary": 1/2 across the face's control
+// volume (b != a), 1 along its own axis.
 template <int d>
 std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d>& grid);
 
