@@ -14,6 +14,18 @@ std::optional<int> stepFace(const MacLayout<d>& layout, int axis, typename MacLa
   else if (f[b] < 0 || f[b] >= dims[b]) return std::nullopt;
   return layout.faceIndex(axis, f);
 }
+
+// A prescribed face with a fluid cell on one side lies on the fluid's boundary (a side of the
+// staircase): its prescribed velocity is the no-penetration condition at that very point, exact
+// there, and the advection also reads it along its own axis.
+template <int d>
+bool onFluidBoundary(const FluidDomain<d>& domain, int face) {
+  for (int which = 0; which < 2; ++which) {
+    int cell = -1;
+    if (domain.faceCell(face, which, cell) && domain.cells[cell] == CellKind::Fluid) return true;
+  }
+  return false;
+}
 }  // namespace
 
 template <int d>
@@ -29,7 +41,7 @@ std::vector<GhostRule> obstacleWallGhosts(const FluidDomain<d>& domain) {
       for (int s = 0; s < 2; ++s) {
         const int towards = s == 0 ? -1 : 1;
         const auto h = stepFace(layout, a, f, b, towards);
-        if (!h || domain.faces[*h] != FaceKind::Prescribed) continue;
+        if (!h || domain.faces[*h] != FaceKind::Prescribed || onFluidBoundary(domain, *h)) continue;
         const double theta = domain.wallDistance[FluidDomain<d>::wallDistanceIndex(g, b, s)];
         if (theta < 0.5) {
           const auto o = stepFace(layout, a, f, b, -towards);

@@ -350,6 +350,42 @@ TEST(WallGhosts, RulesFromTheWallDistancesAreExactForLinearShear) {
   }
 }
 
+TEST(WallGhosts, FacesOnTheStaircaseKeepTheirOwnVelocity) {
+  // A 2 x 2 block of solid cells (columns 3-4, rows 2-3) in a closed 8 x 6 box, every wall half a
+  // cell from the face next to it (the cell-boundary wall). The u-faces on the block's left and
+  // right sides (x = 3 h and 5 h) have a fluid cell on one side: they carry no-penetration where
+  // they sit and must get no ghost value, although each has free u-faces above or below it. Only
+  // the u-faces inside the block (x = 4 h) get ghosts, one rule from below, one from above.
+  const MacLayout<2> layout(Index<2>(8, 6), 0.125, Vec<2>::Zero(), {false, false});
+  FluidDomain<2> domain = boxDomain(layout, BoxSpec<2>{SideSpec<2>::wall(), SideSpec<2>::wall(), SideSpec<2>::wall(), SideSpec<2>::wall()});
+  std::vector<std::uint8_t> solid(layout.cellCount(), 0);
+  for (int i = 3; i <= 4; ++i)
+    for (int j = 2; j <= 3; ++j) solid[layout.cellIndex(Index<2>(i, j))] = 1;
+  markSolid(domain, solid);
+  domain.wallDistance.assign(static_cast<std::size_t>(layout.totalFaces()) * 4, 0.5);
+  const std::vector<GhostRule> rules = obstacleWallGhosts(domain);
+  std::vector<int> ghosted;
+  for (const GhostRule& rule : rules) {
+    const auto [axis, face] = layout.faceCoord(rule.face);
+    EXPECT_EQ(face[axis == 0 ? 0 : 1], axis == 0 ? 4 : 3) << "axis " << axis << " face " << face[0] << "," << face[1];
+    EXPECT_DOUBLE_EQ(rule.factor, -1.0);  // theta = 1/2: the mirror image
+    ghosted.push_back(rule.face);
+  }
+  // u-faces (4, 2) from below and (4, 3) from above; v-faces (3, 3) from the left, (4, 3) from the right.
+  EXPECT_EQ(rules.size(), 4u);
+  // A sample at a side face's centre reads its prescribed (zero) velocity, not a ghost.
+  FaceBoundary boundary = staticObstacleBoundary(layout, solid);
+  boundary.ghosts = rules;
+  const Eigen::VectorXd u = faceField<2>(layout, [](int, const Vec<2>& x) { return 1.0 + x[1]; });
+  const FaceVelocitySampler<2> s(layout, u, boundary);
+  const double h = layout.dx;
+  EXPECT_EQ(s.component(0, Vec<2>(3 * h, 2.5 * h)), 0.0);
+  EXPECT_EQ(s.component(0, Vec<2>(5 * h, 3.5 * h)), 0.0);
+  // Half way between the side face (3, 3) and the free face (3, 4) above it: the mean of 0 and
+  // the fluid value, as with the thesis's staircase.
+  EXPECT_NEAR(s.component(0, Vec<2>(3 * h, 4 * h)), 0.5 * (1.0 + 4.5 * h), 1e-12);
+}
+
 TEST(SemiLagrangian, SolidBlockStaysBoundedAndFinite) {
   BlockScene scene;
   // CFL 2: many traces cross into the block and must be clipped.
