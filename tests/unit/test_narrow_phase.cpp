@@ -981,10 +981,15 @@ TEST(NarrowPhase3, ShallowRandomCylinderContactsHaveThePenetrationDepth) {
   }
   EXPECT_EQ(wrongDepth, 0) << "of " << cases << " cases; worst depth error " << worstError;
   EXPECT_LT(worstError, 1e-3);
-  // Contact points: most lie on both surfaces; where an axis is within kFlatSupport (0.6 degrees)
-  // of a cylinder's cap or side, the whole cap or side line counts as touching, which moves the
-  // point by up to that angle times the cylinder's size (measured: 17 of 314 points more than
-  // 1 mm off, the worst 5.9 mm).
+  // Contact points: most lie on both surfaces. Of the exceptions (17 of 313 points more than 1 mm
+  // off, the worst 5.9 mm) the five inspected are a box or hull edge, or a cylinder's side line,
+  // taken whole because the axis is within kFlatSupport (0.6 degrees) of perpendicular to it,
+  // against a rim point: the closest points of the two features are 5-12 mm apart across the
+  // axis, and the contact sits midway. Reporting the overlap at those points instead of the
+  // projections' overlap (tried 2026-11-26) moves none of them: along the axis both points
+  // already sit at the extremes.
+  std::printf("cylinder contacts: %d of %d points more than 1 mm off a surface, worst %.2e; worst depth error %.2e\n",
+              offSurface, points, worstOff, worstError);
   EXPECT_LE(offSurface, points / 10);
   EXPECT_LT(worstOff, 0.01);
 }
