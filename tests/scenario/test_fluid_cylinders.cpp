@@ -86,6 +86,32 @@ TEST(DfgSteady, CutFacesAndWeno5HitTheReferenceForcesAt10CellsPerDiameter) {
   EXPECT_LT(change, 1e-3);
 }
 
+namespace {
+struct Shedding {
+  Oscillation lift, drag;
+  double strouhal;
+};
+
+// dfg_2d2.json with `overrides` to t = 6 on 2 threads; c_D, c_L and St analysed over t >= 3.
+Shedding dfg2d2ToSixSeconds(const char* label, std::vector<Override> overrides) {
+  overrides.insert(overrides.begin(), {"time.end", "6.0"});
+  const Registry registry = builtins();
+  Simulation<2> sim(loadScene(kScenes + "dfg_2d2.json", overrides), registry, 2);
+  std::vector<double> t, cD, cL;
+  while (!sim.finished()) {
+    const auto& diag = sim.step();
+    t.push_back(sim.time());
+    cD.push_back(2 * diag.at("obstacle_cylinder_force_x") / 0.1);  // rho = 1, Ubar = 1, D = 0.1
+    cL.push_back(2 * diag.at("obstacle_cylinder_force_y") / 0.1);
+  }
+  Shedding r{analyseOscillation(t, cL, 3.0), analyseOscillation(t, cD, 3.0), 0};
+  r.strouhal = r.lift.frequency() * 0.1;
+  std::printf("dfg_2d2 220x41%s t = 6: St = %.4f (%d periods), c_D max = %.4f, c_L max = %.4f\n", label, r.strouhal,
+              r.lift.crossings - 1, r.drag.max, r.lift.max);
+  return r;
+}
+}  // namespace
+
 TEST(DfgPeriodic, VorticesShedAtNearlyTheReferenceFrequencyAt10CellsPerDiameter) {
   // Schaefer & Turek 2D-2 (Re 100) on the coarsest grid of the benchmark, 220 x 41 (D = 10
   // cells), to t = 6 s; the lift is analysed over t >= 3 s (the shedding is periodic from about
@@ -95,19 +121,7 @@ TEST(DfgPeriodic, VorticesShedAtNearlyTheReferenceFrequencyAt10CellsPerDiameter)
   // convergence towards 1.00 (docs/benchmarks.md). The thesis's staircase disk gives 0.43 here,
   // plain semi-Lagrangian advection 0.10: the lift bound fails for either, the others if the
   // shedding stops or its frequency moves by > 20 %.
-  const Registry registry = builtins();
-  Simulation<2> sim(loadScene(kScenes + "dfg_2d2.json", {{"time.end", "6.0"}}), registry, 2);
-  std::vector<double> t, cD, cL;
-  while (!sim.finished()) {
-    const auto& diag = sim.step();
-    t.push_back(sim.time());
-    cD.push_back(2 * diag.at("obstacle_cylinder_force_x") / 0.1);  // rho = 1, Ubar = 1, D = 0.1
-    cL.push_back(2 * diag.at("obstacle_cylinder_force_y") / 0.1);
-  }
-  const Oscillation lift = analyseOscillation(t, cL, 3.0), drag = analyseOscillation(t, cD, 3.0);
-  const double st = lift.frequency() * 0.1;
-  std::printf("dfg_2d2 220x41 t = 6: St = %.4f (%d periods), c_D max = %.4f, c_L max = %.4f\n", st,
-              lift.crossings - 1, drag.max, lift.max);
+  const auto [lift, drag, st] = dfg2d2ToSixSeconds("", {});
   EXPECT_GE(lift.crossings, 6);
   EXPECT_NEAR(st, 0.300, 0.06);
   EXPECT_NEAR(drag.max, 3.23, 0.05 * 3.23);
@@ -125,23 +139,10 @@ TEST(DfgPeriodic, TheStaircasesOwnWallWithInsideGhostsLiftsMoreThanTheSceneAt10C
   // both bounds below fail for the old rule, the lift bound without ghosts. This setting's lift
   // converges faster than the scene's (-9.0 % at 440 x 82, against -22.1 %), its drag pays
   // (+7.2 %, against -0.3 %).
-  const Registry registry = builtins();
-  Simulation<2> sim(loadScene(kScenes + "dfg_2d2.json", {{"time.end", "6.0"},
-                                                          {"solvers.fluid.obstacle_cells", "staircase"},
-                                                          {"solvers.fluid.obstacle_wall", "cell_boundary"},
-                                                          {"solvers.fluid.advection_wall", "surface"}}),
-                    registry, 2);
-  std::vector<double> t, cD, cL;
-  while (!sim.finished()) {
-    const auto& diag = sim.step();
-    t.push_back(sim.time());
-    cD.push_back(2 * diag.at("obstacle_cylinder_force_x") / 0.1);
-    cL.push_back(2 * diag.at("obstacle_cylinder_force_y") / 0.1);
-  }
-  const Oscillation lift = analyseOscillation(t, cL, 3.0), drag = analyseOscillation(t, cD, 3.0);
-  const double st = lift.frequency() * 0.1;
-  std::printf("dfg_2d2 220x41 staircase/cell_boundary/ghosts t = 6: St = %.4f (%d periods), c_D max = %.4f, c_L max = %.4f\n",
-              st, lift.crossings - 1, drag.max, lift.max);
+  const auto [lift, drag, st] = dfg2d2ToSixSeconds(" staircase/cell_boundary/ghosts",
+                                                   {{"solvers.fluid.obstacle_cells", "staircase"},
+                                                    {"solvers.fluid.obstacle_wall", "cell_boundary"},
+                                                    {"solvers.fluid.advection_wall", "surface"}});
   EXPECT_GE(lift.crossings, 6);
   EXPECT_NEAR(st, 0.265, 0.03);
   EXPECT_GT(lift.max, 0.66);
