@@ -420,6 +420,19 @@ TEST(SceneValidationCli, ValidateAcceptsShippedScene) {
   EXPECT_NE(c.output.find("valid (3-D, 300 steps"), std::string::npos) << c.output;
 }
 
+TEST(SceneValidationCli, EveryShippedSceneIsValid) {
+  // The scenes users start from: a settings change that one of them no longer satisfies (e.g. a
+  // combination made illegal) must fail here, not in a user's first run.
+  int scenes = 0;
+  for (const auto& entry : fs::directory_iterator(std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes")) {
+    if (entry.path().extension() != ".json") continue;
+    const Command c = runCommand(quoted(MONOLITH_CLI) + " validate " + quoted(entry.path().string()));
+    EXPECT_EQ(c.status, 0) << entry.path() << "\n" << c.output;
+    ++scenes;
+  }
+  EXPECT_GE(scenes, 20);
+}
+
 TEST(SceneValidationCli, ValidateAcceptsTheValidBaseScenes) {
   // The broken cases above are small edits of these: they must be valid as they stand.
   const fs::path dir = testDirectory();
