@@ -357,19 +357,18 @@ TEST(WallGhosts, FacesOnTheStaircaseKeepTheirOwnVelocity) {
   // they sit and must get no ghost value, although each has free u-faces above or below it. Only
   // the u-faces inside the block (x = 4 h) get ghosts, one rule from below, one from above.
   const MacLayout<2> layout(Index<2>(8, 6), 0.125, Vec<2>::Zero(), {false, false});
-  FluidDomain<2> domain = boxDomain(layout, BoxSpec<2>{SideSpec<2>::wall(), SideSpec<2>::wall(), SideSpec<2>::wall(), SideSpec<2>::wall()});
+  const SideSpec<2> wall = SideSpec<2>::wall();
+  FluidDomain<2> domain = boxDomain(layout, BoxSpec<2>{wall, wall, wall, wall});
   std::vector<std::uint8_t> solid(layout.cellCount(), 0);
   for (int i = 3; i <= 4; ++i)
     for (int j = 2; j <= 3; ++j) solid[layout.cellIndex(Index<2>(i, j))] = 1;
   markSolid(domain, solid);
   domain.wallDistance.assign(static_cast<std::size_t>(layout.totalFaces()) * 4, 0.5);
   const std::vector<GhostRule> rules = obstacleWallGhosts(domain);
-  std::vector<int> ghosted;
   for (const GhostRule& rule : rules) {
     const auto [axis, face] = layout.faceCoord(rule.face);
     EXPECT_EQ(face[axis == 0 ? 0 : 1], axis == 0 ? 4 : 3) << "axis " << axis << " face " << face[0] << "," << face[1];
     EXPECT_DOUBLE_EQ(rule.factor, -1.0);  // theta = 1/2: the mirror image
-    ghosted.push_back(rule.face);
   }
   // u-faces (4, 2) from below and (4, 3) from above; v-faces (3, 3) from the left, (4, 3) from the right.
   EXPECT_EQ(rules.size(), 4u);
