@@ -21,8 +21,8 @@
 //      obstacle's true surface or cell boundary; only faces inside the obstacle) is read as its
 //      ghost value instead: the linear extension of the fluid velocity through the wall, so an
 //      interpolated sample falls to the wall velocity at the wall itself rather than at the
-//      obstacle face's centre (thesis Sec. 5.2: "ghost cells
-//      or clipping"; Gibou et al. 2002 place the wall the same way). Such faces count as fluid
+//      obstacle face's centre (thesis Sec. 5.2: "ghost cells or clipping"; Gibou et al. 2002
+//      place the wall the same way). Such faces count as fluid
 //      faces below, also when they lie inside a structure. A ghost value lies between the wall
 //      velocity u_w and its mirror 2 u_w - u_from, so samples stay within the range of the fluid
 //      values reflected about the wall's.
