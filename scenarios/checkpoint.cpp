@@ -1,5 +1,6 @@
 #include "scenarios/checkpoint.h"
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -88,6 +89,8 @@ void writeCheckpoint(const std::string& path, const CheckpointHeader& header, co
   out.string(header.sceneFile);
   out.string(header.sceneJson);
   out.pod<std::int64_t>(header.checkpointEvery);
+  out.pod<std::int64_t>(header.clock.step);
+  out.pod(header.clock.time);
   serializeWorld(world, out);
   out.pod(fnv1a(out.bytes().data(), out.bytes().size()));
   writeFileAtomically(path, std::string(out.bytes().begin(), out.bytes().end()));
@@ -104,9 +107,10 @@ CheckpointFile readCheckpoint(const std::string& path) {
   r.raw(magic, sizeof magic);
   if (std::memcmp(magic, kMagic, sizeof kMagic) != 0) r.fail("not a Monolith checkpoint (bad magic)");
   const auto format = r.pod<std::uint32_t>();
-  if (format != kCheckpointFormat)
-    throw std::runtime_error("checkpoint '" + path + "': format " + std::to_string(format) + ", this monolith reads format " +
-                             std::to_string(kCheckpointFormat));
+  constexpr std::uint32_t kOldestFormat = 2;
+  if (format < kOldestFormat || format > kCheckpointFormat)
+    throw std::runtime_error("checkpoint '" + path + "': format " + std::to_string(format) + ", this monolith reads formats " +
+                             std::to_string(kOldestFormat) + " to " + std::to_string(kCheckpointFormat));
   constexpr std::size_t kChecksumBytes = sizeof(std::uint64_t);
   if (f.bytes.size() < sizeof kMagic + 4 + kChecksumBytes) r.fail("file too short to be a checkpoint");
   std::uint64_t stored = 0;
@@ -125,6 +129,12 @@ CheckpointFile readCheckpoint(const std::string& path) {
   f.header.sceneJson = r.string();
   f.header.checkpointEvery = static_cast<long>(r.pod<std::int64_t>());
   if (f.header.checkpointEvery < 0) r.fail("negative checkpoint interval");
+  if (format >= 3) {
+    f.header.clock.step = static_cast<long>(r.pod<std::int64_t>());
+    f.header.clock.time = r.pod<double>();
+    if (f.header.clock.step < 0 || f.header.clock.step > f.header.step || !std::isfinite(f.header.clock.time))
+      r.fail("clock origin (step " + std::to_string(f.header.clock.step) + ") is not a step of the run before this one");
+  }
   if (f.header.dimension != 2 && f.header.dimension != 3) r.fail("dimension is not 2 or 3");
   f.worldOffset = f.bytes.size() - r.remaining();
   if (f.worldOffset > f.worldEnd) r.fail("header runs into the checksum");

@@ -2,20 +2,23 @@
 // Checkpoints: the full state of a run in a versioned binary file, written atomically
 // (temporary file + rename), so a crash never leaves a half-written checkpoint behind.
 //
-// Layout (format 2): magic "MONOLITH-CKPT", u32 format, u32 endianness probe 0x01020304,
+// Layout (format 3): magic "MONOLITH-CKPT", u32 format, u32 endianness probe 0x01020304,
 // u32 sizeof(double), i32 dimension, i64 step (steps completed), f64 time, string scene file,
-// string scene JSON (after --set overrides), i64 checkpoint interval of the run, world state
-// (see serializeWorld), u64 FNV-1a of every byte before it (a flipped bit anywhere is caught).
+// string scene JSON (after --set overrides), i64 checkpoint interval of the run, i64 + f64 the
+// clock origin of a fixed-dt run (ClockOrigin), world state (see serializeWorld), u64 FNV-1a of
+// every byte before it (a flipped bit anywhere is caught). Format 2, without the clock origin
+// (which was then always (0, 0)), is still read.
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "ecs/registry.h"
 #include "ecs/world.h"
+#include "scenarios/scene.h"
 
 namespace monolith {
 
-inline constexpr std::uint32_t kCheckpointFormat = 2;
+inline constexpr std::uint32_t kCheckpointFormat = 3;
 
 // Entity table (generations, alive flags, free list, names) and every pool, in name order.
 template <int d>
@@ -36,6 +39,7 @@ struct CheckpointHeader {
   std::string sceneFile;
   std::string sceneJson;
   long checkpointEvery = 0;  // the run's interval, kept by `monolith resume`
+  ClockOrigin clock;         // the run's, so that a resume continues its clock bitwise
 };
 
 template <int d>

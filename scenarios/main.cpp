@@ -19,7 +19,8 @@ const char* kUsage =
     "usage:\n"
     "  monolith run SCENE [--out DIR] [--threads N] [--set key=value]... [--checkpoint-every K]\n"
     "                     [--plugin PATH]... [--no-frames] [--quiet]\n"
-    "  monolith resume CHECKPOINT [--out DIR] [--threads N] [--checkpoint-every K] [--plugin PATH]... [--quiet]\n"
+    "  monolith resume CHECKPOINT [--out DIR] [--threads N] [--set time.KEY=value]... [--checkpoint-every K]\n"
+    "                            [--plugin PATH]... [--quiet]\n"
     "  monolith validate SCENE [--set key=value]... [--plugin PATH]...\n"
     "  monolith graph SCENE          print the step's task graph (Graphviz DOT)\n"
     "  monolith systems [--plugin PATH]...   list component and system types\n"
@@ -132,7 +133,11 @@ int main(int argc, char** argv) {
   if (args.target.empty()) usageError(args.command + " needs a " + (args.command == "resume" ? "CHECKPOINT" : "SCENE"));
 
   if (args.command == "resume") {
-    const RunResult r = resumeRun(args.target, registry, plugins, args.run);
+    for (const auto& o : args.overrides)
+      if (o.first.rfind("time.", 0) != 0)
+        usageError("resume --set changes only time settings (time.end, time.steps, time.dt, time.cfl, "
+                   "time.frame_rate), got '" + o.first + "'");
+    const RunResult r = resumeRun(args.target, registry, plugins, args.run, args.overrides);
     if (r.exitCode != kExitOk) {
       std::fprintf(stderr, "monolith: %s\n", r.message.c_str());
       return r.exitCode;

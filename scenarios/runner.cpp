@@ -290,7 +290,7 @@ RunResult Run<d>::execute() {
     if (sim_->frameDue()) writeFrame(done);
     if (checkpointEvery > 0 && done % checkpointEvery == 0) {
       const std::string path = checkpointPath(done);
-      writeCheckpoint(path, CheckpointHeader{d, done, sim_->time(), fs::absolute(scene_.file).string(), scene_.json.dump(), checkpointEvery_}, world());
+      writeCheckpoint(path, CheckpointHeader{d, done, sim_->time(), fs::absolute(scene_.file).string(), scene_.json.dump(), checkpointEvery_, scene_.clock}, world());
       checkpoints_.push_back(path);
       lastGoodCheckpoint = path;
     }
@@ -349,13 +349,28 @@ RunResult runScene(const SceneSpec& scene, Registry& registry, PluginLoader& plu
   return dispatch(scene, registry, plugins, options, nullptr);
 }
 
-RunResult resumeRun(const std::string& checkpointPath, Registry& registry, PluginLoader& plugins, RunOptions options) {
+RunResult resumeRun(const std::string& checkpointPath, Registry& registry, PluginLoader& plugins, RunOptions options,
+                    const std::vector<Override>& timeOverrides) {
   RunResult r;
   CheckpointFile file;
   SceneSpec scene;
   try {
     file = readCheckpoint(checkpointPath);
-    scene = parseScene(file.header.sceneJson, file.header.sceneFile);
+    const ClockOrigin& clock = file.header.clock;
+    scene = parseScene(file.header.sceneJson, file.header.sceneFile, {}, clock);
+    if (!timeOverrides.empty()) {
+      for (const auto& o : timeOverrides)
+        if (o.first.rfind("time.", 0) != 0)
+          throw std::runtime_error("--set " + o.first + ": a resume may change only \"time\" settings (time.end, "
+                                   "time.steps, time.dt, time.cfl, time.frame_rate); the rest of the run is its "
+                                   "checkpointed state");
+      const SceneSpec before = scene;
+      scene = parseScene(file.header.sceneJson, file.header.sceneFile, timeOverrides, clock);
+      // A new fixed step: the clock goes on from the checkpoint's time (ClockOrigin), not n dt.
+      if (scene.cfl <= 0 && (before.cfl > 0 || before.dt != scene.dt))
+        scene = parseScene(file.header.sceneJson, file.header.sceneFile, timeOverrides,
+                           ClockOrigin{file.header.step, file.header.time});
+    }
   } catch (const SceneError& e) {
     r.exitCode = kExitInvalidScene;
     r.message = std::string("checkpoint '") + checkpointPath + "': embedded scene: " + e.what();
@@ -370,12 +385,17 @@ RunResult resumeRun(const std::string& checkpointPath, Registry& registry, Plugi
     r.message = "checkpoint '" + checkpointPath + "': dimension differs from its scene";
     return r;
   }
-  // A step beyond the scene's end (corrupt header) would silently "complete" without stepping.
+  // A step beyond the scene's end (corrupt header, or an earlier end given to resume) would
+  // silently "complete" without stepping.
   if ((scene.cfl <= 0 && file.header.step > scene.steps) ||
       (scene.cfl > 0 && file.header.time > scene.endTime * (1 + 1e-12))) {
+    char where[160];
+    std::snprintf(where, sizeof where, "step %ld (t = %g) is beyond the scene's end (t = %g", file.header.step,
+                  file.header.time, scene.endTime);
     r.exitCode = kExitInvalidScene;
-    r.message = "checkpoint '" + checkpointPath + "': step " + std::to_string(file.header.step) +
-                " is beyond the scene's " + std::to_string(scene.steps) + " steps";
+    r.message = "checkpoint '" + checkpointPath + "': " + where +
+                (scene.cfl > 0 ? ")" : ", " + std::to_string(scene.steps) + " steps)") +
+                (timeOverrides.empty() ? "" : "; a time.end or time.steps given to resume must lie after the checkpoint");
     return r;
   }
   if (options.outDir.empty()) {  // continue in the run directory the checkpoint belongs to

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "ecs/plugin.h"
 #include "ecs/registry.h"
@@ -38,7 +39,10 @@ struct RunResult {
 };
 
 RunResult runScene(const SceneSpec& scene, Registry& registry, PluginLoader& plugins, const RunOptions& options);
-// Continues the run a checkpoint was taken from (to the scene's end).
-RunResult resumeRun(const std::string& checkpointPath, Registry& registry, PluginLoader& plugins, RunOptions options);
+// Continues the run a checkpoint was taken from (to the scene's end). `timeOverrides` ("--set
+// time.KEY=value" only) move the end or change the step: with a new fixed dt the clock goes on
+// from the checkpoint's time, t = t_ckpt + (n - n_ckpt) dt (see ClockOrigin).
+RunResult resumeRun(const std::string& checkpointPath, Registry& registry, PluginLoader& plugins, RunOptions options,
+                    const std::vector<Override>& timeOverrides = {});
 
 }  // namespace monolith

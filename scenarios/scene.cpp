@@ -173,9 +173,12 @@ void applyOverride(Json& root, const Override& o, const std::string& file) {
   }
 }
 
-// "time": {"dt", "steps" | "end", "frame_rate"}: a fixed step.
-void parseFixedTime(const Config& time, SceneSpec& s) {
+// "time": {"dt", "steps" | "end", "frame_rate"}: a fixed step. "steps" counts from step 0; "end"
+// from the clock's origin (0 but after a resume that changed dt), so that the time left is a
+// whole number of steps.
+void parseFixedTime(const Config& time, const ClockOrigin& clock, SceneSpec& s) {
   s.dt = time.number("dt", Bound::Positive);
+  s.clock = clock;
   if (time.has("steps") && time.has("end")) time.failAt("end", "either \"end\" or \"steps\", not both", "both");
   const long maxSteps = 1000000000L;
   if (!time.has("steps") && !time.has("end")) {
@@ -186,26 +189,33 @@ void parseFixedTime(const Config& time, SceneSpec& s) {
     time.finish();
     time.fail("a \"steps\" or an \"end\" key (neither is given)", "");
   }
+  const bool resumed = clock.step > 0;
+  const std::string after = resumed ? " after the checkpoint's t = " + formatNumber(clock.time) : "";
   if (time.has("steps")) {
     s.steps = time.integer("steps", 1, maxSteps);
   } else {
     const double end = time.number("end", Bound::Positive);
-    const double n = end / s.dt;
+    const double n = (end - clock.time) / s.dt;
+    const std::string ratio = resumed ? "(end - t)/dt" : "end/dt";
     // Checked before lround, which is undefined beyond the range of long.
     if (!(n <= static_cast<double>(maxSteps) + 0.5))
-      time.failAt("end", "at most " + std::to_string(maxSteps) + " steps of dt = " + formatNumber(s.dt) +
-                             " (end/dt = " + formatNumber(n) + ")",
+      time.failAt("end", "at most " + std::to_string(maxSteps) + " steps of dt = " + formatNumber(s.dt) + after +
+                             " (" + ratio + " = " + formatNumber(n) + ")",
                   describeJson(time.raw()["end"]));
-    s.steps = std::lround(n);
-    if (s.steps < 1 || std::abs(n - static_cast<double>(s.steps)) > 1e-6 * std::max(1.0, n))
+    if (resumed && n < 0.5)
+      time.failAt("end", "an end after the checkpoint's t = " + formatNumber(clock.time), describeJson(time.raw()["end"]));
+    const long left = std::lround(n);
+    if (left < 1 || std::abs(n - static_cast<double>(left)) > 1e-6 * std::max(1.0, n))
       time.failAt("end",
-                  "a whole number of steps of dt = " + formatNumber(s.dt) + " (end/dt = " + formatNumber(n) + ")",
+                  "a whole number of steps of dt = " + formatNumber(s.dt) + after + " (" + ratio + " = " +
+                      formatNumber(n) + ")",
                   describeJson(time.raw()["end"]));
+    s.steps = clock.step + left;
   }
   const double frameRate = time.number("frame_rate", 30.0, Bound::NonNegative);
   // Capped before lround, which is undefined beyond the range of long (a tiny frame rate).
   s.frameEvery = frameRate > 0 ? std::max(1L, std::lround(std::min(1.0 / (frameRate * s.dt), 1e15))) : 0;
-  s.endTime = static_cast<double>(s.steps) * s.dt;
+  s.endTime = clock.time + static_cast<double>(s.steps - clock.step) * s.dt;
 }
 
 // "time": {"cfl", "end", "dt" (largest step), "frame_rate"}: the step follows the CFL condition
@@ -265,7 +275,8 @@ void parseProbesAndProfiles(const Config& out, SceneSpec& s) {
 
 }  // namespace
 
-SceneSpec parseScene(const std::string& text, const std::string& file, const std::vector<Override>& overrides) {
+SceneSpec parseScene(const std::string& text, const std::string& file, const std::vector<Override>& overrides,
+                     const ClockOrigin& clock) {
   SceneSpec s;
   s.file = file;
   s.directory = directoryOf(file);
@@ -287,7 +298,7 @@ SceneSpec parseScene(const std::string& text, const std::string& file, const std
   if (time.has("cfl")) {
     parseCflTime(time, s);
   } else {
-    parseFixedTime(time, s);
+    parseFixedTime(time, clock, s);
   }
   time.finish();
 

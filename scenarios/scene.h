@@ -27,6 +27,14 @@ struct ProfileSpec {
   std::string path;
 };
 
+// Where a fixed-dt scene's clock counts from: t^n = time + (n - step) dt. It is (0, 0), so that
+// t^n = n dt exactly, unless `monolith resume --set time.dt=...` changed the step of a run: then
+// it is the checkpoint's (step, time), and the run continues from there at the new dt.
+struct ClockOrigin {
+  long step = 0;
+  double time = 0;
+};
+
 struct SceneSpec {
   std::string file;       // the path as given (used in messages)
   std::string directory;  // relative paths in the scene are resolved against this
@@ -34,7 +42,8 @@ struct SceneSpec {
   std::string description;
   int dimension = 3;
   double dt = 0;
-  long steps = 0;        // fixed-dt scenes; 0 when the step follows the CFL condition
+  long steps = 0;        // fixed-dt scenes (counted from step 0); 0 when the step follows the CFL condition
+  ClockOrigin clock;     // fixed-dt scenes
   double endTime = 0;    // simulated time at the end
   double cfl = 0;        // > 0: adaptive step, dt = cfl * (smallest unit-CFL step of the systems)
   long frameEvery = 1;   // fixed dt: write a frame every this many steps (0: no frames)
@@ -56,8 +65,10 @@ using Override = std::pair<std::string, std::string>;
 
 // Parses the file (comments allowed), applies the overrides and validates the top level.
 SceneSpec loadScene(const std::string& path, const std::vector<Override>& overrides = {});
-// Same, from text already in memory (checkpoints carry their scene).
-SceneSpec parseScene(const std::string& text, const std::string& file, const std::vector<Override>& overrides = {});
+// Same, from text already in memory (checkpoints carry their scene). `clock`: the origin a
+// fixed-dt scene's "end" is counted from (a resumed run's, see ClockOrigin).
+SceneSpec parseScene(const std::string& text, const std::string& file, const std::vector<Override>& overrides = {},
+                     const ClockOrigin& clock = {});
 
 // Creates the scene's entities in `world` (which must be empty) and sets the world settings.
 template <int d>

@@ -33,6 +33,13 @@ double Simulation<d>::nextDt() const {
 }
 
 template <int d>
+double Simulation<d>::fixedTime(long steps) const {
+  // With the origin (0, 0) this is steps * dt exactly (0 + x == x), as before resumes could
+  // change dt.
+  return scene_.clock.time + static_cast<double>(steps - scene_.clock.step) * scene_.dt;
+}
+
+template <int d>
 bool Simulation<d>::finished() const {
   if (scene_.cfl <= 0) return stepsDone_ >= scene_.steps;
   return time_ >= scene_.endTime * (1 - 1e-14);
@@ -41,7 +48,7 @@ bool Simulation<d>::finished() const {
 template <int d>
 void Simulation<d>::restoreClock(long steps, double time) {
   stepsDone_ = steps;
-  time_ = scene_.cfl > 0 ? time : steps * scene_.dt;
+  time_ = scene_.cfl > 0 ? time : fixedTime(steps);
   framesDone_ = scene_.frameInterval > 0 ? std::lround(std::floor(time_ / scene_.frameInterval + 1e-9)) : 0;
 }
 
@@ -56,8 +63,8 @@ const std::map<std::string, double>& Simulation<d>::step() {
   ++stepsDone_;
   lastDt_ = dt;
   if (scene_.cfl <= 0) {
-    time_ = stepsDone_ * scene_.dt;  // from the index: no drift, identical after a resume
-    frameDue_ = scene_.frameEvery > 0 && stepsDone_ % scene_.frameEvery == 0;
+    time_ = fixedTime(stepsDone_);  // from the index: no drift, identical after a resume
+    frameDue_ = scene_.frameEvery > 0 && (stepsDone_ - scene_.clock.step) % scene_.frameEvery == 0;
   } else {
     time_ += dt;
     frameDue_ = false;

@@ -19,7 +19,7 @@ class Simulation {
   Simulation(const SceneSpec& scene, const Registry& registry, int threads = 0);
 
   // Advances one step from t^n; returns the step's diagnostics. Fixed-dt scenes step by dt
-  // (t^n = n dt exactly); CFL scenes by nextDt().
+  // (t^n = n dt exactly, or counted from the scene's clock origin); CFL scenes by nextDt().
   const std::map<std::string, double>& step();
   long stepsDone() const { return stepsDone_; }
   double time() const { return time_; }
@@ -43,6 +43,8 @@ class Simulation {
   void reschedule();
 
  private:
+  double fixedTime(long steps) const;  // t^steps of a fixed-dt scene
+
   SceneSpec scene_;
   const Registry& registry_;
   int threads_;

@@ -10,6 +10,7 @@
 #include "ecs/binary_io.h"
 #include "support/cli_harness.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -164,16 +165,16 @@ TEST(CheckpointRestart, StraightAndResumedRunsAgreeBitwise) {
 
 // --- damaged checkpoints -------------------------------------------------------------------
 
-// Byte offsets of a format-2 checkpoint (layout in scenarios/checkpoint.h): magic (14 bytes),
+// Byte offsets of a format-3 checkpoint (layout in scenarios/checkpoint.h): magic (14 bytes),
 // u32 format, u32 endianness probe, u32 sizeof(double), i32 dimension, i64 step, f64 time,
-// string scene file, string scene JSON (u64 length + bytes), i64 checkpoint interval, then the
-// world (and a trailing u64 FNV-1a checksum): vector
+// string scene file, string scene JSON (u64 length + bytes), i64 checkpoint interval, i64 + f64
+// clock origin, then the world (and a trailing u64 FNV-1a checksum): vector
 // generations, vector alive flags, vector free list (u64 length + items), u64 slot count, one
 // name string per slot, u64 pool count, then per pool: name string, u64 count, and per
 // component u32 entity index, u32 generation, fields (rigid_body starts with f64 mass).
 struct Layout {
-  std::size_t format = 14, dimension = 26, step = 30, sceneFile = 46, sceneJson = 0, world = 0, firstPool = 0,
-              firstRecord = 0;
+  std::size_t format = 14, dimension = 26, step = 30, sceneFile = 46, sceneJson = 0, clock = 0, world = 0,
+              firstPool = 0, firstRecord = 0;
   std::string firstPoolName;
 };
 
@@ -198,7 +199,8 @@ void put(std::string& b, std::size_t at, T v) {
 Layout parseLayout(const std::string& b) {
   Layout l;
   l.sceneJson = l.sceneFile + 8 + u64At(b, l.sceneFile);
-  l.world = l.sceneJson + 8 + u64At(b, l.sceneJson) + 8;
+  l.clock = l.sceneJson + 8 + u64At(b, l.sceneJson) + 8;
+  l.world = l.clock + 16;
   std::size_t p = l.world;
   const std::uint64_t slots = u64At(b, p);
   p += 8 + 4 * slots;                // generations (u32)
@@ -253,6 +255,9 @@ TEST(CheckpointRestart, DamagedCheckpointsAreRejectedCleanly) {
     b = good;
     put<std::int64_t>(b, l.step, 1000000);  // beyond the scene's 2N steps
     damaged["step_beyond_end"] = reseal(b);
+    b = good;
+    put<std::int64_t>(b, l.clock, N + 1);  // a clock origin after the checkpoint's own step
+    damaged["clock_origin_after_step"] = reseal(b);
     b = good;
     b[l.sceneJson + 8] = '#';  // the embedded scene is no longer JSON
     damaged["scene_json"] = reseal(b);
@@ -349,6 +354,135 @@ TEST(CheckpointRestart, ResumeInPlaceKeepsEarlierRowsAndContinues) {
   EXPECT_EQ(after["status"], "completed");
   EXPECT_EQ(after["steps_completed"], 2 * N);
   EXPECT_EQ(after["state_hash"], before["state_hash"]);
+}
+
+// --- resume --set time.* -------------------------------------------------------------------
+
+// A longer end given on resume: the same state, bit for bit, as a run that had that end from
+// the start (the step is unchanged, so t^n = n dt as before).
+TEST(CheckpointRestart, ResumeWithALaterEndMatchesTheLongerRunBitwise) {
+  Fixture f;
+  const fs::path A = f.tmp.path() / "A", L = f.tmp.path() / "L", B = f.tmp.path() / "B";
+  ASSERT_EQ(f.straightRun(A).exitCode, 0);
+  const CommandResult l = run({MONOLITH_CLI, "run", f.scene.string(), "--out", L.string(), "--set",
+                               "time.steps=" + std::to_string(3 * N), "--quiet"},
+                              f.logs, kCommandTimeoutSeconds);
+  ASSERT_EQ(l.exitCode, 0) << l.err;
+  const CommandResult b = run({MONOLITH_CLI, "resume", (A / checkpoint(2 * N)).string(), "--out", B.string(), "--set",
+                               "time.steps=" + std::to_string(3 * N), "--quiet"},
+                              f.logs, kCommandTimeoutSeconds);
+  ASSERT_EQ(b.exitCode, 0) << b.err;
+  const Json sl = Json::parse(slurp(L / "summary.json")), sb = Json::parse(slurp(B / "summary.json"));
+  EXPECT_EQ(sb["steps_completed"], 3 * N);
+  EXPECT_EQ(sl["state_hash"], sb["state_hash"]);
+  expectSameRowsExceptTiming(readMetrics(L / "metrics.csv"), readMetrics(B / "metrics.csv"), 2 * N + 1, 3 * N);
+}
+
+// The fixture's scene with an "end" instead of "steps", stepped at dt = 0.02 to t = 0.6 with a
+// checkpoint every 10 steps.
+struct EndFixture : Fixture {
+  static constexpr double kDt = 0.02;
+  fs::path A;
+  EndFixture() : A(tmp.path() / "A") {
+    std::string text = kScene;
+    const std::string steps = "\"steps\": 300";
+    text.replace(text.find(steps), steps.size(), "\"end\": 10");
+    writeFile(scene, text);
+  }
+  CommandResult runToEnd() {
+    return run({MONOLITH_CLI, "run", scene.string(), "--out", A.string(), "--set", "time.dt=0.02", "--set",
+                "time.end=0.6", "--checkpoint-every", "10", "--quiet"},
+               logs, kCommandTimeoutSeconds);
+  }
+  CommandResult resume(const fs::path& ckpt, const fs::path& out, const std::vector<std::string>& sets) {
+    std::vector<std::string> cmd = {MONOLITH_CLI, "resume", ckpt.string(), "--out", out.string(), "--quiet"};
+    for (const auto& s : sets) cmd.insert(cmd.end(), {"--set", s});
+    return run(cmd, logs, kCommandTimeoutSeconds);
+  }
+};
+
+// A new step on resume: the clock goes on from the checkpoint's time, t^n = t_10 + (n - 10) dt',
+// the end stays 0.6 (40 steps of 0.01 after t = 0.2), and a checkpoint written after the
+// change resumes bitwise (it carries the clock origin). Resuming with the same dt given again
+// is the straight run, bitwise.
+TEST(CheckpointRestart, ResumeWithANewStepContinuesTheClockFromTheCheckpoint) {
+  EndFixture f;
+  ASSERT_EQ(f.runToEnd().exitCode, 0);
+  const double t10 = 10 * EndFixture::kDt;  // the checkpoint's time, as the run computed it
+
+  const fs::path B = f.tmp.path() / "B";
+  const CommandResult b = f.resume(f.A / checkpoint(10), B, {"time.dt=0.01"});
+  ASSERT_EQ(b.exitCode, 0) << b.err;
+  const Metrics mb = readMetrics(B / "metrics.csv");
+  ASSERT_EQ(mb.steps.size(), 40u);
+  const auto timeColumn = std::find(mb.header.begin(), mb.header.end(), "time") - mb.header.begin();
+  const auto dtColumn = std::find(mb.header.begin(), mb.header.end(), "dt") - mb.header.begin();
+  for (long n = 11; n <= 50; ++n) {
+    EXPECT_EQ(std::stod(mb.rows.at(n).at(timeColumn)), t10 + static_cast<double>(n - 10) * 0.01) << "step " << n;
+    EXPECT_EQ(std::stod(mb.rows.at(n).at(dtColumn)), 0.01) << "step " << n;
+  }
+  const Json sb = Json::parse(slurp(B / "summary.json"));
+  EXPECT_EQ(sb["steps_completed"], 50);
+  EXPECT_NEAR(sb["time"].get<double>(), 0.6, 1e-12);
+  // The finer second half moved the bodies differently from the straight run.
+  EXPECT_NE(sb["state_hash"], Json::parse(slurp(f.A / "summary.json"))["state_hash"]);
+
+  const fs::path C = f.tmp.path() / "C";
+  ASSERT_TRUE(fs::exists(B / checkpoint(30)));
+  const CommandResult c = f.resume(B / checkpoint(30), C, {});
+  ASSERT_EQ(c.exitCode, 0) << c.err;
+  EXPECT_EQ(Json::parse(slurp(C / "summary.json"))["state_hash"], sb["state_hash"]);
+  expectSameRowsExceptTiming(mb, readMetrics(C / "metrics.csv"), 31, 50);
+
+  const fs::path D = f.tmp.path() / "D";
+  const CommandResult same = f.resume(f.A / checkpoint(10), D, {"time.dt=0.02"});
+  ASSERT_EQ(same.exitCode, 0) << same.err;
+  EXPECT_EQ(Json::parse(slurp(D / "summary.json"))["state_hash"],
+            Json::parse(slurp(f.A / "summary.json"))["state_hash"]);
+}
+
+// Resume settings that cannot hold: a non-time key (exit 2), an end before the checkpoint, and
+// a step that does not divide the time left (exit 3); each names what was wrong, and nothing
+// is written.
+TEST(CheckpointRestart, ResumeRejectsSettingsItCannotHonour) {
+  EndFixture f;
+  ASSERT_EQ(f.runToEnd().exitCode, 0);
+  struct Case {
+    std::string set;
+    int exitCode;
+    std::vector<std::string> inMessage;
+  };
+  const std::vector<Case> cases = {
+      {"entities.faller.rigid_body.mass=3", 2, {"time settings", "entities.faller.rigid_body.mass"}},
+      {"time.end=0.1", 3, {"step 10 (t = 0.2) is beyond the scene's end (t = 0.1, 5 steps)", "time.end"}},
+      {"time.dt=0.03", 3, {"time.end", "whole number of steps of dt = 0.03 after the checkpoint's t = 0.2"}},
+      {"time.dt=-1", 3, {"time.dt"}},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.set);
+    const fs::path out = f.tmp.path() / "rejected";
+    const CommandResult r = f.resume(f.A / checkpoint(10), out, {c.set});
+    EXPECT_EQ(r.exitCode, c.exitCode) << r.err;
+    for (const auto& m : c.inMessage) EXPECT_NE(r.err.find(m), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+// Checkpoints written before the clock origin existed (format 2) still resume, bitwise.
+TEST(CheckpointRestart, FormatTwoCheckpointsStillResume) {
+  Fixture f;
+  const fs::path A = f.tmp.path() / "A", B = f.tmp.path() / "B";
+  ASSERT_EQ(f.straightRun(A).exitCode, 0);
+  std::string b = slurp(A / checkpoint(N));
+  const Layout l = parseLayout(b);
+  b.erase(l.clock, 16);
+  put<std::uint32_t>(b, l.format, 2);
+  const fs::path old = f.tmp.path() / "format2.ckpt";
+  writeFile(old, reseal(b));
+  const CommandResult r = run({MONOLITH_CLI, "resume", old.string(), "--out", B.string(), "--quiet"}, f.logs,
+                              kCommandTimeoutSeconds);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(Json::parse(slurp(B / "summary.json"))["state_hash"], Json::parse(slurp(A / "summary.json"))["state_hash"]);
 }
 
 }  // namespace
