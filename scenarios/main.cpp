@@ -8,6 +8,7 @@
 #include "ecs/plugin.h"
 #include "ecs/registry.h"
 #include "ecs/scheduler.h"
+#include "scenarios/plugin_search.h"
 #include "scenarios/runner.h"
 #include "scenarios/scene.h"
 
@@ -18,12 +19,12 @@ namespace {
 const char* kUsage =
     "usage:\n"
     "  monolith run SCENE [--out DIR] [--threads N] [--set key=value]... [--checkpoint-every K]\n"
-    "                     [--plugin PATH]... [--no-frames] [--quiet]\n"
+    "                     [--plugin NAME|PATH]... [--no-frames] [--quiet]\n"
     "  monolith resume CHECKPOINT [--out DIR] [--threads N] [--set time.KEY=value]... [--checkpoint-every K]\n"
-    "                            [--plugin PATH]... [--quiet]\n"
-    "  monolith validate SCENE [--set key=value]... [--plugin PATH]...\n"
+    "                            [--plugin NAME|PATH]... [--quiet]\n"
+    "  monolith validate SCENE [--set key=value]... [--plugin NAME|PATH]...\n"
     "  monolith graph SCENE          print the step's task graph (Graphviz DOT)\n"
-    "  monolith systems [--plugin PATH]...   list component and system types\n"
+    "  monolith systems [--plugin NAME|PATH]...   list component and system types\n"
     "  monolith version\n"
     "exit codes: 0 ok, 1 runtime/I-O failure, 2 bad command line, 3 scene/plugin/checkpoint rejected,\n"
     "            4 simulation unstable (stopped by the blow-up guard)\n";
@@ -118,9 +119,12 @@ int main(int argc, char** argv) {
   PluginLoader plugins;
   for (const auto& p : args.plugins) {
     try {
-      plugins.load(p, registry);
+      plugins.load(isPluginName(p) ? findPlugin(p) : p, registry);  // a bare name is searched for
     } catch (const PluginError& e) {
       std::fprintf(stderr, "monolith: %s\n", e.what());
+      return kExitInvalidScene;
+    } catch (const std::runtime_error& e) {  // a name not found
+      std::fprintf(stderr, "monolith: --plugin %s: %s\n", p.c_str(), e.what());
       return kExitInvalidScene;
     }
   }

@@ -10,6 +10,7 @@
 #include "components/forces.h"
 #include "components/rigid_body.h"
 #include "ecs/plugin.h"
+#include "scenarios/plugin_search.h"
 
 namespace monolith {
 
@@ -333,11 +334,21 @@ SceneSpec parseScene(const std::string& text, const std::string& file, const std
   if (top.has("plugins")) {
     top.markUsed("plugins");
     const Json& list = s.json["plugins"];
-    if (!list.is_array()) top.failAt("plugins", "an array of plugin paths", describeJson(list));
+    if (!list.is_array()) top.failAt("plugins", "an array of plugin names or paths", describeJson(list));
     for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string at = "plugins[" + std::to_string(i) + "]";
       if (!list[i].is_string() || list[i].get<std::string>().empty())
-        top.failAt("plugins[" + std::to_string(i) + "]", "a plugin path (string)", describeJson(list[i]));
-      s.plugins.push_back(resolvePath(s.directory, list[i].get<std::string>()));
+        top.failAt(at, "a plugin name or path (string)", describeJson(list[i]));
+      const std::string entry = list[i].get<std::string>();
+      if (!isPluginName(entry)) {
+        s.plugins.push_back(resolvePath(s.directory, entry));
+        continue;
+      }
+      try {
+        s.plugins.push_back(findPlugin(entry));
+      } catch (const std::runtime_error& e) {
+        top.failAt(at, "a plugin that can be found", e.what());
+      }
     }
   }
   // Validated with the world (they depend on the dimension): checked by populateWorld.

@@ -178,6 +178,14 @@ TEST(Cli, SystemsListsBuiltinsAndPluginTypes) {
   ASSERT_EQ(p.exitCode, 0) << p.err;
   EXPECT_TRUE(contains(p.out, "wind_drag")) << p.out;
   EXPECT_TRUE(contains(p.out, "rigid_body")) << p.out;
+
+  // By bare name: this build's own plugin directory is searched.
+  const CommandResult n = run({MONOLITH_CLI, "systems", "--plugin", "wind_drag"}, tmp.logs());
+  ASSERT_EQ(n.exitCode, 0) << n.err;
+  EXPECT_TRUE(contains(n.out, "wind_drag")) << n.out;
+  const CommandResult u = run({MONOLITH_CLI, "systems", "--plugin", "no_such_plugin"}, tmp.logs());
+  EXPECT_EQ(u.exitCode, 3);
+  EXPECT_TRUE(contains(u.err, "--plugin no_such_plugin: no plugin no_such_plugin.so in")) << u.err;
 }
 
 constexpr const char* kMetricsPrefix =

@@ -3,9 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include <unistd.h>
 
 #include "components/rigid_body.h"
 #include "ecs/plugin.h"
+#include "scenarios/plugin_search.h"
 #include "scenarios/simulation.h"
 
 using namespace monolith;
@@ -117,4 +122,54 @@ TEST(PluginAbi, MismatchDescriptionNamesEachDifferingField) {
   EXPECT_NE(m.find("Eigen version"), std::string::npos);
   EXPECT_NE(m.find("debug build"), std::string::npos);
   EXPECT_EQ(m.find("sizeof(Registry)"), std::string::npos);
+}
+
+// A plugin named by bare name is searched for: MONOLITH_PLUGIN_PATH first, then this build's own
+// plugin directory; a name found nowhere is a scene error naming the entry and where it looked.
+TEST(PluginSearch, BareNamesAreFoundInThePluginPathThenInThisBuild) {
+  namespace fs = std::filesystem;
+  const char* old = std::getenv("MONOLITH_PLUGIN_PATH");
+  const std::string saved = old ? old : "";
+  auto scene = [](const std::string& entry) {
+    return parseScene(R"({"dimension": 3, "time": {"dt": 0.01, "steps": 1}, "plugins": [")" + entry +
+                          R"("], "entities": []})",
+                      "/tmp/plugin_search.json");
+  };
+
+  unsetenv("MONOLITH_PLUGIN_PATH");
+  const SceneSpec own = scene("wind_drag");
+  ASSERT_EQ(own.plugins.size(), 1u);
+  EXPECT_TRUE(fs::equivalent(own.plugins[0], MONOLITH_WIND_DRAG_PLUGIN)) << own.plugins[0];
+
+  // A directory earlier in the path wins (empty entries are skipped).
+  const fs::path dir = fs::temp_directory_path() / ("monolith_plugin_search_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  fs::copy_file(MONOLITH_WIND_DRAG_PLUGIN, dir / "wind_drag.so", fs::copy_options::overwrite_existing);
+  setenv("MONOLITH_PLUGIN_PATH", ("/no/such/dir::" + dir.string()).c_str(), 1);
+  EXPECT_EQ(pluginSearchPath().size(), 3u);
+  EXPECT_EQ(scene("wind_drag").plugins.at(0), (dir / "wind_drag.so").string());
+  // ... and the copy really is a loadable plugin.
+  Registry registry;
+  registerBuiltins(registry);
+  PluginLoader loader;
+  EXPECT_NO_THROW(loadScenePlugins(scene("wind_drag"), loader, registry));
+  EXPECT_NE(registry.findComponent<3>("wind_drag"), nullptr);
+
+  try {
+    scene("wind_dragg");
+    ADD_FAILURE() << "an unknown plugin name was accepted";
+  } catch (const SceneError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("/tmp/plugin_search.json"), std::string::npos) << m;
+    EXPECT_NE(m.find("plugins[0]"), std::string::npos) << m;
+    EXPECT_NE(m.find("wind_dragg.so"), std::string::npos) << m;
+    EXPECT_NE(m.find(dir.string()), std::string::npos) << m;
+    EXPECT_NE(m.find("MONOLITH_PLUGIN_PATH"), std::string::npos) << m;
+  }
+  // A path is still a path, relative to the scene file (not searched for).
+  EXPECT_EQ(scene("plugins/wind_drag.so").plugins.at(0), "/tmp/plugins/wind_drag.so");
+
+  if (old) setenv("MONOLITH_PLUGIN_PATH", saved.c_str(), 1);
+  else unsetenv("MONOLITH_PLUGIN_PATH");
+  fs::remove_all(dir);
 }
