@@ -40,6 +40,37 @@ bool anyNeighbourSolid(const MacLayout<d>& layout, const std::vector<std::uint8_
   return false;
 }
 
+// Two raster scans with the 3^d - 1 neighbours (forward: those before a cell in scan order;
+// backward: those after) give the exact chessboard distance on a grid without periodic seams.
+template <int d>
+std::vector<std::uint8_t> chessboardDistanceToSolid(const MacLayout<d>& layout, const std::vector<std::uint8_t>& solid,
+                                                    std::uint8_t cap) {
+  const int cells = layout.cellCount();
+  std::vector<std::uint8_t> dist(cells);
+  for (int c = 0; c < cells; ++c) dist[c] = solid[c] ? 0 : cap;
+  constexpr int kNeighbourhood = d == 2 ? 9 : 27;
+  auto relax = [&](int c, bool forward) {
+    const auto ci = layout.cellCoord(c);
+    int best = dist[c];
+    for (int k = 0; k < kNeighbourhood; ++k) {
+      typename MacLayout<d>::Index n = ci;
+      int rem = k, linear = 0;
+      bool inside = true;
+      for (int a = 0; a < d; ++a, rem /= 3) {
+        n[a] += rem % 3 - 1;
+        inside = inside && n[a] >= 0 && n[a] < layout.cells[a];
+      }
+      if (!inside) continue;
+      linear = layout.cellIndex(n);
+      if ((forward && linear < c) || (!forward && linear > c)) best = std::min(best, dist[linear] + 1);
+    }
+    dist[c] = static_cast<std::uint8_t>(std::min<int>(best, cap));
+  };
+  for (int c = 0; c < cells; ++c) relax(c, true);
+  for (int c = cells - 1; c >= 0; --c) relax(c, false);
+  return dist;
+}
+
 }  // namespace
 
 template <int d>
@@ -118,6 +149,10 @@ FaceVelocitySampler<d>::FaceVelocitySampler(const MacLayout<d>& layout, const Ei
     for (int g = 0; g < layout.totalFaces(); ++g)
       if (count[g] > 0) ghost_[g] = sum[g] / count[g];
   }
+  read_.resize(layout.totalFaces());
+  dropped_.assign(layout.totalFaces(), 0);
+  for (int g = 0; g < layout.totalFaces(); ++g)
+    read_[g] = hasGhost(g) ? ghost_[g] : faceValue(g);
   if (!hasSolids()) return;
   insideSolid_.assign(layout.totalFaces(), 0);
   for (int g = 0; g < layout.totalFaces(); ++g) {
@@ -127,7 +162,11 @@ FaceVelocitySampler<d>::FaceVelocitySampler(const MacLayout<d>& layout, const Ei
     bool inside = count > 0;
     for (int k = 0; k < count; ++k) inside = inside && boundary.solidCell[cells[k]];
     insideSolid_[g] = inside;
+    dropped_[g] = inside && !hasGhost(g);
   }
+  bool periodic = false;
+  for (int a = 0; a < d; ++a) periodic = periodic || layout.periodic[a];
+  if (!periodic) solidDistance_ = chessboardDistanceToSolid(layout, boundary.solidCell, kFarFromSolid);
 }
 
 template <int d>
@@ -205,8 +244,8 @@ double FaceVelocitySampler<d>::component(int axis, const Vec& x, std::pair<doubl
     }
     if (w == 0) continue;  // also keeps exact face-centre samples free of neighbour values
     const int face = layout_.faceIndex(axis, f);
-    const double value = sampleValue(face);        // rules 3, 3b
-    if (insideSolid(face) && !hasGhost(face)) {  // rule 4
+    const double value = read_[face];  // rules 3, 3b
+    if (!dropped_.empty() && dropped_[face]) {  // rule 4
       dropped = true;
       solidSum += w * value;
       solidLo = std::min(solidLo, value), solidHi = std::max(solidHi, value);
@@ -232,9 +271,16 @@ typename FaceVelocitySampler<d>::Vec FaceVelocitySampler<d>::velocity(const Vec&
 template <int d>
 typename FaceVelocitySampler<d>::Vec FaceVelocitySampler<d>::clipToFluid(const Vec& from, const Vec& to) const {
   if (!hasSolids()) return to;
-  if (pointInSolid(from)) return from;
+  const int fromCell = layout_.cellIndex(cellOf(from));
+  if (boundary_->solidCell[fromCell]) return from;
   const double length = (to - from).norm();
   if (!std::isfinite(length)) throw std::domain_error("FaceVelocitySampler: non-finite trace");
+  // Every point of the segment lies in a cell at most floor(length / dx) + 1 cells from
+  // `from`'s along each axis (one more for rounding): if the nearest solid cell is farther, the
+  // walk below would find none.
+  if (!solidDistance_.empty() && length < kFarFromSolid * layout_.dx &&
+      std::floor(length / layout_.dx) + 2 < solidDistance_[fromCell])
+    return to;
   // Quarter-cell steps: a cell can then only be missed by cutting one of its corners.
   const double steps = std::min(std::ceil(length / (0.25 * layout_.dx)), 1048576.0);
   const int n = std::max(1, static_cast<int>(steps));

@@ -82,7 +82,8 @@ template <int d>
 FaceBoundary staticObstacleBoundary(const MacLayout<d>& layout, std::vector<std::uint8_t> solidCell);
 
 // Samples one face-velocity field. Keeps pointers to `u` and `boundary` (temporaries are refused
-// at compile time); both must outlive the sampler. Thread-safe for concurrent reads.
+// at compile time); both must outlive the sampler and keep their values while it is used (the
+// values a sample reads are tabulated at construction). Thread-safe for concurrent reads.
 template <int d>
 class FaceVelocitySampler {
  public:
@@ -103,7 +104,7 @@ class FaceVelocitySampler {
   double faceValue(int face) const { return isPrescribed(face) ? boundary_->prescribedVelocity[face] : (*u_)[face]; }
   // Value a sample or a stencil reads at a stored face: the ghost value if the face has ghost
   // rules (rule 3b), else faceValue.
-  double sampleValue(int face) const { return hasGhost(face) ? ghost_[face] : faceValue(face); }
+  double sampleValue(int face) const { return read_[face]; }
   bool hasGhost(int face) const { return !ghost_.empty() && !std::isnan(ghost_[face]); }
   // True if every existing neighbour cell of face f of `axis` is solid (rule 4).
   bool faceInsideSolid(int axis, const Index& f) const;
@@ -129,6 +130,16 @@ class FaceVelocitySampler {
   bool insideSolid(int face) const { return !insideSolid_.empty() && insideSolid_[face]; }
   // Rule 3b's values for this field, NaN where a face has no rule (empty without rules).
   std::vector<double> ghost_;
+  // sampleValue of every face, tabulated once (rules 3 and 3b), and whether rule 4 drops the
+  // face from a stencil: a sample's 2^d corners then cost two loads each.
+  std::vector<double> read_;
+  std::vector<std::uint8_t> dropped_;
+  // Chessboard distance, in cells, from each cell to the nearest solid cell, capped at
+  // kFarFromSolid (empty without structures, or on a periodic grid, where the raster scan
+  // below would not see across the seam). clipToFluid returns a trace whose cells all lie
+  // nearer than that without walking it: exactly what the walk would return.
+  static constexpr std::uint8_t kFarFromSolid = 32;
+  std::vector<std::uint8_t> solidDistance_;
 };
 
 }  // namespace monolith::solvers

@@ -241,6 +241,53 @@ TEST(VelocitySampling, NeverSamplesInsideTheSolid) {
   EXPECT_EQ(s.component(0, Vec<2>(16 * h, 12.5 * h)), BlockScene::kInside);
 }
 
+// clipToFluid skips the walk along a trace that cannot reach a solid cell (the chessboard
+// distance from its start exceeds its length). The skip must change nothing: on random traces of
+// up to 12 cells, from fluid points of a closed box with a solid block, it returns bitwise the
+// walk's answer (the walk re-implemented here as rule 5 states it). On a periodic grid there
+// is no skip; BlockScene's channel checks that path.
+TEST(VelocitySampling, ClipToFluidSkipsOnlyTracesThatCannotReachASolid) {
+  const MacLayout<2> layout(Index<2>(32, 24), 1.0 / 32, Vec<2>::Zero(), {false, false});
+  std::vector<std::uint8_t> solid(layout.cellCount(), 0);
+  for (int j = 8; j < 16; ++j)
+    for (int i = 12; i < 20; ++i) solid[layout.cellIndex(Index<2>(i, j))] = 1;
+  const FaceBoundary boundary = staticObstacleBoundary(layout, solid);
+  const Eigen::VectorXd u = Eigen::VectorXd::Zero(layout.totalFaces());
+  const FaceVelocitySampler<2> s(layout, u, boundary);
+  auto walk = [&](const Vec<2>& from, const Vec<2>& to) -> Vec<2> {
+    const int n = std::max(1, static_cast<int>(std::ceil((to - from).norm() / (0.25 * layout.dx))));
+    Vec<2> previous = from;
+    for (int k = 1; k <= n; ++k) {
+      const Vec<2> p = k == n ? to : Vec<2>(from + (static_cast<double>(k) / n) * (to - from));
+      if (s.pointInSolid(p)) {
+        Vec<2> fluid = previous, inSolid = p;
+        for (int it = 0; it < 40; ++it) {
+          const Vec<2> mid = 0.5 * (fluid + inSolid);
+          (s.pointInSolid(mid) ? inSolid : fluid) = mid;
+        }
+        return fluid;
+      }
+      previous = p;
+    }
+    return to;
+  };
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> ux(0.0, 1.0), uy(0.0, 0.75), angle(0, 2 * kPi), cells(0.0, 12.0);
+  int clipped = 0, free = 0;
+  for (int k = 0; k < 40000; ++k) {
+    const Vec<2> from(ux(rng), uy(rng));
+    if (s.pointInSolid(from)) continue;
+    const double a = angle(rng), length = cells(rng) * layout.dx;
+    const Vec<2> to = from + length * Vec<2>(std::cos(a), std::sin(a));
+    const Vec<2> expected = walk(from, to), got = s.clipToFluid(from, to);
+    ASSERT_EQ(got[0], expected[0]) << k;
+    ASSERT_EQ(got[1], expected[1]) << k;
+    (got == to ? free : clipped) += 1;
+  }
+  EXPECT_GT(clipped, 1000);  // both outcomes were exercised
+  EXPECT_GT(free, 10000);
+}
+
 // A shear flow u = c (y - y_w) over a solid floor (cell rows 0 and 1, staircase top at y = 2h)
 // whose no-slip wall sits at y_w = 1.7 h, inside the top solid row: the free u-faces of row 2
 // (y = 2.5 h) are theta = 0.8 cells from the wall, and rule 3b extends their velocity into the
