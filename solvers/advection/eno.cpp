@@ -65,17 +65,28 @@ using VecT = typename MacLayout<d>::Vec;
 
 int wrap(int i, int n) { return ((i % n) + n) % n; }
 
-// Seven values along `axis` centred on `node` of a grid with `dims` nodes: periodic axes wrap,
-// others repeat the last stored node (zero-gradient ghosts, see eno.h).
-template <int d, class IndexFn, class ValueFn>
-std::array<double, 7> gather7(const IndexT<d>& node, int axis, const IndexT<d>& dims,
-                              const std::array<bool, d>& periodic, IndexFn index, ValueFn value) {
+// Linear-index stride of each axis in a grid of `dims` nodes numbered x-fastest (the cell and
+// face numbering of MacLayout).
+template <int d>
+std::array<int, d> strides(const IndexT<d>& dims) {
+  std::array<int, d> s{};
+  for (int a = 0, stride = 1; a < d; stride *= dims[a], ++a) s[a] = stride;
+  return s;
+}
+
+// Seven values along `axis` centred on `node` of a grid with `dims` nodes, whose linear index is
+// `first` + (node . stride): periodic axes wrap, others repeat the last stored node
+// (zero-gradient ghosts, see eno.h). The index is stepped by the stride, not recomputed.
+template <int d, class ValueFn>
+std::array<double, 7> gather7(const IndexT<d>& node, int axis, const IndexT<d>& dims, const std::array<bool, d>& periodic,
+                              int first, const std::array<int, d>& stride, ValueFn value) {
   std::array<double, 7> v;
-  IndexT<d> n = node;
+  int base = first;
+  for (int a = 0; a < d; ++a) base += (a == axis ? 0 : node[a]) * stride[a];
   for (int k = 0; k < 7; ++k) {
     const int j = node[axis] + k - 3;
-    n[axis] = periodic[axis] ? wrap(j, dims[axis]) : std::min(std::max(j, 0), dims[axis] - 1);
-    v[k] = value(index(n));
+    const int n = periodic[axis] ? wrap(j, dims[axis]) : std::min(std::max(j, 0), dims[axis] - 1);
+    v[k] = value(base + n * stride[axis]);
   }
   return v;
 }
@@ -103,17 +114,20 @@ bool cubicMidpoint(const FaceVelocitySampler<d>& sampler, int comp, const IndexT
       nodes[e][k] = j;
     }
   }
+  // The nodes lie inside the stored face grid (wrapped or checked above): strides give
+  // layout.faceIndex(comp, n) exactly.
+  const std::array<int, d> stride = strides<d>(dims);
+  const int offset = layout.faceOffset(comp);
   double sum = 0;
   for (int combo = 0; combo < total; ++combo) {
-    IndexT<d> n;
+    int face = offset;
     double w = 1;
     for (int e = 0, rest = combo; e < d; ++e) {
       const int k = rest % count[e];
       rest /= count[e];
-      n[e] = nodes[e][k];
+      face += nodes[e][k] * stride[e];
       if (half[e]) w *= kWeights[k];
     }
-    const int face = layout.faceIndex(comp, n);
     if (sampler.isPrescribed(face)) return false;
     sum += w * sampler.faceValue(face);
   }
@@ -189,10 +203,11 @@ Eigen::VectorXd enoConvectiveTerm(const MacLayout<d>& layout, const Eigen::Vecto
     const auto [axis, f] = layout.faceCoord(g);
     const VecT<d> w = faceUpwindVelocity(sampler, axis, f, g);
     const IndexT<d> dims = layout.faceDims(axis);
+    const std::array<int, d> stride = strides<d>(dims);
     double term = 0;
     for (int b = 0; b < d; ++b) {
       if (w[b] == 0) continue;
-      const auto v = gather7<d>(f, b, dims, layout.periodic, [&](const IndexT<d>& n) { return layout.faceIndex(axis, n); },
+      const auto v = gather7<d>(f, b, dims, layout.periodic, layout.faceOffset(axis), stride,
                                 [&](int face) { return sampler.sampleValue(face); });
       term += w[b] * hjDerivative(stencil, v, layout.dx, w[b] > 0);
     }
@@ -229,11 +244,11 @@ Eigen::VectorXd enoScalarConvectiveTerm(const MacLayout<d>& layout, const Eigen:
     }
     const IndexT<d> c = layout.cellCoord(cell);
     const VecT<d> w = cellUpwindVelocity(sampler, c);
+    const std::array<int, d> stride = strides<d>(layout.cells);
     double term = 0;
     for (int b = 0; b < d; ++b) {
       if (w[b] == 0) continue;
-      const auto v = gather7<d>(c, b, layout.cells, layout.periodic, [&](const IndexT<d>& n) { return layout.cellIndex(n); },
-                                [&](int i) { return phi[i]; });
+      const auto v = gather7<d>(c, b, layout.cells, layout.periodic, 0, stride, [&](int i) { return phi[i]; });
       term += w[b] * hjDerivative(stencil, v, layout.dx, w[b] > 0);
     }
     out[cell] = term;

@@ -136,6 +136,11 @@ FaceVelocitySampler<d>::FaceVelocitySampler(const MacLayout<d>& layout, const Ei
     : layout_(layout), u_(&u), boundary_(&boundary) {
   if (u.size() != layout.totalFaces())
     throw std::invalid_argument("FaceVelocitySampler: field needs one value per face");
+  for (int axis = 0; axis < d; ++axis) {
+    faceOffset_[axis] = layout.faceOffset(axis);
+    const Index dims = layout.faceDims(axis);
+    for (int b = 0, stride = 1; b < d; stride *= dims[b], ++b) faceStride_[axis][b] = stride;
+  }
   validateBoundary(layout, boundary);
   if (!boundary.ghosts.empty()) {
     std::vector<double> sum(layout.totalFaces(), 0.0);
@@ -234,16 +239,18 @@ double FaceVelocitySampler<d>::component(int axis, const Vec& x, std::pair<doubl
   bool dropped = false;
   double fluidLo = std::numeric_limits<double>::infinity(), fluidHi = -fluidLo;
   double solidLo = fluidLo, solidHi = -fluidLo;
+  // lo and hi lie inside the stored face grid (periodic axes wrapped above): the tabulated
+  // strides give layout_.faceIndex(axis, corner) exactly.
+  const std::array<int, d>& stride = faceStride_[axis];
   for (int corner = 0; corner < (1 << d); ++corner) {
-    Index f;
+    int face = faceOffset_[axis];
     double w = 1;
     for (int b = 0; b < d; ++b) {
       const bool upper = (corner >> b) & 1;
-      f[b] = upper ? hi[b] : lo[b];
+      face += (upper ? hi[b] : lo[b]) * stride[b];
       w *= upper ? t[b] : 1 - t[b];
     }
     if (w == 0) continue;  // also keeps exact face-centre samples free of neighbour values
-    const int face = layout_.faceIndex(axis, f);
     const double value = read_[face];  // rules 3, 3b
     if (!dropped_.empty() && dropped_[face]) {  // rule 4
       dropped = true;

@@ -42,6 +42,7 @@
 #include "solvers/mac_layout.h"
 
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -122,6 +123,10 @@ class FaceVelocitySampler {
 
  private:
   MacLayout<d> layout_;
+  // layout_.faceIndex(axis, f) = faceOffset_[axis] + sum_b f[b] faceStride_[axis][b] for f inside
+  // the stored face grid, tabulated because a sample computes 2^d face indices.
+  std::array<int, d> faceOffset_{};
+  std::array<std::array<int, d>, d> faceStride_{};
   const Eigen::VectorXd* u_;
   const FaceBoundary* boundary_;
   // Rule 4's test per face, tabulated once per sampler (empty without structures): it is asked
