@@ -71,18 +71,83 @@ bool neighbour(const solvers::MacLayout<d>& layout, typename solvers::MacLayout<
   return true;
 }
 
+// An inclusive range of cell coordinates, lo[a] <= c[a] <= hi[a]. The faces "in" a box are those
+// of its cells (face coordinates lo[a] .. hi[a] + 1 along their own axis, within the grid).
+template <int d>
+struct CellBox {
+  typename solvers::MacLayout<d>::Index lo, hi;
+};
+
+template <int d>
+CellBox<d> wholeGrid(const solvers::MacLayout<d>& layout) {
+  return {solvers::MacLayout<d>::Index::Zero(), layout.cells - solvers::MacLayout<d>::Index::Ones()};
+}
+
+// Cells within `margin` cells of the obstacle's bounding sphere (the reach the rasterization
+// uses); the whole extent of a periodic axis, on which the obstacle may wrap.
+template <int d>
+CellBox<d> obstacleBox(const solvers::MacLayout<d>& layout, const Shape<d>& shape, const RigidBody<d>& body, int margin) {
+  const double reach = shape.type == ShapeType::Box ? shape.halfExtents.norm() : shape.radius;
+  CellBox<d> box = wholeGrid(layout);
+  for (int a = 0; a < d; ++a) {
+    if (layout.periodic[a]) continue;
+    const double lo = std::floor((body.x[a] - reach - layout.origin[a]) / layout.dx) - margin;
+    const double hi = std::floor((body.x[a] + reach - layout.origin[a]) / layout.dx) + margin;
+    box.lo[a] = static_cast<int>(std::clamp(lo, 0.0, static_cast<double>(layout.cells[a] - 1)));
+    box.hi[a] = static_cast<int>(std::clamp(hi, 0.0, static_cast<double>(layout.cells[a] - 1)));
+  }
+  return box;
+}
+
+// visit(c, ci) for the cells of the box in increasing linear index (x fastest), so that sums
+// over them add in the order of a loop over the whole grid.
+template <int d, class Visit>
+void forEachCellIn(const solvers::MacLayout<d>& layout, const CellBox<d>& box, Visit&& visit) {
+  typename solvers::MacLayout<d>::Index c = box.lo;
+  while (true) {
+    visit(layout.cellIndex(c), c);
+    int a = 0;
+    for (; a < d; ++a) {
+      if (++c[a] <= box.hi[a]) break;
+      c[a] = box.lo[a];
+    }
+    if (a == d) return;
+  }
+}
+
+// visit(g, a, f) for the faces of the box in increasing global index (axis 0 first).
+template <int d, class Visit>
+void forEachFaceIn(const solvers::MacLayout<d>& layout, const CellBox<d>& box, Visit&& visit) {
+  for (int a = 0; a < d; ++a) {
+    CellBox<d> faces = box;
+    faces.hi[a] = std::min(box.hi[a] + 1, layout.faceLayers(a) - 1);
+    typename solvers::MacLayout<d>::Index f = faces.lo;
+    while (true) {
+      visit(layout.faceIndex(a, f), a, f);
+      int b = 0;
+      for (; b < d; ++b) {
+        if (++f[b] <= faces.hi[b]) break;
+        f[b] = faces.lo[b];
+      }
+      if (b == d) break;
+    }
+  }
+}
+
 // Calls visit(g, a, f, b, dir) for every interior face g = (a, f) with isFree(g) and direction
 // dir e_b whose next face of the same axis that way is marked (markedFace[face] != 0). These are
 // the viscous pairs that end on an obstacle face (operators.h).
 template <int d, class IsFree, class Visit>
 void forEachPairIntoMarkedFaces(const solvers::MacLayout<d>& layout, IsFree&& isFree,
-                                const std::vector<std::uint8_t>& markedFace, Visit&& visit) {
+                                const std::vector<std::uint8_t>& markedFace, Visit&& visit,
+                                const CellBox<d>* within = nullptr) {
   using Index = typename solvers::MacLayout<d>::Index;
-  for (int g = 0; g < layout.totalFaces(); ++g) {
-    const auto [a, f] = layout.faceCoord(g);
+  // Only the faces of `within` (when given; in the whole grid's order): the marked faces and
+  // their partners must lie in it.
+  forEachFaceIn(layout, within ? *within : wholeGrid(layout), [&](int g, int a, const Index& f) {
     Index c0;
-    if (!layout.cellInside(f) || !neighbour(layout, f, a, -1, c0)) continue;  // a domain boundary face
-    if (!isFree(g)) continue;
+    if (!layout.cellInside(f) || !neighbour(layout, f, a, -1, c0)) return;  // a domain boundary face
+    if (!isFree(g)) return;
     const Index dims = layout.faceDims(a);
     for (int b = 0; b < d; ++b)
       for (int dir = -1; dir <= 1; dir += 2) {
@@ -94,23 +159,23 @@ void forEachPairIntoMarkedFaces(const solvers::MacLayout<d>& layout, IsFree&& is
         }
         if (markedFace[layout.faceIndex(a, partner)]) visit(g, a, f, b, dir);
       }
-  }
+  });
 }
 
-// Faces touching a cell with mask[c] != 0.
+// Faces touching a cell with mask[c] != 0. `within`: the marked cells all lie in that box.
 template <int d>
-std::vector<std::uint8_t> facesOfMarkedCells(const solvers::MacLayout<d>& layout, const std::vector<std::uint8_t>& mask) {
+std::vector<std::uint8_t> facesOfMarkedCells(const solvers::MacLayout<d>& layout, const std::vector<std::uint8_t>& mask,
+                                             const CellBox<d>* within = nullptr) {
   std::vector<std::uint8_t> marked(layout.totalFaces(), 0);
-  for (int c = 0; c < layout.cellCount(); ++c) {
-    if (!mask[c]) continue;
-    const auto ci = layout.cellCoord(c);
+  forEachCellIn(layout, within ? *within : wholeGrid(layout), [&](int c, const typename solvers::MacLayout<d>::Index& ci) {
+    if (!mask[c]) return;
     for (int a = 0; a < d; ++a)
       for (int side = 0; side < 2; ++side) {
         auto f = ci;
         f[a] += side;
         marked[layout.faceIndex(a, f)] = 1;
       }
-  }
+  });
   return marked;
 }
 
@@ -135,21 +200,22 @@ using ObstacleList = std::vector<std::pair<const Shape<d>*, const RigidBody<d>*>
 constexpr int kCutLines = 8;
 constexpr double kMinOpenFraction = 0.01;
 
+// `within`: only the faces of that box can be near the obstacles (the others stay open).
 template <int d>
-std::vector<double> openFractions(const solvers::MacLayout<d>& layout, const ObstacleList<d>& obstacles) {
+std::vector<double> openFractions(const solvers::MacLayout<d>& layout, const ObstacleList<d>& obstacles,
+                                  const CellBox<d>* within = nullptr) {
   using Vec = Eigen::Matrix<double, d, 1>;
   std::vector<double> open(layout.totalFaces(), 1.0);
   const double h = layout.dx;
   std::vector<std::pair<double, double>> pieces;
-  for (int g = 0; g < layout.totalFaces(); ++g) {
-    const auto [a, f] = layout.faceCoord(g);
+  forEachFaceIn(layout, within ? *within : wholeGrid(layout), [&](int g, int a, const typename solvers::MacLayout<d>::Index& f) {
     const Vec x = layout.faceCenter(a, f);
     bool near = false;
     for (const auto& [shape, body] : obstacles) {
       const double reach = shape->type == ShapeType::Box ? shape->halfExtents.norm() : shape->radius;
       near |= (x - body->x).norm() <= reach + h;
     }
-    if (!near) continue;
+    if (!near) return;
     const int t1 = (a + 1) % d, t2 = (a + 2) % d;  // t2 == a in 2-D: one line
     const int lines = d == 2 ? 1 : kCutLines;
     Vec e = Vec::Zero();
@@ -173,7 +239,7 @@ std::vector<double> openFractions(const solvers::MacLayout<d>& layout, const Obs
     }
     const double theta = 1.0 - covered / (lines * h);
     open[g] = theta < kMinOpenFraction ? 0.0 : theta > 1 - 1e-12 ? 1.0 : theta;
-  }
+  });
   return open;
 }
 
@@ -298,18 +364,23 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
   if (!shape || !body || grid.solid.empty()) return result;
   const solvers::MacLayout<d> layout = macLayoutOf(grid);
   const int n = layout.cellCount();
+  // Everything below happens within a few cells of the obstacle: its faces, the fluid cells and
+  // faces next to them. Looping over that box only, in the whole grid's order, gives the same
+  // sums as a loop over the grid at a fraction of the cost (a large grid, a small obstacle).
+  const CellBox<d> box = obstacleBox(layout, *shape, *body, 3);
   // Part of each face covered by this obstacle: staircase, every face of its solid cells (those
   // with the centre inside its shape); cut faces, the covered part of the face.
   std::vector<double> covered;
   std::vector<std::uint8_t> mine;  // faces this obstacle covers whole: the viscous rows' walls
   if (grid.openFraction.empty()) {
     std::vector<std::uint8_t> cells(n, 0);
-    for (int c = 0; c < n; ++c)
-      cells[c] = grid.solid[c] && shapeContains(*shape, *body, layout.cellCenter(layout.cellCoord(c)));
-    mine = facesOfMarkedCells(layout, cells);
+    forEachCellIn(layout, box, [&](int c, const Index& ci) {
+      cells[c] = grid.solid[c] && shapeContains(*shape, *body, layout.cellCenter(ci));
+    });
+    mine = facesOfMarkedCells(layout, cells, &box);
     covered.assign(mine.begin(), mine.end());
   } else {
-    covered = openFractions(layout, ObstacleList<d>{{shape, body}});
+    covered = openFractions(layout, ObstacleList<d>{{shape, body}}, &box);
     mine.resize(covered.size());
     for (std::size_t g = 0; g < covered.size(); ++g) {
       covered[g] = 1.0 - covered[g];
@@ -320,9 +391,8 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
 
   // Pressure: p of each fluid cell on the covered part of its faces, along the normal from the
   // fluid into the obstacle: the discrete momentum exchange of the constraint's obstacle terms.
-  for (int c = 0; c < n; ++c) {
-    if (grid.solid[c] || grid.p[c] == 0) continue;
-    const Index ci = layout.cellCoord(c);
+  forEachCellIn(layout, box, [&](int c, const Index& ci) {
+    if (grid.solid[c] || grid.p[c] == 0) return;
     for (int a = 0; a < d; ++a)
       for (int side = 0; side < 2; ++side) {
         Index fi = ci;
@@ -330,7 +400,7 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
         const double part = covered[layout.faceIndex(a, fi)];
         if (part > 0) force[a] += (side == 1 ? 1.0 : -1.0) * grid.p[c] * part * area;
       }
-  }
+  });
 
   // Viscous stress, exactly as the viscous operator applies it (operators.h): every free face of
   // axis a whose next face along axis b is one of this obstacle's faces has a row
@@ -349,7 +419,7 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
       wallPoint[b] += dir * layout.dx;
       const double wall = grid.obstacleVelocityAt(wallPoint)[a];
       result.viscous[a] += viscosity * (grid.u[g] - wall) / (theta * layout.dx) * area;
-    });
+    }, &box);
   }
   return result;
 }
