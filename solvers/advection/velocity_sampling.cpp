@@ -40,34 +40,74 @@ bool anyNeighbourSolid(const MacLayout<d>& layout, const std::vector<std::uint8_
   return false;
 }
 
+// visit(g, axis, f) for the 2d faces of every solid cell (a face between two solid cells twice):
+// the faces a structure touches, found without a pass over all faces.
+template <int d, class Visit>
+void forEachFaceOfSolidCells(const MacLayout<d>& layout, const std::vector<std::uint8_t>& solid, Visit&& visit) {
+  for (int c = 0; c < layout.cellCount(); ++c) {
+    if (!solid[c]) continue;
+    const auto ci = layout.cellCoord(c);
+    for (int axis = 0; axis < d; ++axis)
+      for (int side = 0; side < 2; ++side) {
+        auto f = ci;
+        f[axis] += side;  // f[axis] == cells[axis] on a periodic axis: faceIndex wraps it
+        visit(layout.faceIndex(axis, f), axis, f);
+      }
+  }
+}
+
 // Two raster scans with the 3^d - 1 neighbours (forward: those before a cell in scan order;
 // backward: those after) give the exact chessboard distance on a grid without periodic seams.
+// Only the box of the solid cells grown by `cap` is scanned: a shortest path to the nearest
+// solid cell stays inside it, and every cell outside is at least `cap` away.
 template <int d>
 std::vector<std::uint8_t> chessboardDistanceToSolid(const MacLayout<d>& layout, const std::vector<std::uint8_t>& solid,
                                                     std::uint8_t cap) {
+  using Index = typename MacLayout<d>::Index;
   const int cells = layout.cellCount();
-  std::vector<std::uint8_t> dist(cells);
-  for (int c = 0; c < cells; ++c) dist[c] = solid[c] ? 0 : cap;
+  std::vector<std::uint8_t> dist(cells, cap);
+  Index lo = layout.cells, hi = Index::Constant(-1);
+  for (int c = 0; c < cells; ++c)
+    if (solid[c]) {
+      const Index ci = layout.cellCoord(c);
+      lo = lo.cwiseMin(ci), hi = hi.cwiseMax(ci);
+      dist[c] = 0;
+    }
+  if ((hi.array() < 0).any()) return dist;
+  for (int a = 0; a < d; ++a) lo[a] = std::max(lo[a] - cap, 0), hi[a] = std::min(hi[a] + cap, layout.cells[a] - 1);
   constexpr int kNeighbourhood = d == 2 ? 9 : 27;
-  auto relax = [&](int c, bool forward) {
-    const auto ci = layout.cellCoord(c);
+  auto relax = [&](const Index& ci, bool forward) {
+    const int c = layout.cellIndex(ci);
     int best = dist[c];
     for (int k = 0; k < kNeighbourhood; ++k) {
-      typename MacLayout<d>::Index n = ci;
-      int rem = k, linear = 0;
+      Index n = ci;
+      int rem = k;
       bool inside = true;
       for (int a = 0; a < d; ++a, rem /= 3) {
         n[a] += rem % 3 - 1;
-        inside = inside && n[a] >= 0 && n[a] < layout.cells[a];
+        inside = inside && n[a] >= lo[a] && n[a] <= hi[a];
       }
       if (!inside) continue;
-      linear = layout.cellIndex(n);
+      const int linear = layout.cellIndex(n);
       if ((forward && linear < c) || (!forward && linear > c)) best = std::min(best, dist[linear] + 1);
     }
     dist[c] = static_cast<std::uint8_t>(std::min<int>(best, cap));
   };
-  for (int c = 0; c < cells; ++c) relax(c, true);
-  for (int c = cells - 1; c >= 0; --c) relax(c, false);
+  // x-fastest order over the box, forwards and then backwards.
+  auto scan = [&](bool forward) {
+    Index ci = forward ? lo : hi;
+    while (true) {
+      relax(ci, forward);
+      int a = 0;
+      for (; a < d; ++a) {
+        if (forward ? ++ci[a] <= hi[a] : --ci[a] >= lo[a]) break;
+        ci[a] = forward ? lo[a] : hi[a];
+      }
+      if (a == d) return;
+    }
+  };
+  scan(true);
+  scan(false);
   return dist;
 }
 
@@ -99,12 +139,13 @@ void validateBoundary(const MacLayout<d>& layout, const FaceBoundary& boundary) 
   if (boundary.solidCell.empty()) return;
   // The sampler and ENO never read the field on faces touching a structure, so those faces need
   // a prescribed (structure) velocity: thesis Sec. 5.4.1 places the constraints exactly there.
-  for (int g = 0; g < faces; ++g) {
-    const auto [axis, f] = layout.faceCoord(g);
-    if (anyNeighbourSolid(layout, boundary.solidCell, axis, f) && !(anyPrescribed && boundary.prescribedFace[g]))
-      throw std::invalid_argument("FaceBoundary: face " + std::to_string(g) +
-                                  " touches a solid cell but has no prescribed velocity");
-  }
+  int firstUnprescribed = faces;
+  forEachFaceOfSolidCells(layout, boundary.solidCell, [&](int g, int, const typename MacLayout<d>::Index&) {
+    if (!(anyPrescribed && boundary.prescribedFace[g])) firstUnprescribed = std::min(firstUnprescribed, g);
+  });
+  if (firstUnprescribed < faces)
+    throw std::invalid_argument("FaceBoundary: face " + std::to_string(firstUnprescribed) +
+                                " touches a solid cell but has no prescribed velocity");
 }
 
 double ghostFactor(double theta) {
@@ -160,15 +201,14 @@ FaceVelocitySampler<d>::FaceVelocitySampler(const MacLayout<d>& layout, const Ei
     read_[g] = hasGhost(g) ? ghost_[g] : faceValue(g);
   if (!hasSolids()) return;
   insideSolid_.assign(layout.totalFaces(), 0);
-  for (int g = 0; g < layout.totalFaces(); ++g) {
-    const auto [axis, f] = layout.faceCoord(g);
+  forEachFaceOfSolidCells(layout, boundary.solidCell, [&](int g, int axis, const Index& f) {
     int cells[2];
     const int count = faceNeighbourCells(layout, axis, f, cells);
     bool inside = count > 0;
     for (int k = 0; k < count; ++k) inside = inside && boundary.solidCell[cells[k]];
     insideSolid_[g] = inside;
     dropped_[g] = inside && !hasGhost(g);
-  }
+  });
   bool periodic = false;
   for (int a = 0; a < d; ++a) periodic = periodic || layout.periodic[a];
   if (!periodic) solidDistance_ = chessboardDistanceToSolid(layout, boundary.solidCell, kFarFromSolid);
@@ -280,14 +320,17 @@ typename FaceVelocitySampler<d>::Vec FaceVelocitySampler<d>::clipToFluid(const V
   if (!hasSolids()) return to;
   const int fromCell = layout_.cellIndex(cellOf(from));
   if (boundary_->solidCell[fromCell]) return from;
+  // Every point of the segment lies in a cell at most floor(length / dx) + 1 cells from
+  // `from`'s along each axis: if the nearest solid cell is farther, the walk below would find
+  // none. Asked as length < (distance - 2) dx, squared (no root on this hot path), which keeps a
+  // cell of margin for rounding; a non-finite trace fails the test and is caught below.
+  if (!solidDistance_.empty()) {
+    const int free = solidDistance_[fromCell] - 2;
+    const double reach = free * layout_.dx;
+    if (free > 0 && (to - from).squaredNorm() < reach * reach) return to;
+  }
   const double length = (to - from).norm();
   if (!std::isfinite(length)) throw std::domain_error("FaceVelocitySampler: non-finite trace");
-  // Every point of the segment lies in a cell at most floor(length / dx) + 1 cells from
-  // `from`'s along each axis (one more for rounding): if the nearest solid cell is farther, the
-  // walk below would find none.
-  if (!solidDistance_.empty() && length < kFarFromSolid * layout_.dx &&
-      std::floor(length / layout_.dx) + 2 < solidDistance_[fromCell])
-    return to;
   // Quarter-cell steps: a cell can then only be missed by cutting one of its corners.
   const double steps = std::min(std::ceil(length / (0.25 * layout_.dx)), 1048576.0);
   const int n = std::max(1, static_cast<int>(steps));

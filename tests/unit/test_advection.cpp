@@ -244,10 +244,11 @@ TEST(VelocitySampling, NeverSamplesInsideTheSolid) {
 // clipToFluid skips the walk along a trace that cannot reach a solid cell (the chessboard
 // distance from its start exceeds its length). The skip must change nothing: on random traces of
 // up to 12 cells, from fluid points of a closed box with a solid block, it returns bitwise the
-// walk's answer (the walk re-implemented here as rule 5 states it). On a periodic grid there
-// is no skip; BlockScene's channel checks that path.
+// walk's answer (the walk re-implemented here as rule 5 states it). The box is large enough
+// that the distance scan, limited to the block's surroundings, leaves cells out. On a periodic
+// grid there is no skip; BlockScene's channel checks that path.
 TEST(VelocitySampling, ClipToFluidSkipsOnlyTracesThatCannotReachASolid) {
-  const MacLayout<2> layout(Index<2>(32, 24), 1.0 / 32, Vec<2>::Zero(), {false, false});
+  const MacLayout<2> layout(Index<2>(96, 64), 1.0 / 64, Vec<2>::Zero(), {false, false});
   std::vector<std::uint8_t> solid(layout.cellCount(), 0);
   for (int j = 8; j < 16; ++j)
     for (int i = 12; i < 20; ++i) solid[layout.cellIndex(Index<2>(i, j))] = 1;
@@ -272,7 +273,7 @@ TEST(VelocitySampling, ClipToFluidSkipsOnlyTracesThatCannotReachASolid) {
     return to;
   };
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> ux(0.0, 1.0), uy(0.0, 0.75), angle(0, 2 * kPi), cells(0.0, 12.0);
+  std::uniform_real_distribution<double> ux(0.0, 1.5), uy(0.0, 1.0), angle(0, 2 * kPi), cells(0.0, 12.0);
   int clipped = 0, free = 0;
   for (int k = 0; k < 40000; ++k) {
     const Vec<2> from(ux(rng), uy(rng));
@@ -284,7 +285,7 @@ TEST(VelocitySampling, ClipToFluidSkipsOnlyTracesThatCannotReachASolid) {
     ASSERT_EQ(got[1], expected[1]) << k;
     (got == to ? free : clipped) += 1;
   }
-  EXPECT_GT(clipped, 1000);  // both outcomes were exercised
+  EXPECT_GT(clipped, 300);  // both outcomes were exercised
   EXPECT_GT(free, 10000);
 }
 
