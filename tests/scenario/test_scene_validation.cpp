@@ -215,7 +215,9 @@ std::vector<Case> cases() {
       {"bad_abi_plugin", scene3(kBall, R"({ "dt": 0.1, "steps": 10 })", "  \"plugins\": [\"" + badAbi + "\"],\n"),
        "plugins[0]", {"a loadable Monolith plugin", "ABI mismatch", "bad_abi_plugin"}},
       {"plugins_not_array", scene3(kBall, R"({ "dt": 0.1, "steps": 10 })", "  \"plugins\": \"x.so\",\n"), "plugins",
-       {"an array of plugin paths"}},
+       {"an array of plugin names or paths"}},
+      {"unknown_plugin_name", scene3(kBall, R"({ "dt": 0.1, "steps": 10 })", "  \"plugins\": [\"wind_dragg\"],\n"),
+       "plugins[0]", {"a plugin that can be found", "no plugin wind_dragg.so in", "MONOLITH_PLUGIN_PATH"}},
       // --- --set overrides -----------------------------------------------------------------
       {"set_unknown_entity", scene3(kBall), "--set entities.nobody.rigid_body.mass",
        {"an index or entity name that exists at 'entities'", "got 'nobody'"},
