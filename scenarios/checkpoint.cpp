@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
@@ -97,6 +98,10 @@ void writeCheckpoint(const std::string& path, const CheckpointHeader& header, co
 }
 
 CheckpointFile readCheckpoint(const std::string& path) {
+  // An ifstream opens a directory and then fails deep in the read: say what it is.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw std::runtime_error("checkpoint '" + path + "': a directory, not a checkpoint file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("checkpoint '" + path + "': no such file or it cannot be read");
   CheckpointFile f;

@@ -60,7 +60,11 @@ double FluidAdvection<d>::unitCflDt(const World<d>& world) const {
   if (const auto* pool = world.template findPool<MacGrid<d>>())
     for (const auto& grid : pool->components()) {
       const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(grid.u.data(), grid.u.size());
-      dt = std::min(dt, solvers::cflTimeStep(macLayoutOf(grid), u, 1.0, std::numeric_limits<double>::infinity()));
+      // Prescribed faces count with their prescribed speed: a flow started from rest by an
+      // inflow, a moving lid or a moving obstacle must not take its first step at dt_max.
+      const auto domain = fluidDomainOf(grid);
+      dt = std::min(dt, solvers::cflTimeStep(domain.layout, u, 1.0, std::numeric_limits<double>::infinity(),
+                                             faceBoundaryOf(domain, false)));
     }
   return dt;
 }

@@ -293,6 +293,11 @@ TEST(CheckpointRestart, DamagedCheckpointsAreRejectedCleanly) {
   const CommandResult r = run({MONOLITH_CLI, "resume", missing.string(), "--quiet"}, f.logs, kCommandTimeoutSeconds);
   EXPECT_EQ(r.exitCode, 3);
   EXPECT_NE(r.err.find("checkpoint"), std::string::npos) << r.err;
+  // The checkpoints directory instead of a file in it (an easy slip with shell completion).
+  const CommandResult dir = run({MONOLITH_CLI, "resume", (A / "checkpoints").string(), "--quiet"}, f.logs,
+                                kCommandTimeoutSeconds);
+  EXPECT_EQ(dir.exitCode, 3);
+  EXPECT_NE(dir.err.find("a directory, not a checkpoint file"), std::string::npos) << dir.err;
 
   // The undamaged file still resumes (the rejections above are about the damage).
   const CommandResult ok = run({MONOLITH_CLI, "resume", (A / checkpoint(N)).string(), "--out",

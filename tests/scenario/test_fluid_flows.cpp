@@ -57,6 +57,20 @@ TEST(Poiseuille, SteadyProfileIsParabolicWithinOnePercent) {
   EXPECT_LE(worst, 1e-3);
 }
 
+// The CFL step counts prescribed faces: the channel starts at rest, driven only by its inflow,
+// so the first step is cfl dx / (largest inflow face speed), not the scene's dt_max (it was
+// 0.5 s, a CFL number of 16). The parabola peaks between face centres: 4 y (1 - y) at
+// y = 15.5 / 32.
+TEST(Poiseuille, TheFirstCflStepSeesTheInflow) {
+  const Registry registry = builtins();
+  Simulation<2> sim(loadScene(kScenes + "poiseuille.json"), registry);
+  ASSERT_EQ(sim.scene().cfl, 1.0);
+  const double y = 15.5 / 32, peak = 4 * y * (1 - y), dx = 4.0 / 128;
+  EXPECT_DOUBLE_EQ(sim.nextDt(), dx / peak);
+  const auto& diagnostics = sim.step();
+  EXPECT_LE(diagnostics.at("fluid_cfl"), 1.0 + 1e-12);
+}
+
 TEST(TaylorGreen, ErrorConvergesForBothAdvectionSchemes) {
   const Registry registry = builtins();
   for (const std::string scheme : {"semi_lagrangian", "eno3"}) {
