@@ -7,6 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace monolith::solvers {
 
@@ -17,11 +18,17 @@ void checkDt(double dt, const char* who) {
 
 // Foot of the midpoint-rule characteristic through x over a signed time `dt` (dt > 0 traces
 // backwards, dt < 0 forwards), both points clipped to the fluid region.
+// `vx` is trace.velocity(x), passed in so that MacCormack's two traces from one face sample it once.
+template <int d>
+typename MacLayout<d>::Vec characteristicFoot(const FaceVelocitySampler<d>& trace, const typename MacLayout<d>::Vec& x,
+                                              const typename MacLayout<d>::Vec& vx, double dt) {
+  const auto mid = trace.clipToFluid(x, x - 0.5 * dt * vx);
+  return trace.clipToFluid(x, x - dt * trace.velocity(mid));
+}
 template <int d>
 typename MacLayout<d>::Vec characteristicFoot(const FaceVelocitySampler<d>& trace, const typename MacLayout<d>::Vec& x,
                                               double dt) {
-  const auto mid = trace.clipToFluid(x, x - 0.5 * dt * trace.velocity(x));
-  return trace.clipToFluid(x, x - dt * trace.velocity(mid));
+  return characteristicFoot(trace, x, trace.velocity(x), dt);
 }
 
 // out[g] = body(g) for every face that is not prescribed, the prescribed value otherwise;
@@ -52,12 +59,16 @@ Eigen::VectorXd advectFacesMacCormack(const MacLayout<d>& layout, const Eigen::V
                                       const FaceBoundary& boundary) {
   checkDt(dt, "advectFacesMacCormack");
   const FaceVelocitySampler<d> trace(layout, u, boundary);
-  // Forward semi-Lagrangian step, remembering the range of the values each sample blended.
+  // Forward semi-Lagrangian step, remembering the range of the values each sample blended and
+  // the velocity at each face centre (the backward trace starts with it too).
   Eigen::VectorXd forward(u.size()), lo(u.size()), hi(u.size());
+  std::vector<typename MacLayout<d>::Vec> atFace(u.size());
   forEachFreeFace(trace, forward, [&](int g) {
     const auto [axis, f] = layout.faceCoord(g);
+    const auto x = layout.faceCenter(axis, f);
+    atFace[g] = trace.velocity(x);
     std::pair<double, double> range;
-    const double value = trace.component(axis, characteristicFoot(trace, layout.faceCenter(axis, f), dt), &range);
+    const double value = trace.component(axis, characteristicFoot(trace, x, atFace[g], dt), &range);
     lo[g] = range.first, hi[g] = range.second;
     return value;
   });
@@ -67,7 +78,8 @@ Eigen::VectorXd advectFacesMacCormack(const MacLayout<d>& layout, const Eigen::V
   Eigen::VectorXd out(u.size());
   forEachFreeFace(trace, out, [&](int g) {
     const auto [axis, f] = layout.faceCoord(g);
-    const double roundTrip = forwardSampler.component(axis, characteristicFoot(trace, layout.faceCenter(axis, f), -dt));
+    const double roundTrip =
+        forwardSampler.component(axis, characteristicFoot(trace, layout.faceCenter(axis, f), atFace[g], -dt));
     return std::clamp(forward[g] + 0.5 * (u[g] - roundTrip), lo[g], hi[g]);
   });
   return out;
