@@ -92,6 +92,32 @@ struct MacLayout {
   }
   double cellVolume() const { return std::pow(dx, d); }
   double faceArea() const { return std::pow(dx, d - 1); }
+
+  // Linear-index step per axis of a grid of `dims` nodes numbered x-fastest (cells: dims =
+  // cells; faces of axis a: dims = faceDims(a), to be added to faceOffset(a)).
+  static std::array<int, d> strides(const Index& dims) {
+    std::array<int, d> s{};
+    for (int a = 0, stride = 1; a < d; stride *= dims[a], ++a) s[a] = stride;
+    return s;
+  }
 };
+
+// visit(i) for every index with lo <= i <= hi (componentwise), x fastest: in increasing linear
+// index, or decreasing with `backwards`. Nothing is visited if the box is empty.
+template <int d, class Visit>
+void forEachIndexIn(const Eigen::Matrix<int, d, 1>& lo, const Eigen::Matrix<int, d, 1>& hi, Visit&& visit,
+                    bool backwards = false) {
+  if ((hi.array() < lo.array()).any()) return;
+  Eigen::Matrix<int, d, 1> i = backwards ? hi : lo;
+  while (true) {
+    visit(static_cast<const Eigen::Matrix<int, d, 1>&>(i));
+    int a = 0;
+    for (; a < d; ++a) {
+      if (backwards ? --i[a] >= lo[a] : ++i[a] <= hi[a]) break;
+      i[a] = backwards ? hi[a] : lo[a];
+    }
+    if (a == d) return;
+  }
+}
 
 }  // namespace monolith::solvers

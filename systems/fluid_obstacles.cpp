@@ -78,6 +78,12 @@ struct CellBox {
   typename solvers::MacLayout<d>::Index lo, hi;
 };
 
+// Radius of the sphere around the body's position that holds the shape (box or disk/sphere).
+template <int d>
+double boundingRadius(const Shape<d>& shape) {
+  return shape.type == ShapeType::Box ? shape.halfExtents.norm() : shape.radius;
+}
+
 template <int d>
 CellBox<d> wholeGrid(const solvers::MacLayout<d>& layout) {
   return {solvers::MacLayout<d>::Index::Zero(), layout.cells - solvers::MacLayout<d>::Index::Ones()};
@@ -87,7 +93,7 @@ CellBox<d> wholeGrid(const solvers::MacLayout<d>& layout) {
 // uses); the whole extent of a periodic axis, on which the obstacle may wrap.
 template <int d>
 CellBox<d> obstacleBox(const solvers::MacLayout<d>& layout, const Shape<d>& shape, const RigidBody<d>& body, int margin) {
-  const double reach = shape.type == ShapeType::Box ? shape.halfExtents.norm() : shape.radius;
+  const double reach = boundingRadius(shape);
   CellBox<d> box = wholeGrid(layout);
   for (int a = 0; a < d; ++a) {
     if (layout.periodic[a]) continue;
@@ -103,34 +109,16 @@ CellBox<d> obstacleBox(const solvers::MacLayout<d>& layout, const Shape<d>& shap
 // over them add in the order of a loop over the whole grid.
 template <int d, class Visit>
 void forEachCellIn(const solvers::MacLayout<d>& layout, const CellBox<d>& box, Visit&& visit) {
-  typename solvers::MacLayout<d>::Index c = box.lo;
-  while (true) {
-    visit(layout.cellIndex(c), c);
-    int a = 0;
-    for (; a < d; ++a) {
-      if (++c[a] <= box.hi[a]) break;
-      c[a] = box.lo[a];
-    }
-    if (a == d) return;
-  }
+  solvers::forEachIndexIn<d>(box.lo, box.hi, [&](const auto& c) { visit(layout.cellIndex(c), c); });
 }
 
 // visit(g, a, f) for the faces of the box in increasing global index (axis 0 first).
 template <int d, class Visit>
 void forEachFaceIn(const solvers::MacLayout<d>& layout, const CellBox<d>& box, Visit&& visit) {
   for (int a = 0; a < d; ++a) {
-    CellBox<d> faces = box;
-    faces.hi[a] = std::min(box.hi[a] + 1, layout.faceLayers(a) - 1);
-    typename solvers::MacLayout<d>::Index f = faces.lo;
-    while (true) {
-      visit(layout.faceIndex(a, f), a, f);
-      int b = 0;
-      for (; b < d; ++b) {
-        if (++f[b] <= faces.hi[b]) break;
-        f[b] = faces.lo[b];
-      }
-      if (b == d) break;
-    }
+    auto hi = box.hi;
+    hi[a] = std::min(box.hi[a] + 1, layout.faceLayers(a) - 1);
+    solvers::forEachIndexIn<d>(box.lo, hi, [&](const auto& f) { visit(layout.faceIndex(a, f), a, f); });
   }
 }
 
@@ -212,8 +200,7 @@ std::vector<double> openFractions(const solvers::MacLayout<d>& layout, const Obs
     const Vec x = layout.faceCenter(a, f);
     bool near = false;
     for (const auto& [shape, body] : obstacles) {
-      const double reach = shape->type == ShapeType::Box ? shape->halfExtents.norm() : shape->radius;
-      near |= (x - body->x).norm() <= reach + h;
+      near |= (x - body->x).norm() <= boundingRadius(*shape) + h;
     }
     if (!near) return;
     const int t1 = (a + 1) % d, t2 = (a + 2) % d;  // t2 == a in 2-D: one line
@@ -441,7 +428,7 @@ std::vector<ObstacleMotion<d>> obstacleMotions(const World<d>& world) {
   forEachObstacle(world, [&](Entity, const Shape<d>& shape, const RigidBody<d>& body) {
     ObstacleMotion<d> m;
     m.centre = body.x;
-    m.reach = shape.type == ShapeType::Box ? shape.halfExtents.norm() : shape.radius;
+    m.reach = boundingRadius(shape);
     if (!body.isStatic) {
       m.velocity = body.v;
       const AngularVec<d> w = body.omega();

@@ -65,15 +65,6 @@ using VecT = typename MacLayout<d>::Vec;
 
 int wrap(int i, int n) { return ((i % n) + n) % n; }
 
-// Linear-index stride of each axis in a grid of `dims` nodes numbered x-fastest (the cell and
-// face numbering of MacLayout).
-template <int d>
-std::array<int, d> strides(const IndexT<d>& dims) {
-  std::array<int, d> s{};
-  for (int a = 0, stride = 1; a < d; stride *= dims[a], ++a) s[a] = stride;
-  return s;
-}
-
 // Seven values along `axis` centred on `node` of a grid with `dims` nodes, whose linear index is
 // `first` + (node . stride): periodic axes wrap, others repeat the last stored node
 // (zero-gradient ghosts, see eno.h). The index is stepped by the stride, not recomputed.
@@ -116,7 +107,7 @@ bool cubicMidpoint(const FaceVelocitySampler<d>& sampler, int comp, const IndexT
   }
   // The nodes lie inside the stored face grid (wrapped or checked above): strides give
   // layout.faceIndex(comp, n) exactly.
-  const std::array<int, d> stride = strides<d>(dims);
+  const std::array<int, d> stride = MacLayout<d>::strides(dims);
   const int offset = layout.faceOffset(comp);
   double sum = 0;
   for (int combo = 0; combo < total; ++combo) {
@@ -203,7 +194,7 @@ Eigen::VectorXd enoConvectiveTerm(const MacLayout<d>& layout, const Eigen::Vecto
     const auto [axis, f] = layout.faceCoord(g);
     const VecT<d> w = faceUpwindVelocity(sampler, axis, f, g);
     const IndexT<d> dims = layout.faceDims(axis);
-    const std::array<int, d> stride = strides<d>(dims);
+    const std::array<int, d> stride = MacLayout<d>::strides(dims);
     double term = 0;
     for (int b = 0; b < d; ++b) {
       if (w[b] == 0) continue;
@@ -244,7 +235,7 @@ Eigen::VectorXd enoScalarConvectiveTerm(const MacLayout<d>& layout, const Eigen:
     }
     const IndexT<d> c = layout.cellCoord(cell);
     const VecT<d> w = cellUpwindVelocity(sampler, c);
-    const std::array<int, d> stride = strides<d>(layout.cells);
+    const std::array<int, d> stride = MacLayout<d>::strides(layout.cells);
     double term = 0;
     for (int b = 0; b < d; ++b) {
       if (w[b] == 0) continue;

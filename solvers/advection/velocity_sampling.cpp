@@ -93,21 +93,8 @@ std::vector<std::uint8_t> chessboardDistanceToSolid(const MacLayout<d>& layout, 
     }
     dist[c] = static_cast<std::uint8_t>(std::min<int>(best, cap));
   };
-  // x-fastest order over the box, forwards and then backwards.
-  auto scan = [&](bool forward) {
-    Index ci = forward ? lo : hi;
-    while (true) {
-      relax(ci, forward);
-      int a = 0;
-      for (; a < d; ++a) {
-        if (forward ? ++ci[a] <= hi[a] : --ci[a] >= lo[a]) break;
-        ci[a] = forward ? lo[a] : hi[a];
-      }
-      if (a == d) return;
-    }
-  };
-  scan(true);
-  scan(false);
+  forEachIndexIn<d>(lo, hi, [&](const Index& ci) { relax(ci, true); });
+  forEachIndexIn<d>(lo, hi, [&](const Index& ci) { relax(ci, false); }, /*backwards=*/true);
   return dist;
 }
 
@@ -179,8 +166,7 @@ FaceVelocitySampler<d>::FaceVelocitySampler(const MacLayout<d>& layout, const Ei
     throw std::invalid_argument("FaceVelocitySampler: field needs one value per face");
   for (int axis = 0; axis < d; ++axis) {
     faceOffset_[axis] = layout.faceOffset(axis);
-    const Index dims = layout.faceDims(axis);
-    for (int b = 0, stride = 1; b < d; stride *= dims[b], ++b) faceStride_[axis][b] = stride;
+    faceStride_[axis] = MacLayout<d>::strides(layout.faceDims(axis));
   }
   validateBoundary(layout, boundary);
   if (!boundary.ghosts.empty()) {
