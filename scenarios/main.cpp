@@ -138,9 +138,8 @@ int main(int argc, char** argv) {
 
   if (args.command == "resume") {
     for (const auto& o : args.overrides)
-      if (o.first.rfind("time.", 0) != 0)
-        usageError("resume --set changes only time settings (time.end, time.steps, time.dt, time.cfl, "
-                   "time.frame_rate), got '" + o.first + "'");
+      if (!resumeMayChange(o.first))
+        usageError(std::string("resume --set changes only time settings (") + kResumeSettings + "), got '" + o.first + "'");
     const RunResult r = resumeRun(args.target, registry, plugins, args.run, args.overrides);
     if (r.exitCode != kExitOk) {
       std::fprintf(stderr, "monolith: %s\n", r.message.c_str());

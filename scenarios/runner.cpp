@@ -349,6 +349,8 @@ RunResult runScene(const SceneSpec& scene, Registry& registry, PluginLoader& plu
   return dispatch(scene, registry, plugins, options, nullptr);
 }
 
+bool resumeMayChange(const std::string& key) { return key.rfind("time.", 0) == 0; }
+
 RunResult resumeRun(const std::string& checkpointPath, Registry& registry, PluginLoader& plugins, RunOptions options,
                     const std::vector<Override>& timeOverrides) {
   RunResult r;
@@ -360,10 +362,9 @@ RunResult resumeRun(const std::string& checkpointPath, Registry& registry, Plugi
     scene = parseScene(file.header.sceneJson, file.header.sceneFile, {}, clock);
     if (!timeOverrides.empty()) {
       for (const auto& o : timeOverrides)
-        if (o.first.rfind("time.", 0) != 0)
-          throw std::runtime_error("--set " + o.first + ": a resume may change only \"time\" settings (time.end, "
-                                   "time.steps, time.dt, time.cfl, time.frame_rate); the rest of the run is its "
-                                   "checkpointed state");
+        if (!resumeMayChange(o.first))
+          throw std::runtime_error("--set " + o.first + ": a resume may change only " + kResumeSettings +
+                                   "; the rest of the run is its checkpointed state");
       const SceneSpec before = scene;
       scene = parseScene(file.header.sceneJson, file.header.sceneFile, timeOverrides, clock);
       // A new fixed step: the clock goes on from the checkpoint's time (ClockOrigin), not n dt.

@@ -39,6 +39,11 @@ struct RunResult {
 };
 
 RunResult runScene(const SceneSpec& scene, Registry& registry, PluginLoader& plugins, const RunOptions& options);
+// The settings `monolith resume --set` may change: the "time" keys (end, steps, dt, cfl,
+// frame_rate). Everything else is the checkpointed run's own.
+bool resumeMayChange(const std::string& key);
+inline constexpr const char* kResumeSettings = "time.end, time.steps, time.dt, time.cfl, time.frame_rate";
+
 // Continues the run a checkpoint was taken from (to the scene's end). `timeOverrides` ("--set
 // time.KEY=value" only) move the end or change the step: with a new fixed dt the clock goes on
 // from the checkpoint's time, t = t_ckpt + (n - n_ckpt) dt (see ClockOrigin).
