@@ -1,9 +1,8 @@
 #pragma once
-// FluidObstacle: marks an entity with a `shape` and a static `rigid_body` as an obstacle in the
-// scene's MAC grid fluid. The system rasterize_obstacles covers the cells whose centres lie
-// inside the shape (a staircase boundary, thesis Sec. 5.4.1: first-order equal-velocity
-// constraints at the face centres), and obstacle_forces reports the fluid's force on it.
-// Only static obstacles (velocity 0) are supported.
+// FluidObstacle: marks an entity with a static or kinematic `rigid_body` and a `level_set` or
+// `shape` as an obstacle in the scene's MAC grid fluid (one-way: the fluid does not move it). The
+// system rasterize_obstacles turns it into solid cells or cut faces whose velocity is the body's
+// rigid motion (thesis Sec. 5.4.1), and obstacle_forces reports the fluid's force on it.
 namespace monolith {
 
 struct FluidObstacle {

@@ -40,6 +40,8 @@ InertiaMat<d> parseInertia(World<d>& world, Entity e, const Config& c, double ma
   InertiaMat<d> I;
   if (!c.has("inertia")) {
     const Shape<d>* shape = world.template get<Shape<d>>(e);
+    // A static body never moves: its inertia is never used (e.g. a level-set fluid obstacle).
+    if (!shape && c.boolean("static", false)) return InertiaMat<d>::Identity();
     if (!shape)
       c.failAt("inertia", "an inertia, or a \"shape\" component on the entity to derive it from", "neither");
     const bool noClosedForm =

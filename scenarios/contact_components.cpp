@@ -15,8 +15,6 @@
 
 namespace monolith {
 
-namespace {
-
 // A list of d-vectors, e.g. "vertices": [[0,0,0], [1,0,0], ...], flattened.
 template <int d>
 std::vector<double> pointList(const Config& c, const std::string& key, int minimum) {
@@ -78,6 +76,8 @@ void readObj(const Config& c, const std::string& key, Shape<3>& shape) {
   }
   if (shape.triangles.empty()) c.failAt(key, "an OBJ mesh with at least one face", path.string() + " has none");
 }
+
+namespace {
 
 // A 2-D polygon is stored counter-clockwise with its area centroid at the body origin: the
 // body's position is its centre of mass.
@@ -249,6 +249,8 @@ void registerContactComponents(Registry& r) {
       parseKinematic<d>);
 }
 
+template std::vector<double> pointList<2>(const Config&, const std::string&, int);
+template std::vector<double> pointList<3>(const Config&, const std::string&, int);
 template void parseShapeComponent<2>(World<2>&, Entity, const Config&);
 template void parseShapeComponent<3>(World<3>&, Entity, const Config&);
 template void registerContactComponents<2>(Registry&);

@@ -5,10 +5,13 @@
 
 #include "components/fluid_obstacle.h"
 #include "components/kinematic.h"
+#include "components/level_set.h"
 #include "components/mac_grid.h"
 #include "components/rigid_body.h"
 #include "components/shape.h"
+#include "scenarios/level_set_component.h"
 #include "solvers/mac_layout.h"
+#include "systems/obstacle_geometry.h"
 
 namespace monolith {
 
@@ -124,20 +127,23 @@ void parseFluidMaterial(World<d>& world, Entity e, const Config& c) {
   world.add(e, m);
 }
 
-// An obstacle in the fluid: needs the entity's shape and a static or kinematic rigid_body (parsed
-// before this component; registerFluidComponents runs after their registration).
+// An obstacle in the fluid: needs the entity's level_set or shape and a static or kinematic
+// rigid_body (parsed before this component; registerFluidComponents runs after their
+// registration, and registers level_set first).
 template <int d>
 void parseFluidObstacle(World<d>& world, Entity e, const Config& c) {
-  if (!world.template has<Shape<d>>(e)) c.fail("fluid_obstacle on an entity with a \"shape\"", "no shape");
+  const Shape<d>* shape = world.template get<Shape<d>>(e);
+  const bool levelSet = world.template has<LevelSet<d>>(e);
+  if (!shape && !levelSet) c.fail("fluid_obstacle on an entity with a \"level_set\" or a \"shape\"", "neither");
   const RigidBody<d>* body = world.template get<RigidBody<d>>(e);
   if (!body) c.fail("fluid_obstacle on an entity with a \"rigid_body\" (its position/orientation)", "no rigid_body");
   // The fluid does not push obstacles (one-way coupling): they are static or scripted.
   if (!body->isStatic && !world.template has<KinematicMotion<d>>(e))
     c.fail("fluid_obstacle on a static rigid_body (\"static\": true) or a kinematic one (one-way coupling)",
            "a dynamic rigid_body");
-  const ShapeType type = world.template get<Shape<d>>(e)->type;
-  if (type != ShapeType::Box && type != ShapeType::Sphere)
-    c.fail(std::string("fluid_obstacle on a ") + (d == 3 ? "box or sphere" : "box or disk") + " shape",
+  // With a level set the fluid sees it; the shape (if any) is then only for contact and frames.
+  if (!levelSet && !ObstacleGeometry<d>::supports(shape->type))
+    c.fail("fluid_obstacle on a " + ObstacleGeometry<d>::supportedNames() + " shape, or on an entity with a \"level_set\"",
            "another shape type");
   world.add(e, FluidObstacle{});
 }
@@ -151,8 +157,13 @@ void registerFluidComponents(Registry& r) {
       parseMacGrid<d>);
   r.addComponentOf<d, FluidMaterial>("fluid density and dynamic viscosity (on the mac_grid entity)",
                                      parseFluidMaterial<d>);
+  r.addComponentOf<d, LevelSet<d>>(
+      "signed distance (negative inside) in the body frame, for fluid obstacles: {origin, spacing, samples, values "
+      "(x fastest)}, {file (JSON of those)} or " + std::string(d == 2 ? "{polygon, spacing}" : "{mesh (OBJ), scale, spacing}"),
+      parseLevelSetComponent<d>);
   r.addComponentOf<d, FluidObstacle>(
-      "static obstacle in the fluid: the entity's shape at its static rigid_body pose becomes solid cells",
+      "obstacle in the fluid: the entity's level_set, else its shape (" + ObstacleGeometry<d>::supportedNames() +
+          "), at its static or kinematic rigid_body pose",
       parseFluidObstacle<d>);
 }
 

@@ -3,62 +3,18 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include "components/fluid_obstacle.h"
+#include "components/level_set.h"
 #include "solvers/mac_layout.h"
 #include "systems/fluid_domain.h"
+#include "systems/obstacle_geometry.h"
 
 namespace monolith {
 
-template <int d>
-bool shapeContains(const Shape<d>& shape, const RigidBody<d>& body, const Eigen::Matrix<double, d, 1>& x) {
-  const Eigen::Matrix<double, d, 1> local = body.rotation().transpose() * (x - body.x);
-  if (shape.type == ShapeType::Box) return (local.cwiseAbs().array() <= shape.halfExtents.array()).all();
-  return local.squaredNorm() <= shape.radius * shape.radius;
-}
-
 namespace {
-
-// The part [t0, t1] of the segment x + t e, t in [0, tMax] (|e| = 1), inside the shape; t0 > t1
-// when the segment misses it.
-template <int d>
-std::pair<double, double> segmentInside(const Shape<d>& shape, const RigidBody<d>& body, const Eigen::Matrix<double, d, 1>& x,
-                                        const Eigen::Matrix<double, d, 1>& e, double tMax) {
-  constexpr std::pair<double, double> kMiss{1, 0};
-  const Eigen::Matrix<double, d, 1> p = body.rotation().transpose() * (x - body.x);
-  const Eigen::Matrix<double, d, 1> q = body.rotation().transpose() * e;
-  double lo = 0, hi = tMax;
-  if (shape.type == ShapeType::Box) {  // slabs
-    for (int i = 0; i < d; ++i) {
-      const double h = shape.halfExtents[i];
-      if (std::abs(q[i]) < 1e-15) {
-        if (std::abs(p[i]) > h) return kMiss;
-        continue;
-      }
-      double t0 = (-h - p[i]) / q[i], t1 = (h - p[i]) / q[i];
-      if (t0 > t1) std::swap(t0, t1);
-      lo = std::max(lo, t0), hi = std::min(hi, t1);
-      if (lo > hi) return kMiss;
-    }
-    return {lo, hi};
-  }
-  const double r = shape.radius, b = p.dot(q), c = p.squaredNorm() - r * r;
-  const double disc = b * b - c;
-  if (disc < 0) return kMiss;
-  const double root = std::sqrt(disc);
-  lo = std::max(lo, -b - root), hi = std::min(hi, -b + root);
-  return lo <= hi ? std::make_pair(lo, hi) : kMiss;
-}
-
-// Distance t in [0, tMax] along x + t e (|e| = 1) at which the ray enters the shape: 0 if x is
-// inside, +inf if it misses within tMax.
-template <int d>
-double rayEntry(const Shape<d>& shape, const RigidBody<d>& body, const Eigen::Matrix<double, d, 1>& x,
-                const Eigen::Matrix<double, d, 1>& e, double tMax) {
-  const auto [t0, t1] = segmentInside(shape, body, x, e, tMax);
-  return t0 <= t1 ? t0 : std::numeric_limits<double>::infinity();
-}
 
 // The cell next to c along `axis` in direction dir (+-1); false outside a non-periodic domain.
 template <int d>
@@ -78,12 +34,6 @@ struct CellBox {
   typename solvers::MacLayout<d>::Index lo, hi;
 };
 
-// Radius of the sphere around the body's position that holds the shape (box or disk/sphere).
-template <int d>
-double boundingRadius(const Shape<d>& shape) {
-  return shape.type == ShapeType::Box ? shape.halfExtents.norm() : shape.radius;
-}
-
 template <int d>
 CellBox<d> wholeGrid(const solvers::MacLayout<d>& layout) {
   return {solvers::MacLayout<d>::Index::Zero(), layout.cells - solvers::MacLayout<d>::Index::Ones()};
@@ -92,8 +42,9 @@ CellBox<d> wholeGrid(const solvers::MacLayout<d>& layout) {
 // Cells within `margin` cells of the obstacle's bounding sphere (the reach the rasterization
 // uses); the whole extent of a periodic axis, on which the obstacle may wrap.
 template <int d>
-CellBox<d> obstacleBox(const solvers::MacLayout<d>& layout, const Shape<d>& shape, const RigidBody<d>& body, int margin) {
-  const double reach = boundingRadius(shape);
+CellBox<d> obstacleBox(const solvers::MacLayout<d>& layout, const ObstacleGeometry<d>& obstacle, int margin) {
+  const double reach = obstacle.boundingRadius();
+  const RigidBody<d>& body = obstacle.body();
   CellBox<d> box = wholeGrid(layout);
   for (int a = 0; a < d; ++a) {
     if (layout.periodic[a]) continue;
@@ -179,7 +130,7 @@ bool gridFaceFree(const solvers::MacLayout<d>& layout, const MacGrid<d>& grid, i
 }
 
 template <int d>
-using ObstacleList = std::vector<std::pair<const Shape<d>*, const RigidBody<d>*>>;
+using ObstacleList = std::vector<ObstacleGeometry<d>>;
 
 // Part of every face outside all the given obstacles (solvers::cutFaces). A face is measured along
 // exact segment-shape intersections: in 2-D the face is one segment; in 3-D the midpoint rule over
@@ -199,9 +150,7 @@ std::vector<double> openFractions(const solvers::MacLayout<d>& layout, const Obs
   forEachFaceIn(layout, within ? *within : wholeGrid(layout), [&](int g, int a, const typename solvers::MacLayout<d>::Index& f) {
     const Vec x = layout.faceCenter(a, f);
     bool near = false;
-    for (const auto& [shape, body] : obstacles) {
-      near |= (x - body->x).norm() <= boundingRadius(*shape) + h;
-    }
+    for (const auto& obstacle : obstacles) near |= (x - obstacle.body().x).norm() <= obstacle.boundingRadius() + h;
     if (!near) return;
     const int t1 = (a + 1) % d, t2 = (a + 2) % d;  // t2 == a in 2-D: one line
     const int lines = d == 2 ? 1 : kCutLines;
@@ -213,10 +162,7 @@ std::vector<double> openFractions(const solvers::MacLayout<d>& layout, const Obs
       start[t1] -= 0.5 * h;
       if (d == 3) start[t2] += ((k + 0.5) / lines - 0.5) * h;
       pieces.clear();
-      for (const auto& [shape, body] : obstacles) {
-        const auto piece = segmentInside(*shape, *body, start, e, h);
-        if (piece.first <= piece.second) pieces.push_back(piece);
-      }
+      for (const auto& obstacle : obstacles) obstacle.segmentInside(start, e, h, pieces);
       std::sort(pieces.begin(), pieces.end());
       double end = 0;  // union of the pieces along the line
       for (const auto& [lo, hi] : pieces) {
@@ -230,16 +176,26 @@ std::vector<double> openFractions(const solvers::MacLayout<d>& layout, const Obs
   return open;
 }
 
-// Every entity with a fluid_obstacle, shape and rigid_body, in pool order.
+// The geometry of an entity with a fluid_obstacle: its level_set if it has one, else its shape;
+// false without a rigid_body or either geometry.
+template <int d>
+bool obstacleGeometryOf(const World<d>& world, Entity e, std::optional<ObstacleGeometry<d>>& out) {
+  const RigidBody<d>* body = world.template get<RigidBody<d>>(e);
+  const LevelSet<d>* levelSet = world.template get<LevelSet<d>>(e);
+  const Shape<d>* shape = world.template get<Shape<d>>(e);
+  if (!body || (!levelSet && !shape)) return false;
+  out.emplace(shape, levelSet, *body);
+  return true;
+}
+
+// Every entity with a fluid_obstacle, its geometry and rigid_body, in pool order.
 template <int d, class F>
 void forEachObstacle(const World<d>& world, F&& f) {
   const auto* pool = world.template findPool<FluidObstacle>();
   if (!pool) return;
-  for (Entity e : pool->entities()) {
-    const Shape<d>* shape = world.template get<Shape<d>>(e);
-    const RigidBody<d>* body = world.template get<RigidBody<d>>(e);
-    if (shape && body) f(e, *shape, *body);
-  }
+  std::optional<ObstacleGeometry<d>> geometry;
+  for (Entity e : pool->entities())
+    if (obstacleGeometryOf(world, e, geometry)) f(e, *geometry);
 }
 
 // Everything rasterize_obstacles' output depends on, as numbers: equal keys give equal results.
@@ -252,15 +208,10 @@ std::vector<double> rasterizationKey(const World<d>& world, const MacGrid<d>& gr
   put(grid.origin);
   key.push_back(world.settings().fluid.cutCells);
   key.push_back(static_cast<double>(world.settings().fluid.obstacleWall));
-  forEachObstacle(world, [&](Entity e, const Shape<d>& shape, const RigidBody<d>& body) {
+  forEachObstacle(world, [&](Entity e, const ObstacleGeometry<d>& obstacle) {
+    const RigidBody<d>& body = obstacle.body();
     key.push_back(e.index);
-    key.push_back(static_cast<double>(shape.type));
-    put(shape.halfExtents);
-    key.push_back(shape.radius);
-    key.push_back(shape.halfHeight);
-    put(shape.normal);
-    put(shape.vertices);
-    key.insert(key.end(), shape.triangles.begin(), shape.triangles.end());
+    obstacle.appendKey(key);
     put(body.x);
     if constexpr (d == 3) put(body.orientation.coeffs());
     else key.push_back(body.orientation);
@@ -274,9 +225,9 @@ template <int d>
 std::vector<std::uint8_t> obstacleMask(const World<d>& world, const MacGrid<d>& grid) {
   const solvers::MacLayout<d> layout = macLayoutOf(grid);
   std::vector<std::uint8_t> mask(layout.cellCount(), 0);
-  forEachObstacle(world, [&](Entity, const Shape<d>& shape, const RigidBody<d>& body) {
+  forEachObstacle(world, [&](Entity, const ObstacleGeometry<d>& obstacle) {
     for (int c = 0; c < layout.cellCount(); ++c)
-      if (!mask[c] && shapeContains(shape, body, layout.cellCenter(layout.cellCoord(c)))) mask[c] = 1;
+      if (!mask[c] && obstacle.contains(layout.cellCenter(layout.cellCoord(c)))) mask[c] = 1;
   });
   return mask;
 }
@@ -284,7 +235,7 @@ std::vector<std::uint8_t> obstacleMask(const World<d>& world, const MacGrid<d>& 
 template <int d>
 std::vector<double> obstacleOpenFractions(const World<d>& world, const MacGrid<d>& grid) {
   ObstacleList<d> obstacles;
-  forEachObstacle(world, [&](Entity, const Shape<d>& shape, const RigidBody<d>& body) { obstacles.emplace_back(&shape, &body); });
+  forEachObstacle(world, [&](Entity, const ObstacleGeometry<d>& obstacle) { obstacles.push_back(obstacle); });
   return openFractions(macLayoutOf(grid), obstacles);
 }
 
@@ -318,7 +269,7 @@ std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d
   using Index = typename solvers::MacLayout<d>::Index;
   const solvers::MacLayout<d> layout = macLayoutOf(grid);
   ObstacleList<d> obstacles;
-  forEachObstacle(world, [&](Entity, const Shape<d>& shape, const RigidBody<d>& body) { obstacles.emplace_back(&shape, &body); });
+  forEachObstacle(world, [&](Entity, const ObstacleGeometry<d>& obstacle) { obstacles.push_back(obstacle); });
   std::vector<double> distance(static_cast<std::size_t>(layout.totalFaces()) * 2 * d, 1.0);
   if (grid.solid.empty()) return distance;
   const auto isFree = [&](int g) { return gridFaceFree(layout, grid, g); };
@@ -334,7 +285,7 @@ std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d
     e[b] = dir;
     const auto x = layout.faceCenter(a, f);
     double t = std::numeric_limits<double>::infinity();
-    for (const auto& [shape, body] : obstacles) t = std::min(t, rayEntry(*shape, *body, x, e, layout.dx));
+    for (const auto& obstacle : obstacles) t = std::min(t, obstacle.rayEntry(x, e, layout.dx));
     distance[solvers::FluidDomain<d>::wallDistanceIndex(g, b, dir > 0)] =
         std::clamp(t / layout.dx, solvers::FluidDomain<d>::kMinWallDistance, 1.0);
   });
@@ -346,15 +297,14 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
   using Index = typename solvers::MacLayout<d>::Index;
   ObstacleForce<d> result;
   auto& force = result.pressure;
-  const Shape<d>* shape = world.template get<Shape<d>>(obstacle);
-  const RigidBody<d>* body = world.template get<RigidBody<d>>(obstacle);
-  if (!shape || !body || grid.solid.empty()) return result;
+  std::optional<ObstacleGeometry<d>> geometry;
+  if (!obstacleGeometryOf(world, obstacle, geometry) || grid.solid.empty()) return result;
   const solvers::MacLayout<d> layout = macLayoutOf(grid);
   const int n = layout.cellCount();
   // Everything below happens within a few cells of the obstacle: its faces, the fluid cells and
   // faces next to them. Looping over that box only, in the whole grid's order, gives the same
   // sums as a loop over the grid at a fraction of the cost (a large grid, a small obstacle).
-  const CellBox<d> box = obstacleBox(layout, *shape, *body, 3);
+  const CellBox<d> box = obstacleBox(layout, *geometry, 3);
   // Part of each face covered by this obstacle: staircase, every face of its solid cells (those
   // with the centre inside its shape); cut faces, the covered part of the face.
   std::vector<double> covered;
@@ -362,12 +312,12 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
   if (grid.openFraction.empty()) {
     std::vector<std::uint8_t> cells(n, 0);
     forEachCellIn(layout, box, [&](int c, const Index& ci) {
-      cells[c] = grid.solid[c] && shapeContains(*shape, *body, layout.cellCenter(ci));
+      cells[c] = grid.solid[c] && geometry->contains(layout.cellCenter(ci));
     });
     mine = facesOfMarkedCells(layout, cells, &box);
     covered.assign(mine.begin(), mine.end());
   } else {
-    covered = openFractions(layout, ObstacleList<d>{{shape, body}}, &box);
+    covered = openFractions(layout, ObstacleList<d>{*geometry}, &box);
     mine.resize(covered.size());
     for (std::size_t g = 0; g < covered.size(); ++g) {
       covered[g] = 1.0 - covered[g];
@@ -413,7 +363,7 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
 
 template <int d>
 std::vector<std::string> RasterizeObstacles<d>::reads() const {
-  return {Shape<d>::kName, RigidBody<d>::kName, FluidObstacle::kName};
+  return {Shape<d>::kName, LevelSet<d>::kName, RigidBody<d>::kName, FluidObstacle::kName};
 }
 
 template <int d>
@@ -425,10 +375,11 @@ bool RasterizeObstacles<d>::needed(const World<d>& w) const {
 template <int d>
 std::vector<ObstacleMotion<d>> obstacleMotions(const World<d>& world) {
   std::vector<ObstacleMotion<d>> motions;
-  forEachObstacle(world, [&](Entity, const Shape<d>& shape, const RigidBody<d>& body) {
+  forEachObstacle(world, [&](Entity, const ObstacleGeometry<d>& obstacle) {
+    const RigidBody<d>& body = obstacle.body();
     ObstacleMotion<d> m;
     m.centre = body.x;
-    m.reach = boundingRadius(shape);
+    m.reach = obstacle.boundingRadius();
     if (!body.isStatic) {
       m.velocity = body.v;
       const AngularVec<d> w = body.omega();
@@ -469,7 +420,8 @@ void RasterizeObstacles<d>::run(World<d>& world, StepContext&) {
 
 template <int d>
 std::vector<std::string> ObstacleForces<d>::reads() const {
-  return {Shape<d>::kName, RigidBody<d>::kName, FluidObstacle::kName, MacGrid<d>::kName, FluidMaterial::kName};
+  return {Shape<d>::kName, LevelSet<d>::kName, RigidBody<d>::kName, FluidObstacle::kName, MacGrid<d>::kName,
+          FluidMaterial::kName};
 }
 
 template <int d>
@@ -485,7 +437,7 @@ void ObstacleForces<d>::run(World<d>& world, StepContext& ctx) {
   const FluidMaterial* material = world.template get<FluidMaterial>(pool.entities()[0]);
   const double mu = material ? material->viscosity : 0.0;
   const char* axes[] = {"x", "y", "z"};
-  forEachObstacle(world, [&](Entity e, const Shape<d>&, const RigidBody<d>&) {
+  forEachObstacle(world, [&](Entity e, const ObstacleGeometry<d>&) {
     const ObstacleForce<d> f = obstacleForce(world, e, grid, mu);
     const std::string& name = world.name(e);
     const std::string prefix = "obstacle_" + (name.empty() ? std::to_string(e.index) : name);
@@ -496,8 +448,6 @@ void ObstacleForces<d>::run(World<d>& world, StepContext& ctx) {
   });
 }
 
-template bool shapeContains<2>(const Shape<2>&, const RigidBody<2>&, const Eigen::Vector2d&);
-template bool shapeContains<3>(const Shape<3>&, const RigidBody<3>&, const Eigen::Vector3d&);
 template std::vector<std::uint8_t> obstacleMask<2>(const World<2>&, const MacGrid<2>&);
 template std::vector<std::uint8_t> obstacleMask<3>(const World<3>&, const MacGrid<3>&);
 template std::vector<double> obstacleOpenFractions<2>(const World<2>&, const MacGrid<2>&);

@@ -2,7 +2,8 @@
 // Static and kinematic obstacles in a MAC grid fluid (thesis Sec. 5.4.1: a staircase of solid
 // cells whose faces carry the obstacle's velocity at the face centre, first order).
 //  - rasterize_obstacles: grid.solid[c] = 1 for the cells whose centre lies inside any entity
-//    with shape + (static or kinematic) rigid_body + fluid_obstacle; writes the mask only when
+//    with fluid_obstacle + (static or kinematic) rigid_body + a level_set or a shape (box,
+//    disk/sphere, 2-D polygon, 3-D cylinder or capsule; systems/obstacle_geometry.h); writes the mask only when
 //    it changes (the projection caches its operators keyed on the mask and on the obstacles'
 //    motions), and grid.obstacleMotions (pose + rigid velocity) every step. With the default
 //    "obstacle_wall": "surface" it also casts, from every free face whose neighbour face along
@@ -24,10 +25,6 @@
 #include "ecs/system.h"
 
 namespace monolith {
-
-// Whether the world point x lies inside the shape at the body's pose (boundary included).
-template <int d>
-bool shapeContains(const Shape<d>& shape, const RigidBody<d>& body, const Eigen::Matrix<double, d, 1>& x);
 
 // The obstacle mask of the grid: 1 for cells whose centre is inside some obstacle.
 template <int d>

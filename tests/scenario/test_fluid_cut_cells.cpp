@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "support/scenes.h"
+#include "support/started_obstacle.h"
 
 #include <algorithm>
 #include <cmath>
@@ -25,33 +26,6 @@ const MacGrid<d>& gridOf(Simulation<d>& sim) {
   return sim.world().template pool<MacGrid<d>>().components()[0];
 }
 
-// A kinematic obstacle (shape JSON) started suddenly at velocity (1, 0, ...) in fluid at rest,
-// inviscid, no advection: one step. Returns the force impulse along x and the largest constraint
-// divergence after the projection.
-template <int d>
-std::pair<double, double> startedObstacle(const std::string& cells, double half, const std::string& shape,
-                                          const std::string& position, const std::string& cellsMode) {
-  const Registry registry = builtins();
-  const std::string lo = d == 2 ? "[" + std::to_string(-half) + "," + std::to_string(-half) + "]"
-                                : "[" + std::to_string(-half) + "," + std::to_string(-half) + "," + std::to_string(-half) + "]";
-  const std::string hi = d == 2 ? "[" + std::to_string(half) + "," + std::to_string(half) + "]"
-                                : "[" + std::to_string(half) + "," + std::to_string(half) + "," + std::to_string(half) + "]";
-  std::string walls = R"("x_min": { "type": "wall" }, "x_max": { "type": "wall" }, "y_min": { "type": "wall" }, "y_max": { "type": "wall" })";
-  if (d == 3) walls += R"(, "z_min": { "type": "wall" }, "z_max": { "type": "wall" })";
-  const std::string velocity = d == 2 ? "[1, 0]" : "[1, 0, 0]";
-  Simulation<d> sim(parseScene(R"({ "dimension": )" + std::to_string(d) + R"(, "time": { "dt": 0.001, "end": 0.001 },
-    "solvers": { "fluid": { "advection": "none", "tolerance": 1e-12, "obstacle_cells": ")" + cellsMode + R"(" } },
-    "entities": [
-      { "name": "fluid", "mac_grid": { "cells": )" + cells + R"(, "domain_min": )" + lo + R"(, "domain_max": )" + hi + R"(,
-                                       "boundaries": { )" + walls + R"( } },
-        "fluid_material": { "density": 1, "viscosity": 0 } },
-      { "name": "body", "shape": )" + shape + R"(, "rigid_body": { "mass": 1, "position": )" + position + R"( },
-        "kinematic": { "velocity": )" + velocity + R"( }, "fluid_obstacle": {} } ] })",
-                               "started_obstacle.json"),
-                    registry, 1);
-  const auto& diag = sim.step();
-  return {diag.at("obstacle_body_force_x") * 0.001, diag.at("fluid_divergence_max")};
-}
 }  // namespace
 
 TEST(CutCells, OpenFractionsAreTheExactChordsOfTheDisk) {
@@ -148,8 +122,8 @@ namespace {
 template <int d>
 void expectAddedMass(const std::string& cells, double half, const std::string& shape, const std::string& position,
                      double exact, double bound) {
-  const auto [cut, cutDivergence] = startedObstacle<d>(cells, half, shape, position, "cut");
-  const auto [stair, stairDivergence] = startedObstacle<d>(cells, half, shape, position, "staircase");
+  const auto [cut, cutDivergence] = startedObstacle<d>(cells, half, "\"shape\": " + shape, position, "cut");
+  const auto [stair, stairDivergence] = startedObstacle<d>(cells, half, "\"shape\": " + shape, position, "staircase");
   std::printf("%d-D added mass / potential flow: cut %.5f, staircase %.5f\n", d, cut / exact, stair / exact);
   EXPECT_LT(cutDivergence, 1e-6);
   EXPECT_LT(stairDivergence, 1e-6);
