@@ -221,29 +221,52 @@ std::vector<double> rasterizationKey(const World<d>& world, const MacGrid<d>& gr
 
 }  // namespace
 
+namespace {
+
+// Every obstacle's geometry, in pool order.
 template <int d>
-std::vector<std::uint8_t> obstacleMask(const World<d>& world, const MacGrid<d>& grid) {
-  const solvers::MacLayout<d> layout = macLayoutOf(grid);
+ObstacleList<d> obstacleList(const World<d>& world) {
+  ObstacleList<d> obstacles;
+  forEachObstacle(world, [&](Entity, const ObstacleGeometry<d>& obstacle) { obstacles.push_back(obstacle); });
+  return obstacles;
+}
+
+// The cells within kRasterMargin cells of any obstacle's bounding sphere, as one box (empty, lo >
+// hi, without obstacles): rasterization changes nothing outside it, so its passes skip the rest
+// of the grid (a small moving body in a large grid is rasterized every step). Three cells: a
+// face centre farther than reach + dx from a body (openFractions' "near" test) lies over two
+// cells beyond its box, and the viscous pairs into obstacle faces reach one face further.
+constexpr int kRasterMargin = 3;
+
+template <int d>
+CellBox<d> obstaclesBox(const solvers::MacLayout<d>& layout, const ObstacleList<d>& obstacles) {
+  using Index = typename solvers::MacLayout<d>::Index;
+  CellBox<d> box{layout.cells, Index::Constant(-1)};
+  for (const auto& obstacle : obstacles) {
+    const CellBox<d> one = obstacleBox(layout, obstacle, kRasterMargin);
+    box.lo = box.lo.cwiseMin(one.lo);
+    box.hi = box.hi.cwiseMax(one.hi);
+  }
+  return box;
+}
+
+// Staircase: cells whose centre lies inside some obstacle.
+template <int d>
+std::vector<std::uint8_t> staircaseMask(const solvers::MacLayout<d>& layout, const ObstacleList<d>& obstacles) {
   std::vector<std::uint8_t> mask(layout.cellCount(), 0);
-  forEachObstacle(world, [&](Entity, const ObstacleGeometry<d>& obstacle) {
-    for (int c = 0; c < layout.cellCount(); ++c)
-      if (!mask[c] && obstacle.contains(layout.cellCenter(layout.cellCoord(c)))) mask[c] = 1;
-  });
+  for (const auto& obstacle : obstacles)
+    forEachCellIn(layout, obstacleBox(layout, obstacle, 1), [&](int c, const typename solvers::MacLayout<d>::Index& ci) {
+      if (!mask[c] && obstacle.contains(layout.cellCenter(ci))) mask[c] = 1;
+    });
   return mask;
 }
 
+// Cut faces: the cells whose faces are all covered (only cells of `box` can be).
 template <int d>
-std::vector<double> obstacleOpenFractions(const World<d>& world, const MacGrid<d>& grid) {
-  ObstacleList<d> obstacles;
-  forEachObstacle(world, [&](Entity, const ObstacleGeometry<d>& obstacle) { obstacles.push_back(obstacle); });
-  return openFractions(macLayoutOf(grid), obstacles);
-}
-
-template <int d>
-std::vector<std::uint8_t> coveredCells(const solvers::MacLayout<d>& layout, const std::vector<double>& openFraction) {
+std::vector<std::uint8_t> coveredCells(const solvers::MacLayout<d>& layout, const std::vector<double>& openFraction,
+                                       const CellBox<d>& box) {
   std::vector<std::uint8_t> mask(layout.cellCount(), 0);
-  for (int c = 0; c < layout.cellCount(); ++c) {
-    const auto ci = layout.cellCoord(c);
+  forEachCellIn(layout, box, [&](int c, const typename solvers::MacLayout<d>::Index& ci) {
     bool covered = true;
     for (int a = 0; a < d && covered; ++a)
       for (int side = 0; side < 2; ++side) {
@@ -252,29 +275,30 @@ std::vector<std::uint8_t> coveredCells(const solvers::MacLayout<d>& layout, cons
         covered = covered && openFraction[layout.faceIndex(a, f)] == 0;
       }
     mask[c] = covered;
-  }
+  });
   return mask;
 }
 
-// The obstacle faces the viscous rows end on: faces of solid cells, and cut faces covered whole.
+// The obstacle faces the viscous rows end on: faces of solid cells, and cut faces covered whole
+// (all of them in `box`).
 template <int d>
-std::vector<std::uint8_t> obstacleFaces(const solvers::MacLayout<d>& layout, const MacGrid<d>& grid) {
-  std::vector<std::uint8_t> marked = facesOfMarkedCells(layout, grid.solid);
-  for (std::size_t g = 0; g < grid.openFraction.size(); ++g) marked[g] |= grid.openFraction[g] == 0;
+std::vector<std::uint8_t> obstacleFaces(const solvers::MacLayout<d>& layout, const MacGrid<d>& grid, const CellBox<d>& box) {
+  std::vector<std::uint8_t> marked = facesOfMarkedCells(layout, grid.solid, &box);
+  if (!grid.openFraction.empty())
+    forEachFaceIn(layout, box, [&](int g, int, const auto&) { marked[g] |= grid.openFraction[g] == 0; });
   return marked;
 }
 
 template <int d>
-std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d>& grid) {
+std::vector<double> wallDistances(const World<d>& world, const MacGrid<d>& grid, const ObstacleList<d>& obstacles,
+                                  const CellBox<d>& box) {
   using Index = typename solvers::MacLayout<d>::Index;
   const solvers::MacLayout<d> layout = macLayoutOf(grid);
-  ObstacleList<d> obstacles;
-  forEachObstacle(world, [&](Entity, const ObstacleGeometry<d>& obstacle) { obstacles.push_back(obstacle); });
   std::vector<double> distance(static_cast<std::size_t>(layout.totalFaces()) * 2 * d, 1.0);
   if (grid.solid.empty()) return distance;
   const auto isFree = [&](int g) { return gridFaceFree(layout, grid, g); };
   const bool cellBoundary = world.settings().fluid.obstacleWall == FluidSolverSettings::ObstacleWall::CellBoundary;
-  forEachPairIntoMarkedFaces(layout, isFree, obstacleFaces(layout, grid), [&](int g, int a, const Index& f, int b, int dir) {
+  const auto visit = [&](int g, int a, const Index& f, int b, int dir) {
     if (cellBoundary) {
       // The staircase's wall is the solid cells' boundary: half a cell across the face's control
       // volume (b != a); along the face's own axis the obstacle face lies on that boundary.
@@ -288,8 +312,30 @@ std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d
     for (const auto& obstacle : obstacles) t = std::min(t, obstacle.rayEntry(x, e, layout.dx));
     distance[solvers::FluidDomain<d>::wallDistanceIndex(g, b, dir > 0)] =
         std::clamp(t / layout.dx, solvers::FluidDomain<d>::kMinWallDistance, 1.0);
-  });
+  };
+  forEachPairIntoMarkedFaces(layout, isFree, obstacleFaces(layout, grid, box), visit, &box);
   return distance;
+}
+
+}  // namespace
+
+template <int d>
+std::vector<std::uint8_t> obstacleMask(const World<d>& world, const MacGrid<d>& grid) {
+  return staircaseMask(macLayoutOf(grid), obstacleList(world));
+}
+
+template <int d>
+std::vector<double> obstacleOpenFractions(const World<d>& world, const MacGrid<d>& grid) {
+  const solvers::MacLayout<d> layout = macLayoutOf(grid);
+  const ObstacleList<d> obstacles = obstacleList(world);
+  const CellBox<d> box = obstaclesBox(layout, obstacles);
+  return openFractions(layout, obstacles, &box);
+}
+
+template <int d>
+std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d>& grid) {
+  const ObstacleList<d> obstacles = obstacleList(world);
+  return wallDistances(world, grid, obstacles, obstaclesBox(macLayoutOf(grid), obstacles));
 }
 
 template <int d>
@@ -403,17 +449,19 @@ void RasterizeObstacles<d>::run(World<d>& world, StepContext&) {
     if (key == grid.rasterizedFrom && grid.solid.size() == static_cast<std::size_t>(grid.cells.prod())) continue;
     grid.rasterizedFrom = std::move(key);
     const solvers::MacLayout<d> layout = macLayoutOf(grid);
+    const ObstacleList<d> obstacles = obstacleList(world);
+    const CellBox<d> box = obstaclesBox(layout, obstacles);
     std::vector<std::uint8_t> mask;
     if (world.settings().fluid.cutCells) {
-      std::vector<double> open = obstacleOpenFractions(world, grid);
-      mask = coveredCells(layout, open);
+      std::vector<double> open = openFractions(layout, obstacles, &box);
+      mask = coveredCells(layout, open, box);
       if (open != grid.openFraction) grid.openFraction = std::move(open);
     } else {
-      mask = obstacleMask(world, grid);
+      mask = staircaseMask(layout, obstacles);
       grid.openFraction.clear();
     }
     if (mask != grid.solid) grid.solid = std::move(mask);  // unchanged: keep the projection's cache
-    if (world.settings().fluid.obstacleWallDistances()) grid.obstacleWallDistance = obstacleWallDistances(world, grid);
+    if (world.settings().fluid.obstacleWallDistances()) grid.obstacleWallDistance = wallDistances(world, grid, obstacles, box);
     else grid.obstacleWallDistance.clear();
   }
 }

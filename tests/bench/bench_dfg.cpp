@@ -11,7 +11,8 @@
 //
 // usage: bench_dfg [2d2] [max cells across the channel: 41|82|164] [threads] [end time, default the scene's]
 //                  [first cells across, default 41] [key=value scene overrides, e.g.
-//                  solvers.fluid.obstacle_cells=cut solvers.fluid.obstacle_wall=surface]
+//                  solvers.fluid.obstacle_cells=cut solvers.fluid.obstacle_wall=surface; scene=FILE runs
+//                  another scene of scenarios/scenes/, e.g. scene=dfg_2d1_level_set.json]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -57,9 +58,11 @@ struct Row {
 };
 
 std::vector<Override> extraOverrides;  // key=value arguments
+std::string sceneName;                 // scene=FILE (in scenarios/scenes/): another scene of the benchmark
 
 Row run(const Registry& registry, int ny, int threads, const std::string& end) {
-  const std::string file = std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/dfg_2d1.json";
+  const std::string file =
+      std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/" + (sceneName.empty() ? "dfg_2d1.json" : sceneName);
   const int nx = ny * 220 / 41;  // square cells: 2.2 / nx = 0.41 / ny
   std::vector<Override> overrides = {
       {"entities.fluid.mac_grid.cells", "[" + std::to_string(nx) + "," + std::to_string(ny) + "]"}};
@@ -98,7 +101,8 @@ Row run(const Registry& registry, int ny, int threads, const std::string& end) {
 constexpr double kCDmax = 3.23, kCLmax = 1.00, kSt = 0.300, kUbar2 = 1.0;
 
 void runPeriodic(const Registry& registry, int ny, int threads, const std::string& end) {
-  const std::string file = std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/dfg_2d2.json";
+  const std::string file =
+      std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/" + (sceneName.empty() ? "dfg_2d2.json" : sceneName);
   const int nx = ny * 220 / 41;
   std::vector<Override> overrides = {
       {"entities.fluid.mac_grid.cells", "[" + std::to_string(nx) + "," + std::to_string(ny) + "]"}};
@@ -135,6 +139,7 @@ int main(int argc, char** argv) {
     const std::string arg = argv[i];
     const auto eq = arg.find('=');
     if (eq == std::string::npos) argv[kept++] = argv[i];
+    else if (arg.substr(0, eq) == "scene") sceneName = arg.substr(eq + 1);
     else extraOverrides.push_back({arg.substr(0, eq), arg.substr(eq + 1)});
   }
   argc = kept;
