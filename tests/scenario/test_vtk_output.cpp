@@ -763,4 +763,67 @@ TEST(VtkOutput, LevelSetSurfacesAreClosedAndFollowTheZeroOfPhi3D) {
               worstOver(parts[0], pose, phiOf(ball)), worstOver(parts[1], pose, phiOf(torus)));
 }
 
+// The same shapes and a level set read from a scene and drawn by the CLI run: the scene's
+// parsers and the frame series hand the writer what it draws.
+TEST(VtkOutput, SceneShapesAndLevelSetsAreDrawnAsThemselves) {
+  const Eigen::Quaterniond q = Eigen::Quaterniond(0.9, 0.1, -0.3, 0.2).normalized();
+  const Eigen::Matrix3d R = q.toRotationMatrix();
+  const LevelSet<3> ball = sampled<3>(Eigen::Vector3d::Constant(-2), 0.25, 17, [](const Eigen::Vector3d& p) {
+    return p.norm() - 1.2;
+  });
+  Json house = Json::array(), octaVertices = Json::array(), octaTriangles = Json::array();
+  for (const auto& v : kHouse) house.push_back({v.x(), v.y(), v.z()});
+  house.push_back({kHouseInside.x(), kHouseInside.y(), kHouseInside.z()});
+  const Shape<3> octa = octahedron(0.5, 1.0, 1.5);
+  for (int i = 0; i < octa.vertexCount(); ++i) octaVertices.push_back({octa.vertex(i).x(), octa.vertex(i).y(), octa.vertex(i).z()});
+  for (std::size_t k = 0; k < octa.triangles.size(); k += 3)
+    octaTriangles.push_back({octa.triangles[k], octa.triangles[k + 1], octa.triangles[k + 2]});
+  const std::vector<Json> geometry = {
+      {{"shape", {{"type", "cylinder"}, {"radius", 0.6}, {"half_height", 0.9}}}},
+      {{"shape", {{"type", "capsule"}, {"radius", 0.4}, {"half_height", 0.8}}}},
+      {{"shape", {{"type", "convex"}, {"vertices", house}}}},
+      {{"shape", {{"type", "mesh"}, {"vertices", octaVertices}, {"triangles", octaTriangles}}}},
+      {{"shape", {{"type", "plane"}, {"normal", {0, 0, 1}}}}},
+      {{"level_set", {{"origin", {-2, -2, -2}}, {"spacing", 0.25}, {"samples", {17, 17, 17}}, {"values", ball.values}}}}};
+  Json scene = {{"dimension", 3}, {"time", {{"dt", 0.1}, {"steps", 1}, {"frame_rate", 10}}}, {"entities", Json::array()}};
+  std::vector<Pose> poses;
+  for (std::size_t b = 0; b < geometry.size(); ++b) {
+    poses.push_back({Eigen::Vector3d(3.0 * b, -1, 0.5), R});
+    Json entity = geometry[b];
+    entity["rigid_body"] = {{"static", true}, {"position", {3.0 * b, -1, 0.5}}, {"orientation", {q.w(), q.x(), q.y(), q.z()}}};
+    scene["entities"].push_back(entity);
+  }
+  TempDir tmp;
+  const fs::path file = tmp.path() / "shapes.json", out = tmp.path() / "run", frame = out / "frames/geometry_000000.vtp";
+  writeFile(file, scene.dump(2));
+  const CommandResult r = run({MONOLITH_CLI, "run", file.string(), "--out", out.string(), "--quiet"}, tmp.logs());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  Json j;
+  std::string skip;
+  if (!readWithVtk({frame}, tmp.logs(), j, skip)) GTEST_SKIP() << skip;
+  auto parts = splitGeometry(j["files"][frame.string()]);
+  ASSERT_EQ(parts.size(), geometry.size());
+  for (long b : {0, 1, 2, 3, 5}) EXPECT_EQ(unmatchedEdges(parts[b]), 0) << "body " << b;
+  const int n = monolith::kRoundSegments;
+  EXPECT_NEAR(enclosedVolume(parts[0]), M_PI * 0.36 * 1.8 * n / (2 * M_PI) * std::sin(2 * M_PI / n), 1e-12);
+  EXPECT_LT(worstOver(parts[0], poses[0], [](const Eigen::Vector3d& p) { return cylinderDistance(p, 0.6, 0.9); }),
+            kOnSurface);
+  std::vector<Eigen::Vector2d> capsule = latitudeRings(0.4, 0.8, 0, 8, 16);
+  const auto lower = latitudeRings(0.4, -0.8, 8, 16, 16);
+  capsule.insert(capsule.end(), lower.begin(), lower.end());
+  EXPECT_NEAR(enclosedVolume(parts[1]), stackedFrustums(capsule, n), 1e-12);
+  EXPECT_LT(worstOver(parts[1], poses[1], [](const Eigen::Vector3d& p) { return capsuleDistance(p, 0.4, 0.8); }),
+            kOnSurface);
+  EXPECT_NEAR(enclosedVolume(parts[2]), 3.5, 1e-12);
+  EXPECT_EQ(parts[2].points.size(), kHouse.size());
+  EXPECT_NEAR(enclosedVolume(parts[3]), 1.0, 1e-12);
+  const double side = monolith::kPlanePatchSize;
+  ASSERT_EQ(parts[4].polys, 1);
+  expectNear3(vectorArea(parts[4], parts[4].faces[0]), side * side * (R * Eigen::Vector3d::UnitZ()), 1e-12, "plane");
+  // The level set: closed, on phi = 0, within (h / r)^2 of the ball's volume.
+  EXPECT_EQ(eulerCharacteristic(parts[5]), 2);
+  EXPECT_LT(worstOver(parts[5], poses[5], [&](const Eigen::Vector3d& p) { return ball.value(p); }), kOnSurface);
+  EXPECT_NEAR(enclosedVolume(parts[5]) / (4.0 / 3 * M_PI * std::pow(1.2, 3)), 1, std::pow(0.25 / 1.2, 2));
+}
+
 }  // namespace
