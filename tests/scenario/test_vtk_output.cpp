@@ -431,13 +431,16 @@ std::vector<Eigen::Vector2d> latitudeRings(double r, double zc, int first, int l
   return rings;
 }
 
-template <int d>
-void addBody(World<d>& world, monolith::Entity e, const Eigen::Matrix<double, d, 1>& x,
-             const monolith::Orientation<d>& orientation) {
+// A new entity with a rigid body at the given pose and `component` (a shape or a level set).
+template <int d, class Component>
+void addPosed(World<d>& world, const Eigen::Matrix<double, d, 1>& x, const monolith::Orientation<d>& orientation,
+              const Component& component) {
+  const monolith::Entity e = world.create();
   RigidBody<d> body;
   body.x = x;
   body.orientation = orientation;
   world.add(e, body);
+  world.add(e, component);
 }
 
 // Writes the geometry frame of `world`, reads it back with VTK and splits it by body.
@@ -499,9 +502,7 @@ TEST(VtkOutput, EveryShapeTypeIsDrawnAsItself3D) {
                                         octahedron(0.5, 1.0, 1.5),
                                         plane};
   for (const auto& shape : shapes) {
-    const monolith::Entity e = world.create();
-    addBody<3>(world, e, pose.x, q);
-    world.add(e, shape);
+    addPosed<3>(world, pose.x, q, shape);
   }
   TempDir tmp;
   std::map<long, BodyGeometry> parts;
@@ -583,9 +584,7 @@ TEST(VtkOutput, PolygonDiskAndHalfPlaneOutlines2D) {
   plane.type = ShapeType::Plane;
   plane.normal = Eigen::Vector2d(0, 1);
   for (const Shape<2>& shape : {polygon, disk, plane}) {
-    const monolith::Entity e = world.create();
-    addBody<2>(world, e, x, angle);
-    world.add(e, shape);
+    addPosed<2>(world, x, angle, shape);
   }
   TempDir tmp;
   std::map<long, BodyGeometry> parts;
@@ -655,9 +654,7 @@ TEST(VtkOutput, LevelSetContoursFollowTheZeroOfPhi2D) {
     return std::max((p - centre).norm() - outer, inner - (p - centre).norm());
   });
   for (const LevelSet<2>* ls : {&disk, &ring}) {
-    const monolith::Entity e = world.create();
-    addBody<2>(world, e, x, angle);
-    world.add(e, *ls);
+    addPosed<2>(world, x, angle, *ls);
   }
   TempDir tmp;
   std::map<long, BodyGeometry> parts;
@@ -700,9 +697,7 @@ TEST(VtkOutput, LevelSetSaddleCellsFollowTheCellCentre2D) {
     ls.values[2 + 4 * 1] = ls.values[1 + 4 * 2] = across;
     ls.refresh();
     levelSets.push_back(ls);
-    const monolith::Entity e = world.create();
-    addBody<2>(world, e, Eigen::Vector2d::Zero(), 0.0);
-    world.add(e, ls);
+    addPosed<2>(world, Eigen::Vector2d::Zero(), 0.0, ls);
   }
   TempDir tmp;
   std::map<long, BodyGeometry> parts;
@@ -734,9 +729,7 @@ TEST(VtkOutput, LevelSetSurfacesAreClosedAndFollowTheZeroOfPhi3D) {
     return Eigen::Vector2d(std::hypot(c.x(), c.y()) - major, c.z()).norm() - minor;
   });
   for (const LevelSet<3>* ls : {&ball, &torus}) {
-    const monolith::Entity e = world.create();
-    addBody<3>(world, e, pose.x, q);
-    world.add(e, *ls);
+    addPosed<3>(world, pose.x, q, *ls);
   }
   TempDir tmp;
   std::map<long, BodyGeometry> parts;
