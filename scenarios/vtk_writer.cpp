@@ -6,76 +6,19 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "components/level_set.h"
 #include "components/rigid_body.h"
 #include "components/shape.h"
+#include "scenarios/body_surfaces.h"
 
 namespace monolith {
 
 namespace {
 
-struct Polygons {
-  std::vector<Eigen::Vector3d> points;
-  std::vector<int> pointBody;
-  std::vector<std::vector<int>> faces;
-};
-
 std::string num(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.17g", v);
   return buf;
-}
-
-Eigen::Vector3d lift(const Eigen::Vector2d& p) { return {p.x(), p.y(), 0.0}; }
-Eigen::Vector3d lift(const Eigen::Vector3d& p) { return p; }
-
-template <int d>
-void addShape(const RigidBody<d>& body, const Shape<d>& shape, int bodyId, Polygons& out) {
-  const auto R = body.rotation();
-  const int base = static_cast<int>(out.points.size());
-  auto addPoint = [&](const Eigen::Matrix<double, d, 1>& local) {
-    out.points.push_back(lift(Eigen::Matrix<double, d, 1>(body.x + R * local)));
-    out.pointBody.push_back(bodyId);
-  };
-  if constexpr (d == 3) {
-    if (shape.type == ShapeType::Box) {
-      const Eigen::Vector3d h = shape.halfExtents;
-      for (int k = 0; k < 8; ++k)
-        addPoint(Eigen::Vector3d((k & 1) ? h.x() : -h.x(), (k & 2) ? h.y() : -h.y(), (k & 4) ? h.z() : -h.z()));
-      const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-      for (const auto& q : quads) out.faces.push_back({base + q[0], base + q[1], base + q[2], base + q[3]});
-    } else {
-      const int rings = 8, segments = 16;  // latitude-longitude sphere, poles as rings of points
-      for (int i = 0; i <= rings; ++i) {
-        const double theta = M_PI * i / rings;
-        for (int j = 0; j < segments; ++j) {
-          const double phi = 2 * M_PI * j / segments;
-          addPoint(shape.radius * Eigen::Vector3d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                                                  std::cos(theta)));
-        }
-      }
-      for (int i = 0; i < rings; ++i)
-        for (int j = 0; j < segments; ++j) {
-          const int a = base + i * segments + j, b = base + i * segments + (j + 1) % segments;
-          out.faces.push_back({a, a + segments, b + segments, b});
-        }
-    }
-  } else {
-    std::vector<int> face;
-    if (shape.type == ShapeType::Box) {
-      const Eigen::Vector2d h = shape.halfExtents;
-      const Eigen::Vector2d corners[4] = {{-h.x(), -h.y()}, {h.x(), -h.y()}, {h.x(), h.y()}, {-h.x(), h.y()}};
-      for (const auto& c : corners) {
-        face.push_back(static_cast<int>(out.points.size()));
-        addPoint(c);
-      }
-    } else {
-      for (int j = 0; j < 32; ++j) {
-        face.push_back(static_cast<int>(out.points.size()));
-        addPoint(shape.radius * Eigen::Vector2d(std::cos(2 * M_PI * j / 32), std::sin(2 * M_PI * j / 32)));
-      }
-    }
-    out.faces.push_back(face);
-  }
 }
 
 void appendArray(std::ostringstream& x, const char* type, const char* name, int components,
@@ -191,16 +134,32 @@ void writeRigidBodyFrame(const World<d>& world, const std::string& path) {
   writeFileAtomically(path, polyDataFile(ids.size(), coords, pd.str(), cellBlock("Verts", verts), verts.size(), 0));
 }
 
+namespace {
+
+// draw(body, component, body id) for every component of type C whose entity has a rigid body,
+// in pool order.
+template <class C, int d, class Draw>
+void forEachBodyWith(const World<d>& world, Draw&& draw) {
+  const auto* pool = world.template findPool<C>();
+  for (std::size_t i = 0; pool && i < pool->size(); ++i) {
+    const Entity e = pool->entities()[i];
+    if (const auto* body = world.template get<RigidBody<d>>(e)) draw(*body, pool->components()[i], static_cast<int>(e.index));
+  }
+}
+
+}  // namespace
+
+// Every shape, then every level set: an entity with both shows both (a fluid obstacle moves the
+// fluid with its level set, a collider collides with its shape).
 template <int d>
 void writeRigidGeometryFrame(const World<d>& world, const std::string& path) {
-  Polygons polys;
-  if (const auto* shapes = world.template findPool<Shape<d>>()) {
-    for (std::size_t i = 0; i < shapes->size(); ++i) {
-      const Entity e = shapes->entities()[i];
-      if (const auto* body = world.template get<RigidBody<d>>(e))
-        addShape(*body, shapes->components()[i], static_cast<int>(e.index), polys);
-    }
-  }
+  SurfacePolygons polys;
+  forEachBodyWith<Shape<d>>(world, [&](const RigidBody<d>& body, const Shape<d>& shape, int id) {
+    appendShapeSurface(body, shape, id, polys);
+  });
+  forEachBodyWith<LevelSet<d>>(world, [&](const RigidBody<d>& body, const LevelSet<d>& levelSet, int id) {
+    appendLevelSetContour(body, levelSet, id, polys);
+  });
   std::vector<double> coords;
   for (const auto& p : polys.points) coords.insert(coords.end(), p.data(), p.data() + 3);
   std::ostringstream pd;

@@ -2,7 +2,8 @@
 // VTK XML PolyData (.vtp) frames and the .pvd collection ParaView opens as a time series.
 // Rigid bodies give two files per frame: bodies_N.vtp, one point per body at its centre of
 // mass carrying id, name, velocity, angular velocity, orientation (quaternion w,x,y,z) and
-// mass; geometry_N.vtp, the surfaces of the bodies' shapes with the body id per point.
+// mass; geometry_N.vtp, the surfaces of the bodies' shapes and the zero contours of their level
+// sets (scenarios/body_surfaces.h), with the body id per point.
 #include <string>
 #include <utility>
 #include <vector>
