@@ -168,7 +168,7 @@ void registerDimension(Registry& r) {
   r.addSystem<d>({"fluid_gravity", "gravity on the fluid's free faces", [] { return single<FluidGravity<d>>(); }, ""});
   r.addSystem<d>({"project_fluid", "coupled SPD pressure-viscosity solve (5.31) or Chorin splitting",
                   [] { return single<FluidProjection<d>>(); }, ""});
-  r.addSystem<d>({"rasterize_obstacles", "solid cells of the MAC grid covered by fluid_obstacle shapes (staircase)",
+  r.addSystem<d>({"rasterize_obstacles", "solid cells (staircase) or cut faces of the MAC grid covered by fluid_obstacle shapes and level sets",
                   [] { return single<RasterizeObstacles<d>>(); }, ""});
   r.addSystem<d>({"obstacle_forces", "first-order force of the fluid on each fluid_obstacle (pressure + wall shear)",
                   [] { return single<ObstacleForces<d>>(); }, ""});
