@@ -5,6 +5,7 @@
 // solid flags of cells covered by obstacles and the domain's boundary conditions.
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross product of ObstacleMotion
+#include <functional>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -36,6 +37,10 @@ struct ObstacleMotion {
   Eigen::Matrix<double, d, 1> velocity = Eigen::Matrix<double, d, 1>::Zero();
   Eigen::Vector3d angularVelocity = Eigen::Vector3d::Zero();
   double reach = 0;  // bounding radius about the centre
+  Eigen::Vector4d orientation = Eigen::Vector4d::Zero();  // quaternion coefficients (3-D) or angle (2-D)
+  // Signed distance to the body's surface (negative inside), valid for the step that set it
+  // (it reads the body's components); empty: the bounding sphere's.
+  std::function<double(const Eigen::Matrix<double, d, 1>&)> signedDistance;
 
   Eigen::Matrix<double, d, 1> velocityAt(const Eigen::Matrix<double, d, 1>& x) const {
     Eigen::Vector3d r = Eigen::Vector3d::Zero();
@@ -44,7 +49,8 @@ struct ObstacleMotion {
   }
   bool moving() const { return !velocity.isZero(0) || !angularVelocity.isZero(0); }
   bool operator==(const ObstacleMotion& o) const {
-    return centre == o.centre && velocity == o.velocity && angularVelocity == o.angularVelocity && reach == o.reach;
+    return centre == o.centre && velocity == o.velocity && angularVelocity == o.angularVelocity && reach == o.reach &&
+           orientation == o.orientation;
   }
 };
 
@@ -79,13 +85,16 @@ struct MacGrid {
   // checkpointed: empty after a restart, so the first step rasterizes afresh.
   std::vector<double> rasterizedFrom;
 
-  // Velocity of the obstacle nearest to x (the one whose bounding sphere x is deepest in); zero
-  // without obstacles. Solid faces take its normal component (Sec. 5.4.1).
+  // Velocity of the obstacle nearest to x: the one of smallest signed distance to its surface
+  // (the deepest one x lies in), so that a body inside another's hollow (a disk in a ring) moves
+  // the faces next to it; zero without obstacles. Solid faces take its normal component (Sec.
+  // 5.4.1).
   Eigen::Matrix<double, d, 1> obstacleVelocityAt(const Eigen::Matrix<double, d, 1>& x) const {
+    if (obstacleMotions.size() == 1) return obstacleMotions[0].velocityAt(x);
     const ObstacleMotion<d>* best = nullptr;
     double bestDistance = 0;
     for (const auto& m : obstacleMotions) {
-      const double distance = (x - m.centre).norm() - m.reach;
+      const double distance = m.signedDistance ? m.signedDistance(x) : (x - m.centre).norm() - m.reach;
       if (!best || distance < bestDistance) best = &m, bestDistance = distance;
     }
     return best ? best->velocityAt(x) : Eigen::Matrix<double, d, 1>::Zero().eval();

@@ -338,6 +338,17 @@ std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d
   return wallDistances(world, grid, obstacles, obstaclesBox(macLayoutOf(grid), obstacles));
 }
 
+namespace {
+// torque += r x (f e_axis), r lifted to 3-D.
+template <int d>
+void addTorque(Eigen::Vector3d& torque, const Eigen::Matrix<double, d, 1>& r, int axis, double f) {
+  Eigen::Vector3d r3 = Eigen::Vector3d::Zero(), f3 = Eigen::Vector3d::Zero();
+  r3.head<d>() = r;
+  f3[axis] = f;
+  torque += r3.cross(f3);
+}
+}  // namespace
+
 template <int d>
 ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const MacGrid<d>& grid, double viscosity) {
   using Index = typename solvers::MacLayout<d>::Index;
@@ -381,7 +392,10 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
         Index fi = ci;
         fi[a] += side;
         const double part = covered[layout.faceIndex(a, fi)];
-        if (part > 0) force[a] += (side == 1 ? 1.0 : -1.0) * grid.p[c] * part * area;
+        if (part <= 0) continue;
+        const double f = (side == 1 ? 1.0 : -1.0) * grid.p[c] * part * area;
+        force[a] += f;
+        addTorque<d>(result.pressureTorque, layout.faceCenter(a, fi) - geometry->body().x, a, f);
       }
   });
 
@@ -395,13 +409,32 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
   if (viscosity > 0) {
     const std::vector<double>& wallDistance = grid.obstacleWallDistance;
     const auto isFree = [&](int g) { return gridFaceFree(layout, grid, g); };
+    Eigen::Vector3d spin = Eigen::Vector3d::Zero();  // the body's angular velocity (z only in 2-D)
+    if (!geometry->body().isStatic) {
+      if constexpr (d == 3) spin = geometry->body().omega();
+      else spin.z() = geometry->body().omega()(0);
+    }
     forEachPairIntoMarkedFaces(layout, isFree, mine, [&](int g, int a, const Index& fi, int b, int dir) {
       const double theta = wallDistance.empty() ? 1.0 : wallDistance[solvers::FluidDomain<d>::wallDistanceIndex(g, b, dir > 0)];
       // The operator's known value: the obstacle face's prescribed velocity (its centre, one cell away).
       Eigen::Matrix<double, d, 1> wallPoint = layout.faceCenter(a, fi);
       wallPoint[b] += dir * layout.dx;
       const double wall = grid.obstacleVelocityAt(wallPoint)[a];
-      result.viscous[a] += viscosity * (grid.u[g] - wall) / (theta * layout.dx) * area;
+      const double f = viscosity * (grid.u[g] - wall) / (theta * layout.dx) * area;
+      result.viscous[a] += f;
+      Eigen::Matrix<double, d, 1> onWall = layout.faceCenter(a, fi);
+      onWall[b] += dir * theta * layout.dx;
+      addTorque<d>(result.viscousTorque, onWall - geometry->body().x, a, f);
+      // The rows are the vector Laplacian's, mu du/dn: on a wall spinning at w that traction
+      // differs from the stress mu (grad u + grad u^T) n by mu (w x n), which sums to no force
+      // over a closed surface but to a torque -2 mu V w (V the body's volume; rotating Couette
+      // flow: test LevelSets.CouetteTorqueOnTheSpinningAndTheStillCylinder). So the torque adds
+      // that part of every tangential row, n = -dir e_b pointing out of the body.
+      if (b != a && spin.squaredNorm() > 0) {
+        Eigen::Vector3d n = Eigen::Vector3d::Zero();
+        n[b] = -dir;
+        addTorque<d>(result.viscousTorque, onWall - geometry->body().x, a, -viscosity * spin.cross(n)[a] * area);
+      }
     }, &box);
   }
   return result;
@@ -426,6 +459,9 @@ std::vector<ObstacleMotion<d>> obstacleMotions(const World<d>& world) {
     ObstacleMotion<d> m;
     m.centre = body.x;
     m.reach = obstacle.boundingRadius();
+    if constexpr (d == 3) m.orientation = body.orientation.coeffs();
+    else m.orientation[0] = body.orientation;
+    m.signedDistance = [obstacle](const Vec<d>& x) { return obstacle.signedDistance(x); };
     if (!body.isStatic) {
       m.velocity = body.v;
       const AngularVec<d> w = body.omega();
@@ -492,6 +528,10 @@ void ObstacleForces<d>::run(World<d>& world, StepContext& ctx) {
     for (int a = 0; a < d; ++a) {
       ctx.diagnostics.set(prefix + "_force_" + axes[a], f.total()[a]);
       ctx.diagnostics.set(prefix + "_pressure_force_" + axes[a], f.pressure[a]);
+    }
+    for (int a = d == 2 ? 2 : 0; a < 3; ++a) {
+      ctx.diagnostics.set(prefix + "_torque_" + axes[a], f.torque()[a]);
+      ctx.diagnostics.set(prefix + "_pressure_torque_" + axes[a], f.pressureTorque[a]);
     }
   });
 }

@@ -18,7 +18,8 @@
 //    fluid-solid face (on the covered part of every cut face), plus the viscous stress exactly as the viscous operator applies it,
 //    mu (u - u_wall) / (theta dx) for every free face and axis whose neighbour face that way is
 //    an obstacle face (the body's share of the discrete momentum balance); diagnostics obstacle_<name>_force_x, _y (, _z), and its pressure part
-//    obstacle_<name>_pressure_force_x, ...
+//    obstacle_<name>_pressure_force_x, ...; the torque about the body's position,
+//    obstacle_<name>_torque_z in 2-D (_x, _y, _z in 3-D).
 #include "components/mac_grid.h"
 #include "components/rigid_body.h"
 #include "components/shape.h"
@@ -45,11 +46,16 @@ std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d
 
 // The force of the fluid on the obstacle (entity) from the grid's current velocity and pressure,
 // split into its pressure and viscous parts.
+// The torque about the body's position (z only in 2-D) takes each pressure term at its face's
+// centre and each viscous row at the wall point it measures the shear against (the face centre
+// moved theta dx towards the obstacle), so a wall's shear acts on the wall's own radius.
 template <int d>
 struct ObstacleForce {
   Eigen::Matrix<double, d, 1> pressure = Eigen::Matrix<double, d, 1>::Zero();
   Eigen::Matrix<double, d, 1> viscous = Eigen::Matrix<double, d, 1>::Zero();
+  Eigen::Vector3d pressureTorque = Eigen::Vector3d::Zero(), viscousTorque = Eigen::Vector3d::Zero();
   Eigen::Matrix<double, d, 1> total() const { return pressure + viscous; }
+  Eigen::Vector3d torque() const { return pressureTorque + viscousTorque; }
 };
 template <int d>
 ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const MacGrid<d>& grid, double viscosity);

@@ -184,6 +184,39 @@ double ObstacleGeometry<d>::rayEntry(const Vec& x, const Vec& e, double tMax) co
 }
 
 template <int d>
+double ObstacleGeometry<d>::signedDistance(const Vec& x) const {
+  const Vec p = toBody(x);
+  if (levelSet_) return levelSet_->value(p);
+  const Shape<d>& s = *shape_;
+  // A box-like solid from per-axis excesses q (positive outside): outside, the distance to the
+  // nearest point; inside, the largest (least negative) excess.
+  const auto fromExcess = [](const auto& q) { return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0); };
+  switch (s.type) {
+    case ShapeType::Box:
+      return fromExcess((p.cwiseAbs() - s.halfExtents).eval());
+    case ShapeType::Convex: {
+      const int n = s.vertexCount();
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int i = 0; i < n; ++i) {
+        const Vec a = s.vertex(i), edge = s.vertex((i + 1) % n) - a;
+        const double t = std::clamp((p - a).dot(edge) / edge.squaredNorm(), 0.0, 1.0);
+        nearest = std::min(nearest, (a + t * edge - p).norm());
+      }
+      return contains(x) ? -nearest : nearest;
+    }
+    case ShapeType::Cylinder:
+      return fromExcess(Eigen::Vector2d(p.head(2).norm() - s.radius, std::abs(p[d - 1]) - s.halfHeight));
+    case ShapeType::Capsule: {
+      Vec axisPoint = Vec::Zero();
+      axisPoint[d - 1] = std::clamp(p[d - 1], -s.halfHeight, s.halfHeight);
+      return (p - axisPoint).norm() - s.radius;
+    }
+    default:
+      return p.norm() - s.radius;
+  }
+}
+
+template <int d>
 double ObstacleGeometry<d>::boundingRadius() const {
   if (levelSet_) return levelSet_->reach;
   const Shape<d>& s = *shape_;

@@ -38,6 +38,8 @@ class ObstacleGeometry {
   void segmentInside(const Vec& x, const Vec& e, double tMax, std::vector<Interval>& out) const;
   // Distance t in [0, tMax] at which x + t e enters the body: 0 if x is inside, +inf on a miss.
   double rayEntry(const Vec& x, const Vec& e, double tMax) const;
+  // Signed distance from x to the body's surface, negative inside (a level set's interpolated phi).
+  double signedDistance(const Vec& x) const;
   // Radius of the ball about the body's position that holds the body.
   double boundingRadius() const;
   // The numbers the rasterization depends on (besides the pose): equal keys, equal geometry.
