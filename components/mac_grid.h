@@ -77,6 +77,9 @@ struct MacGrid {
   // Per face and direction, cells from the face centre to an obstacle surface (FluidDomain::
   // wallDistance); empty when the obstacles' walls sit at the face centres ("obstacle_wall": "face").
   std::vector<double> obstacleWallDistance;
+  // With it, when an obstacle moves: the wall's velocity at those wall points (FluidDomain::
+  // wallVelocity); empty for still obstacles.
+  std::vector<double> obstacleWallVelocity;
   // Per face, the part of its area outside every obstacle (FluidDomain::openFraction); empty for
   // the staircase ("obstacle_cells": "staircase"), where `solid` alone describes the obstacles.
   std::vector<double> openFraction;

@@ -56,6 +56,7 @@ solvers::FluidDomain<d> fluidDomainOf(const MacGrid<d>& grid) {
     solvers::markSolid(domain, grid.solid, obstacleVelocity);
     if (!grid.openFraction.empty()) solvers::cutFaces(domain, grid.openFraction, obstacleVelocity);
     domain.wallDistance = grid.obstacleWallDistance;
+    domain.wallVelocity = grid.obstacleWallVelocity;
   }
   return domain;
 }

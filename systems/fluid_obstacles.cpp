@@ -215,6 +215,8 @@ std::vector<double> rasterizationKey(const World<d>& world, const MacGrid<d>& gr
     put(body.x);
     if constexpr (d == 3) put(body.orientation.coeffs());
     else key.push_back(body.orientation);
+    put(body.v);  // the wall velocities (a kinematic body may change speed where it stands)
+    put(body.omega());
   });
   return key;
 }
@@ -289,32 +291,67 @@ std::vector<std::uint8_t> obstacleFaces(const solvers::MacLayout<d>& layout, con
   return marked;
 }
 
+// The rigid velocity of the body at x.
 template <int d>
-std::vector<double> wallDistances(const World<d>& world, const MacGrid<d>& grid, const ObstacleList<d>& obstacles,
-                                  const CellBox<d>& box) {
+Eigen::Matrix<double, d, 1> rigidVelocityAt(const RigidBody<d>& body, const Eigen::Matrix<double, d, 1>& x) {
+  if (body.isStatic) return Eigen::Matrix<double, d, 1>::Zero();
+  const Eigen::Matrix<double, d, 1> r = x - body.x;
+  if constexpr (d == 3) return body.v + body.omega().cross(r);
+  else return body.v + body.omega()(0) * Eigen::Vector2d(-r.y(), r.x());
+}
+
+template <int d>
+bool anyMoves(const ObstacleList<d>& obstacles) {
+  for (const auto& obstacle : obstacles)
+    if (rigidVelocityAt(obstacle.body(), obstacle.body().x).squaredNorm() > 0 || (!obstacle.body().isStatic && obstacle.body().omega().squaredNorm() > 0))
+      return true;
+  return false;
+}
+
+// Per free face and direction into an obstacle face: the distance in cells to the wall
+// (FluidDomain::wallDistance) and, when some obstacle moves, the wall's velocity component along
+// the face's axis at that wall point, from the obstacle of smallest signed distance there
+// (FluidDomain::wallVelocity, kNoWallVelocity for the pairs that end elsewhere; empty otherwise).
+template <int d>
+struct WallGeometry {
+  std::vector<double> distance, velocity;
+};
+
+template <int d>
+WallGeometry<d> wallGeometry(const World<d>& world, const MacGrid<d>& grid, const ObstacleList<d>& obstacles,
+                             const CellBox<d>& box) {
   using Index = typename solvers::MacLayout<d>::Index;
   const solvers::MacLayout<d> layout = macLayoutOf(grid);
-  std::vector<double> distance(static_cast<std::size_t>(layout.totalFaces()) * 2 * d, 1.0);
-  if (grid.solid.empty()) return distance;
+  WallGeometry<d> wall;
+  wall.distance.assign(static_cast<std::size_t>(layout.totalFaces()) * 2 * d, 1.0);
+  if (grid.solid.empty()) return wall;
+  if (anyMoves(obstacles)) wall.velocity.assign(wall.distance.size(), solvers::FluidDomain<d>::kNoWallVelocity);
   const auto isFree = [&](int g) { return gridFaceFree(layout, grid, g); };
   const bool cellBoundary = world.settings().fluid.obstacleWall == FluidSolverSettings::ObstacleWall::CellBoundary;
   const auto visit = [&](int g, int a, const Index& f, int b, int dir) {
+    const std::size_t k = solvers::FluidDomain<d>::wallDistanceIndex(g, b, dir > 0);
+    const auto x = layout.faceCenter(a, f);
     if (cellBoundary) {
       // The staircase's wall is the solid cells' boundary: half a cell across the face's control
       // volume (b != a); along the face's own axis the obstacle face lies on that boundary.
-      distance[solvers::FluidDomain<d>::wallDistanceIndex(g, b, dir > 0)] = b == a ? 1.0 : 0.5;
-      return;
+      wall.distance[k] = b == a ? 1.0 : 0.5;
+    } else {
+      Eigen::Matrix<double, d, 1> e = Eigen::Matrix<double, d, 1>::Zero();
+      e[b] = dir;
+      double t = std::numeric_limits<double>::infinity();
+      for (const auto& obstacle : obstacles) t = std::min(t, obstacle.rayEntry(x, e, layout.dx));
+      wall.distance[k] = std::clamp(t / layout.dx, solvers::FluidDomain<d>::kMinWallDistance, 1.0);
     }
-    Eigen::Matrix<double, d, 1> e = Eigen::Matrix<double, d, 1>::Zero();
-    e[b] = dir;
-    const auto x = layout.faceCenter(a, f);
-    double t = std::numeric_limits<double>::infinity();
-    for (const auto& obstacle : obstacles) t = std::min(t, obstacle.rayEntry(x, e, layout.dx));
-    distance[solvers::FluidDomain<d>::wallDistanceIndex(g, b, dir > 0)] =
-        std::clamp(t / layout.dx, solvers::FluidDomain<d>::kMinWallDistance, 1.0);
+    if (wall.velocity.empty()) return;
+    Eigen::Matrix<double, d, 1> point = x;
+    point[b] += dir * wall.distance[k] * layout.dx;
+    const ObstacleGeometry<d>* owner = &obstacles.front();
+    for (const auto& obstacle : obstacles)
+      if (obstacle.signedDistance(point) < owner->signedDistance(point)) owner = &obstacle;
+    wall.velocity[k] = rigidVelocityAt(owner->body(), point)[a];
   };
   forEachPairIntoMarkedFaces(layout, isFree, obstacleFaces(layout, grid, box), visit, &box);
-  return distance;
+  return wall;
 }
 
 }  // namespace
@@ -335,7 +372,7 @@ std::vector<double> obstacleOpenFractions(const World<d>& world, const MacGrid<d
 template <int d>
 std::vector<double> obstacleWallDistances(const World<d>& world, const MacGrid<d>& grid) {
   const ObstacleList<d> obstacles = obstacleList(world);
-  return wallDistances(world, grid, obstacles, obstaclesBox(macLayoutOf(grid), obstacles));
+  return wallGeometry(world, grid, obstacles, obstaclesBox(macLayoutOf(grid), obstacles)).distance;
 }
 
 namespace {
@@ -416,10 +453,13 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
     }
     forEachPairIntoMarkedFaces(layout, isFree, mine, [&](int g, int a, const Index& fi, int b, int dir) {
       const double theta = wallDistance.empty() ? 1.0 : wallDistance[solvers::FluidDomain<d>::wallDistanceIndex(g, b, dir > 0)];
-      // The operator's known value: the obstacle face's prescribed velocity (its centre, one cell away).
+      // The operator's known value: the moving wall's velocity where it is (grid.obstacleWallVelocity),
+      // else the obstacle face's prescribed velocity (its centre, one cell away).
       Eigen::Matrix<double, d, 1> wallPoint = layout.faceCenter(a, fi);
       wallPoint[b] += dir * layout.dx;
-      const double wall = grid.obstacleVelocityAt(wallPoint)[a];
+      const double wall = grid.obstacleWallVelocity.empty()
+                              ? grid.obstacleVelocityAt(wallPoint)[a]
+                              : grid.obstacleWallVelocity[solvers::FluidDomain<d>::wallDistanceIndex(g, b, dir > 0)];
       const double f = viscosity * (grid.u[g] - wall) / (theta * layout.dx) * area;
       result.viscous[a] += f;
       Eigen::Matrix<double, d, 1> onWall = layout.faceCenter(a, fi);
@@ -497,8 +537,14 @@ void RasterizeObstacles<d>::run(World<d>& world, StepContext&) {
       grid.openFraction.clear();
     }
     if (mask != grid.solid) grid.solid = std::move(mask);  // unchanged: keep the projection's cache
-    if (world.settings().fluid.obstacleWallDistances()) grid.obstacleWallDistance = wallDistances(world, grid, obstacles, box);
-    else grid.obstacleWallDistance.clear();
+    if (world.settings().fluid.obstacleWallDistances()) {
+      WallGeometry<d> wall = wallGeometry(world, grid, obstacles, box);
+      grid.obstacleWallDistance = std::move(wall.distance);
+      grid.obstacleWallVelocity = std::move(wall.velocity);
+    } else {
+      grid.obstacleWallDistance.clear();
+      grid.obstacleWallVelocity.clear();
+    }
   }
 }
 

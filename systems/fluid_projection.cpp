@@ -13,6 +13,7 @@ struct FluidProjection<d>::Cache {
   std::vector<std::uint8_t> solid;  // geometry the operators were built for
   std::vector<ObstacleMotion<d>> motions;  // moving obstacles' velocities sit in the operators' RHS terms
   std::vector<double> wallDistance;        // obstacle surfaces seen by the viscous rows
+  std::vector<double> wallVelocity;        // and their velocities
   std::vector<double> openFraction;        // cut faces
   double dt = -1, density = 0, viscosity = -1;
   solvers::PoissonPreconditionerKind kind = solvers::PoissonPreconditionerKind::None;
@@ -59,7 +60,8 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
                                                            : solvers::CoupledPreconditionerKind::BlockDiagonal;
     if (!c.ops || c.dt != ctx.dt || c.density != rho || c.viscosity != mu || c.solid != grid.solid || c.kind != kind ||
         c.cutCorrection != settings.coupledCutCorrection ||
-        c.wallDistance != grid.obstacleWallDistance || c.openFraction != grid.openFraction ||
+        c.wallDistance != grid.obstacleWallDistance || c.wallVelocity != grid.obstacleWallVelocity ||
+        c.openFraction != grid.openFraction ||
         ((grid.obstaclesMove() || !c.motions.empty()) && c.motions != grid.obstacleMotions)) {
       c.ops = std::make_unique<solvers::FluidOperators<d>>(
           solvers::buildFluidOperators(fluidDomainOf(grid), solvers::FluidParameters{rho, mu, ctx.dt}));
@@ -73,6 +75,7 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
       c.viscosity = mu;
       c.solid = grid.solid;
       c.wallDistance = grid.obstacleWallDistance;
+      c.wallVelocity = grid.obstacleWallVelocity;
       c.openFraction = grid.openFraction;
       c.motions = grid.obstaclesMove() ? grid.obstacleMotions : std::vector<ObstacleMotion<d>>{};
       c.kind = kind;

@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <vector>
 
 namespace monolith::solvers {
@@ -80,6 +81,12 @@ struct FluidDomain {
   // The viscous operator reads it for pairs whose other end is a prescribed face (operators.h).
   std::vector<double> wallDistance;
   static constexpr double kMinWallDistance = 0.1;  // bounds the wall term's weight by 1/0.1
+  // Optional, with wallDistance; empty: the wall moves with the prescribed face's velocity. Else,
+  // same layout, the velocity component (along the face's own axis) of the obstacle's surface
+  // at the wall point: a moving body's wall sits theta cells away, not at the next face's centre.
+  // kNoWallVelocity (+inf) where the pair ends on something else (a domain wall, an inflow).
+  std::vector<double> wallVelocity;
+  static constexpr double kNoWallVelocity = std::numeric_limits<double>::infinity();
   // Position in wallDistance of face `face`'s entry along axis b towards side s (0: -e_b, 1: +e_b).
   static std::size_t wallDistanceIndex(int face, int b, int s) {
     return static_cast<std::size_t>(face) * 2 * d + 2 * b + s;

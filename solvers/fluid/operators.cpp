@@ -146,8 +146,8 @@ void buildViscousRows(FluidOperators<d>& ops) {
         }
         auto f0 = f1;
         f0[b] -= 1;
-        const PairEnd e0 = pairEnd<d>(domain, ops.dofs, a, b, f0);
-        const PairEnd e1 = pairEnd<d>(domain, ops.dofs, a, b, f1);
+        PairEnd e0 = pairEnd<d>(domain, ops.dofs, a, b, f0);
+        PairEnd e1 = pairEnd<d>(domain, ops.dofs, a, b, f1);
         if (e0.kind == PairEnd::Drop || e1.kind == PairEnd::Drop) continue;
         if (e0.kind != PairEnd::Unknown && e1.kind != PairEnd::Unknown) continue;
         double c = (e0.ghost || e1.ghost) ? std::sqrt(2.0) * w : w;
@@ -160,8 +160,21 @@ void buildViscousRows(FluidOperators<d>& ops) {
             return domain.wallDistance[FluidDomain<d>::wallDistanceIndex(ops.dofs.velocityToFace[unknown.velocity], b,
                                                                          towardsUpper)];
           };
-          if (e0.kind == PairEnd::Unknown && e1.kind == PairEnd::Known && !e1.ghost) c = w / std::sqrt(theta(e0, 1));
-          if (e1.kind == PairEnd::Unknown && e0.kind == PairEnd::Known && !e0.ghost) c = w / std::sqrt(theta(e1, 0));
+          // A moving wall: its velocity where it is (domain.wallVelocity), not at the face beyond.
+          const auto wallVelocity = [&](const PairEnd& unknown, int towardsUpper, double faceValue) {
+            if (domain.wallVelocity.empty()) return faceValue;
+            const double v = domain.wallVelocity[FluidDomain<d>::wallDistanceIndex(ops.dofs.velocityToFace[unknown.velocity],
+                                                                                 b, towardsUpper)];
+            return v == FluidDomain<d>::kNoWallVelocity ? faceValue : v;
+          };
+          if (e0.kind == PairEnd::Unknown && e1.kind == PairEnd::Known && !e1.ghost) {
+            c = w / std::sqrt(theta(e0, 1));
+            e1.value = wallVelocity(e0, 1, e1.value);
+          }
+          if (e1.kind == PairEnd::Unknown && e0.kind == PairEnd::Known && !e0.ghost) {
+            c = w / std::sqrt(theta(e1, 0));
+            e0.value = wallVelocity(e1, 0, e0.value);
+          }
         }
         ViscousRow row;
         double h = 0;
@@ -198,6 +211,7 @@ FluidOperators<d> buildFluidOperators(const FluidDomain<d>& domain, const FluidP
       static_cast<int>(domain.faces.size()) != layout.totalFaces() ||
       static_cast<int>(domain.faceVelocity.size()) != layout.totalFaces() ||
       !(domain.wallDistance.empty() || domain.wallDistance.size() == static_cast<std::size_t>(layout.totalFaces()) * 2 * d) ||
+      !(domain.wallVelocity.empty() || domain.wallVelocity.size() == domain.wallDistance.size()) ||
       !(domain.openFraction.empty() || static_cast<int>(domain.openFraction.size()) == layout.totalFaces()))
     throw std::invalid_argument("buildFluidOperators: domain arrays do not match its layout");
   FluidOperators<d> ops;
