@@ -303,7 +303,7 @@ Eigen::Matrix<double, d, 1> rigidVelocityAt(const RigidBody<d>& body, const Eige
 template <int d>
 bool anyMoves(const ObstacleList<d>& obstacles) {
   for (const auto& obstacle : obstacles)
-    if (rigidVelocityAt(obstacle.body(), obstacle.body().x).squaredNorm() > 0 || (!obstacle.body().isStatic && obstacle.body().omega().squaredNorm() > 0))
+    if (!obstacle.body().isStatic && (obstacle.body().v.squaredNorm() > 0 || obstacle.body().omega().squaredNorm() > 0))
       return true;
   return false;
 }
@@ -494,14 +494,19 @@ bool RasterizeObstacles<d>::needed(const World<d>& w) const {
 template <int d>
 std::vector<ObstacleMotion<d>> obstacleMotions(const World<d>& world) {
   std::vector<ObstacleMotion<d>> motions;
-  forEachObstacle(world, [&](Entity, const ObstacleGeometry<d>& obstacle) {
+  forEachObstacle(world, [&](Entity e, const ObstacleGeometry<d>& obstacle) {
     const RigidBody<d>& body = obstacle.body();
     ObstacleMotion<d> m;
     m.centre = body.x;
     m.reach = obstacle.boundingRadius();
     if constexpr (d == 3) m.orientation = body.orientation.coeffs();
     else m.orientation[0] = body.orientation;
-    m.signedDistance = [obstacle](const Vec<d>& x) { return obstacle.signedDistance(x); };
+    // Looked up again at every call: the motions outlive this step (a CFL step size is taken
+    // from them before the next rasterization), and the components may have moved in memory.
+    m.signedDistance = [&world, e](const Vec<d>& x) {
+      std::optional<ObstacleGeometry<d>> geometry;
+      return obstacleGeometryOf(world, e, geometry) ? geometry->signedDistance(x) : std::numeric_limits<double>::infinity();
+    };
     if (!body.isStatic) {
       m.velocity = body.v;
       const AngularVec<d> w = body.omega();
