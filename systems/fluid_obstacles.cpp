@@ -291,27 +291,11 @@ std::vector<std::uint8_t> obstacleFaces(const solvers::MacLayout<d>& layout, con
   return marked;
 }
 
-// The rigid velocity of the body at x.
-template <int d>
-Eigen::Matrix<double, d, 1> rigidVelocityAt(const RigidBody<d>& body, const Eigen::Matrix<double, d, 1>& x) {
-  if (body.isStatic) return Eigen::Matrix<double, d, 1>::Zero();
-  const Eigen::Matrix<double, d, 1> r = x - body.x;
-  if constexpr (d == 3) return body.v + body.omega().cross(r);
-  else return body.v + body.omega()(0) * Eigen::Vector2d(-r.y(), r.x());
-}
-
-template <int d>
-bool anyMoves(const ObstacleList<d>& obstacles) {
-  for (const auto& obstacle : obstacles)
-    if (!obstacle.body().isStatic && (obstacle.body().v.squaredNorm() > 0 || obstacle.body().omega().squaredNorm() > 0))
-      return true;
-  return false;
-}
-
 // Per free face and direction into an obstacle face: the distance in cells to the wall
 // (FluidDomain::wallDistance) and, when some obstacle moves, the wall's velocity component along
 // the face's axis at that wall point, from the obstacle of smallest signed distance there
-// (FluidDomain::wallVelocity, kNoWallVelocity for the pairs that end elsewhere; empty otherwise).
+// (grid.obstacleVelocityAt, from the motions of this step; FluidDomain::wallVelocity,
+// kNoWallVelocity for the pairs that end elsewhere; empty otherwise).
 template <int d>
 struct WallGeometry {
   std::vector<double> distance, velocity;
@@ -325,7 +309,7 @@ WallGeometry<d> wallGeometry(const World<d>& world, const MacGrid<d>& grid, cons
   WallGeometry<d> wall;
   wall.distance.assign(static_cast<std::size_t>(layout.totalFaces()) * 2 * d, 1.0);
   if (grid.solid.empty()) return wall;
-  if (anyMoves(obstacles)) wall.velocity.assign(wall.distance.size(), solvers::FluidDomain<d>::kNoWallVelocity);
+  if (grid.obstaclesMove()) wall.velocity.assign(wall.distance.size(), solvers::FluidDomain<d>::kNoWallVelocity);
   const auto isFree = [&](int g) { return gridFaceFree(layout, grid, g); };
   const bool cellBoundary = world.settings().fluid.obstacleWall == FluidSolverSettings::ObstacleWall::CellBoundary;
   const auto visit = [&](int g, int a, const Index& f, int b, int dir) {
@@ -345,10 +329,7 @@ WallGeometry<d> wallGeometry(const World<d>& world, const MacGrid<d>& grid, cons
     if (wall.velocity.empty()) return;
     Eigen::Matrix<double, d, 1> point = x;
     point[b] += dir * wall.distance[k] * layout.dx;
-    const ObstacleGeometry<d>* owner = &obstacles.front();
-    for (const auto& obstacle : obstacles)
-      if (obstacle.signedDistance(point) < owner->signedDistance(point)) owner = &obstacle;
-    wall.velocity[k] = rigidVelocityAt(owner->body(), point)[a];
+    wall.velocity[k] = grid.obstacleVelocityAt(point)[a];
   };
   forEachPairIntoMarkedFaces(layout, isFree, obstacleFaces(layout, grid, box), visit, &box);
   return wall;
