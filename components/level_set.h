@@ -41,6 +41,11 @@ struct LevelSet {
     for (int a = 0; a < d; ++a) k += i[a] * stride, stride *= samples[a];
     return k;
   }
+  Index sampleCoord(int k) const {  // inverse of sampleIndex
+    Index i;
+    for (int a = 0; a < d; ++a) i[a] = k % samples[a], k /= samples[a];
+    return i;
+  }
   VecD node(const Index& i) const { return origin + spacing * i.template cast<double>(); }
 
   // phi at a body-frame point.
@@ -76,8 +81,7 @@ struct LevelSet {
     double axisSlope = 0;
     reach = 0;
     for (int k = 0; k < static_cast<int>(values.size()); ++k) {
-      Index i;
-      for (int a = 0, rest = k; a < d; ++a) i[a] = rest % samples[a], rest /= samples[a];
+      const Index i = sampleCoord(k);
       for (int a = 0; a < d; ++a) {
         if (i[a] + 1 >= samples[a]) continue;
         Index j = i;

@@ -22,14 +22,6 @@ constexpr double kMaxMeshWork = 2e10;
 // samples lie at least that far outside the body).
 constexpr int kMargin = 2;
 
-template <int d>
-std::string sampleName(const LevelSet<d>& ls, int k) {
-  std::string name = "[";
-  for (int a = 0; a < d; ++a, k /= ls.samples[a - 1])
-    name += (a ? ", " : "") + std::to_string(k % ls.samples[a]);
-  return name + "]";
-}
-
 // The checks every level set passes, whatever its source: a body (some sample <= 0) that lies
 // inside the sampled box (every boundary sample > 0), so that phi outside the box is positive.
 template <int d>
@@ -38,13 +30,13 @@ void checkEnclosed(const Config& c, const std::string& key, const LevelSet<d>& l
   for (int k = 0; k < static_cast<int>(ls.values.size()); ++k) {
     const double v = ls.values[k];
     anyInside |= v <= 0;
-    int rest = k;
-    bool boundary = false;
-    for (int a = 0; a < d; ++a, rest /= ls.samples[a - 1])
-      boundary |= rest % ls.samples[a] == 0 || rest % ls.samples[a] == ls.samples[a] - 1;
+    const auto i = ls.sampleCoord(k);
+    const bool boundary = (i.array() == 0).any() || (i.array() == ls.samples.array() - 1).any();
     if (boundary && v <= 0) {
       std::ostringstream got;
-      got << "sample " << sampleName(ls, k) << " = " << v;
+      got << "sample [";
+      for (int a = 0; a < d; ++a) got << (a ? ", " : "") << i[a];
+      got << "] = " << v;
       c.failAt(key, "every sample on the sampled box's boundary > 0 (the body must lie inside the box)", got.str());
     }
   }
@@ -121,11 +113,7 @@ LevelSet<d> fromField(const solvers::SampledField<d>& field, double spacing) {
 
 template <int d>
 double latticeSize(const std::vector<Eigen::Matrix<double, d, 1>>& points, double spacing) {
-  Eigen::Matrix<double, d, 1> lo = points[0], hi = points[0];
-  for (const auto& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  double total = 1;
-  for (int a = 0; a < d; ++a) total *= std::ceil((hi[a] - lo[a]) / spacing) + 2 * kMargin + 1;
-  return total;
+  return solvers::latticeAround<d>(points, spacing, kMargin).sampleCount();
 }
 
 // {"polygon": [[x, y], ...], "spacing"} (2-D) or {"mesh": "file.obj", "scale", "spacing"} (3-D).

@@ -16,8 +16,7 @@ SampledField<d> latticeAround(const std::vector<Eigen::Matrix<double, d, 1>>& po
   SampledField<d> field;
   field.origin = lo - Vec::Constant(margin * spacing);
   for (int a = 0; a < d; ++a)
-    field.samples[a] = static_cast<int>(std::ceil((hi[a] - lo[a]) / spacing)) + 2 * margin + 1;
-  field.values.assign(static_cast<std::size_t>(field.samples.prod()), 0.0);
+    field.samples[a] = static_cast<int>(std::min(std::ceil((hi[a] - lo[a]) / spacing) + 2 * margin + 1, double(1 << 30)));
   return field;
 }
 
@@ -49,6 +48,7 @@ double solidAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eige
 
 SampledField<2> polygonDistance(const std::vector<Eigen::Vector2d>& vertices, double spacing, int margin) {
   SampledField<2> field = latticeAround<2>(vertices, spacing, margin);
+  field.values.assign(static_cast<std::size_t>(field.sampleCount()), 0.0);
   const std::size_t n = vertices.size();
   forEachSample<2>(field, spacing, [&](std::size_t k, const Eigen::Vector2d& x) {
     double nearest = std::numeric_limits<double>::infinity();
@@ -70,6 +70,7 @@ SampledField<2> polygonDistance(const std::vector<Eigen::Vector2d>& vertices, do
 SampledField<3> meshDistance(const std::vector<Eigen::Vector3d>& vertices, const std::vector<int>& triangles,
                              double spacing, int margin) {
   SampledField<3> field = latticeAround<3>(vertices, spacing, margin);
+  field.values.assign(static_cast<std::size_t>(field.sampleCount()), 0.0);
   forEachSample<3>(field, spacing, [&](std::size_t k, const Eigen::Vector3d& x) {
     double nearest = std::numeric_limits<double>::infinity(), angle = 0;
     for (std::size_t t = 0; t + 2 < triangles.size(); t += 3) {

@@ -13,9 +13,11 @@ struct SampledField {
   Eigen::Matrix<double, d, 1> origin;  // position of sample 0
   Eigen::Matrix<int, d, 1> samples;    // per axis
   std::vector<double> values;          // x fastest
+  double sampleCount() const { return samples.template cast<double>().prod(); }
 };
 
-// Samples on the lattice origin + i * spacing that covers the points' box plus `margin` samples.
+// The lattice origin + i * spacing that covers the points' box plus `margin` samples (values
+// not yet allocated: callers check sampleCount() first; counts beyond 2^30 per axis are capped).
 template <int d>
 SampledField<d> latticeAround(const std::vector<Eigen::Matrix<double, d, 1>>& points, double spacing, int margin);
 

@@ -631,11 +631,7 @@ LevelSet<d> sampled(const Eigen::Matrix<double, d, 1>& lo, double spacing, int s
   ls.spacing = spacing;
   ls.samples.setConstant(samples);
   ls.values.resize(static_cast<std::size_t>(ls.samples.prod()));
-  for (std::size_t k = 0; k < ls.values.size(); ++k) {
-    Eigen::Matrix<int, d, 1> i;
-    for (int a = 0, rest = static_cast<int>(k); a < d; ++a) i[a] = rest % samples, rest /= samples;
-    ls.values[k] = phi(ls.node(i));
-  }
+  for (std::size_t k = 0; k < ls.values.size(); ++k) ls.values[k] = phi(ls.node(ls.sampleCoord(static_cast<int>(k))));
   ls.refresh();
   return ls;
 }
