@@ -72,7 +72,7 @@ struct ContactSettings {
   int contactLevelIterations = 2;    // per level and sweep
   int contactPairIterations = 10;    // Gauss-Seidel sweeps of one pair's manifold solve (measured)
   bool shockPropagation = true;      // GBF 2003 shock propagation after contact
-  int shockLevelIterations = 8;      // thesis code: 2; see docs/architecture.md
+  int shockLevelIterations = 2;      // the thesis code's (8 were needed before projectFriction)
   int shockPairIterations = 10;
   bool pushOut = true;               // interpenetration resolution, Sec. 4.6.1 / App. B
   int pushOutLevelIterations = 2;

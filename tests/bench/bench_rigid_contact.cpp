@@ -9,7 +9,8 @@
 //    deepest overlap, final kinetic energy, 1T == 2T.
 //
 // usage: bench_rigid_contact [pyramid|pour|mixed|all, default all] [seconds] [pyramid scene, e.g. pyramid_20]
-//                            [key=value scene overrides for the pyramids, e.g. solvers.contact.contact_iterations=4]
+//                            [key=value scene overrides for the pyramids, e.g. solvers.contact.contact_iterations=4;
+//                             frames=30 or frames=60: only that step size; threads=N: only N threads]
 //   seconds: simulated time per run; pour default 1.0, pyramids default the scenes' 10 s (a
 //   shorter run is for quick comparisons while profiling; report the 10 s numbers).
 #include <chrono>
@@ -81,12 +82,18 @@ const char* sameText(int threads, const TimedRun& run, const TimedRun& oneThread
   return threads == 1 ? "-" : (bitwiseSame(run.end, oneThread.end) ? "yes" : "NO");
 }
 
-void pyramids(const Registry& registry, double seconds, const std::string& only, const std::vector<Override>& extra) {
+struct PyramidChoice {
+  std::vector<double> dts{1.0 / 30, 1.0 / 60};
+  std::vector<int> threads{1, 2};
+};
+
+void pyramids(const Registry& registry, double seconds, const std::string& only, const std::vector<Override>& extra,
+              const PyramidChoice& choice) {
   std::printf("| scene | boxes | dt | steps | threads | us/step | speed-up | max drift | final KE | max penetration / size | 1T == 2T |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const char* name : {"pyramid_10", "pyramid_20"}) {
     if (!only.empty() && only != name) continue;
-    for (double dt : {1.0 / 30, 1.0 / 60}) {
+    for (double dt : choice.dts) {
       char dtText[64];
       std::snprintf(dtText, sizeof dtText, "%.17g", dt);
       char end[64];
@@ -96,9 +103,9 @@ void pyramids(const Registry& registry, double seconds, const std::string& only,
       if (seconds > 0) overrides.push_back({"time.end", end});
       const SceneSpec scene = loadScene(kScenes + name + ".json", overrides);
       TimedRun oneThread;
-      for (int threads : {1, 2}) {
+      for (int threads : choice.threads) {
         const TimedRun run = runTimed(scene, registry, threads);
-        if (threads == 1) oneThread = run;
+        if (threads == choice.threads.front()) oneThread = run;
         const DynamicSummary d = summarize(run);
         std::printf("| %s | %d | 1/%.0f | %ld | %d | %.1f | %.2f | %.2e | %.2e | %.2e | %s |\n", name, d.count, 1 / dt,
                     run.steps, threads, 1e6 * run.wall / run.steps, oneThread.wall / run.wall, d.drift, d.kineticEnergy,
@@ -161,6 +168,7 @@ int main(int argc, char** argv) {
   Registry registry;
   registerBuiltins(registry);
   std::vector<Override> extra;
+  PyramidChoice choice;
   for (int i = 4; i < argc; ++i) {
     const std::string arg = argv[i];
     const auto eq = arg.find('=');
@@ -168,9 +176,13 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "expected key=value, got %s\n", argv[i]);
       return 2;
     }
-    extra.push_back({arg.substr(0, eq), arg.substr(eq + 1)});
+    const std::string key = arg.substr(0, eq), value = arg.substr(eq + 1);
+    // Not scene overrides: which steps per second (frames=30 or 60) and thread counts to run.
+    if (key == "frames") choice.dts = {1.0 / std::atof(value.c_str())};
+    else if (key == "threads") choice.threads = {std::atoi(value.c_str())};
+    else extra.push_back({key, value});
   }
-  if (what == "pyramid" || what == "all") pyramids(registry, seconds, argc > 3 ? argv[3] : "", extra);
+  if (what == "pyramid" || what == "all") pyramids(registry, seconds, argc > 3 ? argv[3] : "", extra, choice);
   if (what == "pour" || what == "all") pour(registry, seconds > 0 ? seconds : 1.0);
   if (what == "mixed" || what == "all") mixedPile(registry);
   return 0;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "solvers/contact/manifold_pgs.h"
@@ -14,6 +15,8 @@ namespace {
 using namespace monolith::solvers::contact;
 using V3 = Eigen::Vector3d;
 using M3 = Eigen::Matrix3d;
+using V2 = Eigen::Vector2d;
+using M2 = Eigen::Matrix2d;
 
 // A unit cube (mass 1, inertia I/6) with its bottom face at y = yBottom: its four corners as
 // points with normal +y, lever arm from the cube's centre, target normal velocity 0 where they
@@ -155,18 +158,100 @@ TEST(ManifoldPgs, TwoMovingBodiesKeepTheirTotalMomentum) {
   expectConeAndComplementarity(points, s, 1e-10);
 }
 
-TEST(ManifoldPgs, TenSweepsTheDefaultLeaveATenThousandthOfTheLandingSpeed) {
+TEST(ManifoldPgs, TenSweepsTheDefaultLeaveAFewTenThousandthsOfTheLandingSpeed) {
   // The contact stages stop a manifold solve after 10 sweeps (contact_pair_iterations, measured
   // in docs/architecture.md), not at convergence. Projected Gauss-Seidel converges linearly
-  // here; after 10 sweeps a flat landing at 1 m/s has 1.1e-4 m/s left at its worst corner and
-  // after 20 about 2e-8 (measured), so the bounds below catch a slower sweep.
+  // here; after 10 sweeps a flat landing at 1 m/s has 2.9e-4 m/s left at its worst corner and
+  // after 20 about 1.2e-7 (measured; 1.1e-4 and 2e-8 with the friction rule before
+  // projectFriction), so the bounds below catch a slower sweep.
   auto worstCorner = [](int sweeps) {
     const SolvedCube r(V3(0, -1, 0), V3::Zero(), 0.5, sweeps, 0.0);
     double worst = 0;
     for (const auto& p : r.cube.points) worst = std::max(worst, std::abs((r.s.va + r.s.wa.cross(p.ra)).dot(p.n)));
     return worst;
   };
-  EXPECT_LT(worstCorner(10), 2e-4);
-  EXPECT_LT(worstCorner(20), 1e-7);
+  EXPECT_LT(worstCorner(10), 4e-4);
+  EXPECT_LT(worstCorner(20), 2e-7);
   EXPECT_GT(worstCorner(1), 1e-2);  // one sweep is far from it: the bound above is not vacuous
+}
+
+namespace {
+// The slip energy (f' - f)^T Ktt (f' - f) of the friction impulse f' for the sticking impulse f.
+double slipEnergy(const M2& Ktt, const V2& fPrime, const V2& f) { return (fPrime - f).dot(Ktt * (fPrime - f)); }
+}  // namespace
+
+TEST(ProjectFriction, IsTheDiskPointOfLeastSlipEnergyAndOpposesTheSlipItLeaves) {
+  // Random contact points (lever arms up to 1, random inertias and normals, one or two moving
+  // bodies) and sticking impulses outside disks of random size: the projection lies on the rim,
+  // its slip energy is the least over the rim (a scan of 20000 angles refined by golden-section
+  // search: projectFriction must not be worse by more than 1e-9 relative), and the slip it leaves,
+  // Ktt (f' - f), points against f' (Coulomb's maximal dissipation; to 1e-6 in the sine of the
+  // angle: the Newton iteration stops once the radius is right to 1e-7).
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int anisotropic = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    PgsPoint<3> p;
+    p.n = V3(u(rng), u(rng), u(rng)).normalized();
+    p.ra = V3(u(rng), u(rng), u(rng));
+    p.rb = V3(u(rng), u(rng), u(rng));
+    M3 A = M3::Random(), B = M3::Random();
+    const M3 Ia = A * A.transpose() + 0.1 * M3::Identity();
+    const M3 Ib = trial % 2 ? M3(B * B.transpose() + 0.1 * M3::Identity()) : M3::Zero();
+    p.prepare(trial % 2 ? 2.0 : 1.0, Ia, Ib, false);
+    const M2 Ktt = p.tangentMass.inverse();
+    if (Ktt(0, 0) + Ktt(1, 1) > 0 && std::abs(p.tangentStiffness[0] - p.tangentStiffness[1]) >
+                                         0.3 * (p.tangentStiffness[0] + p.tangentStiffness[1]))
+      ++anisotropic;
+    // The eigen-decomposition the projection works in reproduces Ktt.
+    M2 Q;
+    Q << p.eigenCos, -p.eigenSin, p.eigenSin, p.eigenCos;
+    const M2 D = V2(p.tangentStiffness[0], p.tangentStiffness[1]).asDiagonal();
+    EXPECT_LT((Q * D * Q.transpose() - Ktt).norm(), 1e-12 * Ktt.norm());
+
+    const V2 f(u(rng), u(rng));
+    const double limit = f.norm() * (0.01 + 0.98 * (0.5 + 0.5 * u(rng)));
+    double out[2] = {f.x(), f.y()};
+    projectFriction<3>(p, out, limit);
+    const V2 fp(out[0], out[1]);
+    EXPECT_NEAR(fp.norm(), limit, 1e-12 * limit);
+
+    auto energyAt = [&](double angle) { return slipEnergy(Ktt, limit * V2(std::cos(angle), std::sin(angle)), f); };
+    double best = 0, bestEnergy = energyAt(0);
+    const int n = 20000;
+    for (int k = 1; k < n; ++k) {
+      const double angle = 2 * M_PI * k / n;
+      if (energyAt(angle) < bestEnergy) best = angle, bestEnergy = energyAt(angle);
+    }
+    double lo = best - 2 * M_PI / n, hi = best + 2 * M_PI / n;
+    for (int it = 0; it < 100; ++it) {
+      const double m1 = lo + 0.382 * (hi - lo), m2 = hi - 0.382 * (hi - lo);
+      (energyAt(m1) < energyAt(m2) ? hi : lo) = energyAt(m1) < energyAt(m2) ? m2 : m1;
+    }
+    bestEnergy = std::min(bestEnergy, energyAt(0.5 * (lo + hi)));
+    EXPECT_LE(slipEnergy(Ktt, fp, f), bestEnergy * (1 + 1e-9) + 1e-15) << "trial " << trial;
+
+    const V2 slip = Ktt * (fp - f);
+    EXPECT_LT(slip.dot(fp), 0.0);
+    EXPECT_NEAR(slip.x() * fp.y() - slip.y() * fp.x(), 0.0, 1e-6 * slip.norm() * fp.norm()) << "trial " << trial;
+  }
+  EXPECT_GT(anisotropic, 50);  // the cases are not all nearly isotropic, where any rule would do
+}
+
+TEST(ProjectFriction, ClampsIn2DAndVanishesWithoutLoad) {
+  PgsPoint<2> p;
+  p.n = Eigen::Vector2d(0, 1);
+  p.ra = Eigen::Vector2d(0.3, -0.5);
+  p.prepare(1.0, Eigen::Matrix<double, 1, 1>(6.0), Eigen::Matrix<double, 1, 1>::Zero(), false);
+  double f[1] = {-2.0};
+  projectFriction<2>(p, f, 0.5);
+  EXPECT_EQ(f[0], -0.5);
+  double g[2] = {1.0, -3.0};
+  PgsPoint<3> q;
+  q.n = V3::UnitY();
+  q.ra = V3(0.5, -0.5, 0.5);
+  q.prepare(1.0, 6.0 * M3::Identity(), M3::Zero(), false);
+  projectFriction<3>(q, g, 0.0);
+  EXPECT_EQ(g[0], 0.0);
+  EXPECT_EQ(g[1], 0.0);
 }
