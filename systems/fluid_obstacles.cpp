@@ -449,7 +449,8 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
       // The rows are the vector Laplacian's, mu du/dn: on a wall spinning at w that traction
       // differs from the stress mu (grad u + grad u^T) n by mu (w x n), which sums to no force
       // over a closed surface but to a torque -2 mu V w (V the body's volume; rotating Couette
-      // flow: test LevelSets.CouetteTorqueOnTheSpinningAndTheStillCylinder). So the torque adds
+      // flow: tests LevelSets.CouetteTorqueOnTheSpinningAndTheStillCylinder, and in 3-D
+      // LevelSets.SphericalCouetteTorqueOnTheSpinningSphereAndTheStillShell). So the torque adds
       // that part of every tangential row, n = -dir e_b pointing out of the body.
       if (b != a && spin.squaredNorm() > 0) {
         Eigen::Vector3d n = Eigen::Vector3d::Zero();
