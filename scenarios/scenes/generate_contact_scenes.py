@@ -4,7 +4,7 @@
     python3 scenarios/scenes/generate_contact_scenes.py [output_dir] [--pour N ...]
 
 pyramid_10/20: boxes of edge 1 in layers of n, n-1, ..., 1 with horizontal spacing 1.02, mu 0.5,
-resting on a plane, one step per frame (dt = 1/30). sliver_shards: thin boxes dropped with spin at
+resting on a plane, one step per frame (dt = 1/30); pyramid_2d_10 the same in 2-D. sliver_shards: thin boxes dropped with spin at
 frame rate (the energy-clamp comparison of Sec. 2.3). box_stack_scatter: Fig. 2.2, boxes dropped
 into a stack, then a large box scatters it. pour_spheres_N: N spheres poured into a box.
 mixed_pile: boxes, spheres, capsules, cylinders and convex octahedra dropped into a walled box.
@@ -30,10 +30,10 @@ def ground(friction=0.5, restitution=0.0):
                 restitution=restitution)
 
 
-def write(directory, name, description, dt, end, entities, frame_rate=30, solvers=None):
-    scene = {"description": description, "dimension": 3,
+def write(directory, name, description, dt, end, entities, frame_rate=30, solvers=None, dimension=3):
+    scene = {"description": description, "dimension": dimension,
              "time": {"dt": dt, "end": end, "frame_rate": frame_rate},
-             "gravity": [0, -9.81, 0], "entities": entities}
+             "gravity": [0, -9.81, 0][:dimension], "entities": entities}
     if solvers:
         scene["solvers"] = solvers
     entities = scene.pop("entities")
@@ -56,6 +56,19 @@ def pyramid(directory, layers):
     write(directory, "pyramid_%d" % layers,
           "pyramid of %d boxes in %d layers at one step per frame" % (len(entities) - 1, layers),
           1 / 30, 10.0, entities)
+
+
+def pyramid_2d(directory, layers):
+    entities = [body("ground", {"type": "plane", "normal": [0, 1]}, static=True, position=(0, 0))]
+    for k in range(layers):
+        n = layers - k
+        for i in range(n):
+            x = (i - (n - 1) / 2) * 1.02
+            entities.append(body("box_%d_%d" % (k, i), {"type": "box", "half_extents": [0.5, 0.5]},
+                                 position=(x, 0.5 + k)))
+    write(directory, "pyramid_2d_%d" % layers,
+          "2-D pyramid of %d boxes in %d layers at one step per frame" % (len(entities) - 1, layers),
+          1 / 30, 10.0, entities, dimension=2)
 
 
 def sliver_shards(directory):
@@ -160,6 +173,7 @@ def main(argv):
         return
     pyramid(directory, 10)
     pyramid(directory, 20)
+    pyramid_2d(directory, 10)
     sliver_shards(directory)
     box_stack_scatter(directory)
     pour_spheres(directory, 250)

@@ -210,23 +210,46 @@ TEST(Elevator, BoxRidesTheKinematicPlatform) {
   EXPECT_NEAR(positionOf(sim, "platform").y(), 2.5, 1e-9);
 }
 
-TEST(Pyramid, TenLayersStandAtOneStepPerFrame) {
+namespace {
+
+// Runs a pyramid scene to its end: every box within 0.05 of its start, kinetic energy < 1e-3,
+// no energy gain (issue 3).
+template <int d>
+void expectPyramidStands(const std::string& sceneName, double keBound = 1e-3, double riseBound = -1) {
   const Registry registry = builtins();
-  Simulation<3> sim(loadScene(kScenes + "pyramid_10.json"), registry);
+  Simulation<d> sim(loadScene(kScenes + sceneName), registry);
   ASSERT_NEAR(sim.scene().dt, 1.0 / 30, 1e-15);
-  std::vector<Eigen::Vector3d> start;
-  for (const auto& b : sim.world().pool<RigidBody<3>>().components()) start.push_back(b.x);
+  std::vector<Eigen::Matrix<double, d, 1>> start;
+  for (const auto& b : sim.world().template pool<RigidBody<d>>().components()) start.push_back(b.x);
   EnergyWatch watch;
   while (!sim.finished()) watch.observe(sim.step());
   double drift = 0, ke = 0;
-  const auto& bodies = sim.world().pool<RigidBody<3>>().components();
+  const auto& bodies = sim.world().template pool<RigidBody<d>>().components();
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     drift = std::max(drift, (bodies[i].x - start[i]).norm());
     ke += bodies[i].translationalKineticEnergy() + bodies[i].rotationalKineticEnergy();
   }
+  std::printf("%s: max drift %.2e, final KE %.2e\n", sceneName.c_str(), drift, ke);
   EXPECT_LT(drift, 0.05);
-  EXPECT_LT(ke, 1e-3);
+  EXPECT_LT(ke, keBound);
   watch.expectNoGain(std::abs(watch.initialTotal));
+  if (riseBound >= 0) {
+    EXPECT_LT(watch.worstRise, riseBound);
+  }
+}
+
+}  // namespace
+
+TEST(Pyramid, TenLayersStandAtOneStepPerFrame) { expectPyramidStands<3>("pyramid_10.json"); }
+
+TEST(Pyramid, TenLayersStandAtOneStepPerFrameIn2D) {
+  // Two points per box pair, one friction direction: the shock propagation's joint solves of a
+  // box against the two below converge more slowly than in 3-D. With their 10 sweeps (the
+  // default before 2026-11-26) and 2 level passes this pyramid kept 5.9e-5 J of kinetic energy
+  // and its total energy rose steadily, 0.70 J over the 10 s (20 layers: 8e-3 J and 11 J), inside
+  // the issue's bounds but far from rest; with 40 sweeps 4e-12 J and 2.2e-4 J (measured). The
+  // tighter bounds below tell the two apart.
+  expectPyramidStands<2>("pyramid_2d_10.json", 1e-8, 0.01);
 }
 
 TEST(BoxStackScatter, PenetrationStaysBelowOnePercentOfTheSmallerBody) {
