@@ -179,22 +179,30 @@ inline void projectFriction(const PgsPoint<d>& p, double* f, double limit) {
   } else {
     const double c = p.eigenCos, s = p.eigenSin;
     const double k0 = p.tangentStiffness[0], k1 = p.tangentStiffness[1];
-    // Ktt f in Ktt's eigenbasis; f' there is (a0 / (k0 + g), a1 / (k1 + g)).
-    const double a0 = k0 * (c * f[0] + s * f[1]), a1 = k1 * (-s * f[0] + c * f[1]);
+    // Worked on f / |f| with the disk's radius rho = limit / |f| < 1, so that neither a tiny
+    // load nor a tiny f under- or overflows: Ktt f / |f| in Ktt's eigenbasis, (a0, a1); f' there
+    // is |f| (a0 / (k0 + g), a1 / (k1 + g)).
+    const double inverseSize = 1 / std::sqrt(f[0] * f[0] + f[1] * f[1]), rho = limit * inverseSize;
+    const double x0 = (c * f[0] + s * f[1]) * inverseSize, x1 = (-s * f[0] + c * f[1]) * inverseSize;
+    const double a0 = k0 * x0, a1 = k1 * x1;
     // Start at the root for an isotropic Ktt of the a-weighted mean stiffness.
     const double w0 = std::abs(a0), w1 = std::abs(a1);
     const double mean = (k0 * w0 + k1 * w1) / (w0 + w1);
-    double g = std::max(0.0, std::sqrt(a0 * a0 + a1 * a1) / limit - mean);
-    for (int it = 0; it < 16; ++it) {
-      const double e0 = 1 / (k0 + g), e1 = 1 / (k1 + g);
-      const double n2 = a0 * a0 * e0 * e0 + a1 * a1 * e1 * e1;
-      const double norm = std::sqrt(n2);
-      const double psi = 1 / norm - 1 / limit;
-      if (std::abs(psi) * limit <= 1e-7) break;
-      const double dpsi = (a0 * a0 * e0 * e0 * e0 + a1 * a1 * e1 * e1 * e1) / (n2 * norm);
-      g = std::max(0.0, g - psi / dpsi);
+    double g = std::max(0.0, std::sqrt(a0 * a0 + a1 * a1) / rho - mean);
+    double h0 = a0, h1 = a1;  // g >> Ktt (a disk far smaller than f): f' is along Ktt f
+    if (g < 1e8 * (k0 + k1)) {
+      for (int it = 0; it < 16; ++it) {
+        const double e0 = 1 / (k0 + g), e1 = 1 / (k1 + g);
+        const double n2 = a0 * a0 * e0 * e0 + a1 * a1 * e1 * e1;
+        const double norm = std::sqrt(n2);
+        const double psi = 1 / norm - 1 / rho;
+        if (std::abs(psi) * rho <= 1e-7) break;
+        const double dpsi = (a0 * a0 * e0 * e0 * e0 + a1 * a1 * e1 * e1 * e1) / (n2 * norm);
+        g = std::max(0.0, g - psi / dpsi);
+      }
+      h0 = a0 / (k0 + g);
+      h1 = a1 / (k1 + g);
     }
-    double h0 = a0 / (k0 + g), h1 = a1 / (k1 + g);
     const double rim = limit / std::sqrt(h0 * h0 + h1 * h1);  // exactly on the disk's rim
     h0 *= rim;
     h1 *= rim;

@@ -109,7 +109,7 @@ void pyramids(const Registry& registry, double seconds, const std::string& only,
         const DynamicSummary d = summarize(run);
         std::printf("| %s | %d | 1/%.0f | %ld | %d | %.1f | %.2f | %.2e | %.2e | %.2e | %s |\n", name, d.count, 1 / dt,
                     run.steps, threads, 1e6 * run.wall / run.steps, oneThread.wall / run.wall, d.drift, d.kineticEnergy,
-                    run.penetration, sameText(threads, run, oneThread));
+                    run.penetration, choice.threads.front() == 1 ? sameText(threads, run, oneThread) : "-");
         std::fflush(stdout);
       }
     }

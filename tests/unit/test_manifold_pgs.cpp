@@ -255,3 +255,18 @@ TEST(ProjectFriction, ClampsIn2DAndVanishesWithoutLoad) {
   EXPECT_EQ(g[0], 0.0);
   EXPECT_EQ(g[1], 0.0);
 }
+
+TEST(ProjectFriction, StaysFiniteOnADiskOfVanishingRadius) {
+  // A load of the order of the smallest doubles (a normal impulse that has all but vanished):
+  // the Newton start |Ktt f| / limit overflows; the result must still lie on the rim.
+  PgsPoint<3> q;
+  q.n = V3::UnitY();
+  q.ra = V3(0.5, -0.5, 0.5);
+  q.prepare(1.0, 6.0 * M3::Identity(), M3::Zero(), false);
+  for (const double limit : {1e-310, 1e-200, 1e-20}) {
+    double f[2] = {3.0, -4.0};
+    projectFriction<3>(q, f, limit);
+    EXPECT_TRUE(std::isfinite(f[0]) && std::isfinite(f[1])) << limit;
+    EXPECT_NEAR(std::hypot(f[0], f[1]), limit, 1e-9 * limit) << limit;
+  }
+}
