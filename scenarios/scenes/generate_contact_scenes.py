@@ -4,9 +4,9 @@
     python3 scenarios/scenes/generate_contact_scenes.py [output_dir] [--pour N ...]
 
 pyramid_10/20: boxes of edge 1 in layers of n, n-1, ..., 1 with horizontal spacing 1.02, mu 0.5,
-resting on a plane, one step per frame (dt = 1/30); pyramid_2d_10 the same in 2-D. sliver_shards: thin boxes dropped with spin at
-frame rate (the energy-clamp comparison of Sec. 2.3). box_stack_scatter: Fig. 2.2, boxes dropped
-into a stack, then a large box scatters it. pour_spheres_N: N spheres poured into a box.
+resting on a plane, one step per frame (dt = 1/30); pyramid_2d_10 the same in 2-D.
+sliver_shards: thin boxes dropped with spin at frame rate (the energy-clamp comparison of Sec. 2.3).
+box_stack_scatter: Fig. 2.2, boxes dropped into a stack, then a large box scatters it. pour_spheres_N: N spheres poured into a box.
 mixed_pile: boxes, spheres, capsules, cylinders and convex octahedra dropped into a walled box.
 """
 import json

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -371,19 +372,33 @@ TEST(LevelSets, ErrorsInALevelSetFileNameThatFile) {
 }
 
 namespace {
+// The Couette cases' outer body: the shell 0.5 < r < 0.8 about the origin as a "level_set"
+// object, phi = max(0.5 - r, r - 0.8) sampled on n points per axis from `lo` at `spacing`.
+template <int d>
+std::string couetteShellLevelSet(double lo, double spacing, int n) {
+  std::string values;
+  const int total = d == 2 ? n * n : n * n * n;
+  for (int k = 0; k < total; ++k) {
+    double x[3] = {};
+    for (int a = 0, rest = k; a < d; ++a, rest /= n) x[a] = lo + (rest % n) * spacing;
+    const double r = d == 2 ? std::hypot(x[0], x[1]) : std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    values += (values.empty() ? "" : ",") + std::to_string(std::max(0.5 - r, r - 0.8));
+  }
+  char head[256];
+  if constexpr (d == 2)
+    std::snprintf(head, sizeof head, R"({ "origin": [%.17g, %.17g], "spacing": %.17g, "samples": [%d, %d], "values": [)", lo, lo,
+                  spacing, n, n);
+  else
+    std::snprintf(head, sizeof head, R"({ "origin": [%.17g, %.17g, %.17g], "spacing": %.17g, "samples": [%d, %d, %d], "values": [)",
+                  lo, lo, lo, spacing, n, n, n);
+  return head + values + "] }";
+}
+
 // Steady rotating Couette flow between a disk of radius 0.25 and a ring 0.5 < r < 0.8 (a
 // non-convex level set, sampled at 0.01), mu = 1, Stokes (no advection), 64 x 64 cells over
 // [-0.55, 0.55]^2: the torques on both bodies at t = 0.2 (steady to 6 digits). `spinning`:
 // which body turns at 1 rad/s (kinematic), the other is static.
 std::pair<double, double> couetteTorques(const std::string& wall, bool innerSpins) {
-  std::string values;
-  const double spacing = 0.01, lo = -0.85;
-  const int n = 171;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      const double r = std::hypot(lo + i * spacing, lo + j * spacing);
-      values += (values.empty() ? "" : ",") + std::to_string(std::max(0.5 - r, r - 0.8));
-    }
   const std::string spin = R"("rigid_body": { "mass": 1, "inertia": 1, "position": [0.0013, -0.0007] }, "kinematic": { "angular_velocity": 1 })";
   const std::string still = R"("rigid_body": { "static": true, "position": [0.0013, -0.0007] })";
   const Registry registry = builtins();
@@ -395,8 +410,8 @@ std::pair<double, double> couetteTorques(const std::string& wall, bool innerSpin
           "boundaries": { "x_min": { "type": "wall" }, "x_max": { "type": "wall" }, "y_min": { "type": "wall" }, "y_max": { "type": "wall" } } },
         "fluid_material": { "density": 1, "viscosity": 1 } },
       { "name": "inner", "shape": { "type": "disk", "radius": 0.25 }, )" + (innerSpins ? spin : still) + R"(, "fluid_obstacle": {} },
-      { "name": "outer", "level_set": { "origin": [-0.85, -0.85], "spacing": 0.01, "samples": [171, 171], "values": [)" +
-                                   values + R"(] }, )" + (innerSpins ? still : spin) + R"(, "fluid_obstacle": {} } ] })",
+      { "name": "outer", "level_set": )" + couetteShellLevelSet<2>(-0.85, 0.01, 171) + R"(, )" +
+                                   (innerSpins ? still : spin) + R"(, "fluid_obstacle": {} } ] })",
                                "couette.json"),
                     registry, 1);
   std::pair<double, double> torques;
@@ -439,15 +454,6 @@ namespace {
 // still spherical shell 0.5 < r < 0.8 (a non-convex level set, sampled at 0.04), mu = 1, Stokes,
 // 32^3 cells over [-0.55, 0.55]^3: the torques on both bodies at t = 0.2 (steady to 5 digits).
 std::pair<Eigen::Vector3d, Eigen::Vector3d> sphericalCouetteTorques(const std::string& wall) {
-  std::string values;
-  const double spacing = 0.04, lo = -0.88;
-  const int n = 45;
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        const double r = std::sqrt(std::pow(lo + i * spacing, 2) + std::pow(lo + j * spacing, 2) + std::pow(lo + k * spacing, 2));
-        values += (values.empty() ? "" : ",") + std::to_string(std::max(0.5 - r, r - 0.8));
-      }
   const Registry registry = builtins();
   Simulation<3> sim(parseScene(R"({ "dimension": 3, "time": { "dt": 0.02, "end": 0.2 },
     "solvers": { "fluid": { "advection": "none", "tolerance": 1e-8, "obstacle_cells": "staircase", "obstacle_wall": ")" +
@@ -460,8 +466,7 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> sphericalCouetteTorques(const std::s
       { "name": "inner", "shape": { "type": "sphere", "radius": 0.25 },
         "rigid_body": { "mass": 1, "inertia": [1, 1, 1], "position": [0.0013, -0.0007, 0.0011] },
         "kinematic": { "angular_velocity": [0, 0, 1] }, "fluid_obstacle": {} },
-      { "name": "outer", "level_set": { "origin": [-0.88, -0.88, -0.88], "spacing": 0.04, "samples": [45, 45, 45], "values": [)" +
-                                   values + R"(] }, "rigid_body": { "static": true, "position": [0.0013, -0.0007, 0.0011] }, "fluid_obstacle": {} } ] })",
+      { "name": "outer", "level_set": )" + couetteShellLevelSet<3>(-0.88, 0.04, 45) + R"(, "rigid_body": { "static": true, "position": [0.0013, -0.0007, 0.0011] }, "fluid_obstacle": {} } ] })",
                                "spherical_couette.json"),
                     registry, 2);
   std::pair<Eigen::Vector3d, Eigen::Vector3d> torques;
