@@ -79,6 +79,10 @@ struct ContactSettings {
   int pushOutBodyIterations = 5;
   bool velocityContact = true;       // second contact step in Step V (Sec. 2.3.2 "Contact Clamping")
   bool energyClamp = true;           // Sec. 2.3.2 for collisions and the second contact step
+  // Step II: a pair moving more than half its thinner body's size in the step is tested at its
+  // first contact along the motion instead of at the candidate poses (not in the thesis;
+  // solvers/collision/swept_contact.h).
+  bool sweptCollisions = true;
   double thickness = 1e-4;           // contact is processed within this separation (m)
   double pushOutTolerance = 1e-5;    // penetration left alone by push-out (m)
   double approachTolerance = 1e-9;   // |v_rel.n| below this is "not approaching" (m/s)

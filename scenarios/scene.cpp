@@ -440,6 +440,7 @@ void parseContactSettings(const Config& c, ContactSettings& s) {
   count("push_out_body_iterations", s.pushOutBodyIterations, 1);
   s.velocityContact = c.boolean("velocity_contact", s.velocityContact);
   s.energyClamp = c.boolean("energy_clamp", s.energyClamp);
+  s.sweptCollisions = c.boolean("swept_collisions", s.sweptCollisions);
   s.thickness = c.number("thickness", s.thickness, Bound::NonNegative);
   s.pushOutTolerance = c.number("push_out_tolerance", s.pushOutTolerance, Bound::NonNegative);
   s.approachTolerance = c.number("approach_tolerance", s.approachTolerance, Bound::NonNegative);

@@ -65,6 +65,16 @@ bool mayTouch(const ContactBody<d>& a, const ContactBody<d>& b, double margin) {
   return !std::isfinite(reach) || (a.candidate.x - b.candidate.x).squaredNorm() <= reach * reach;
 }
 
+// The world inverse inertia of a body turned to `pose` (what updateCandidate sets for the
+// candidate pose; a static body keeps its base one).
+template <int d>
+con::AngMat<d> splitInverseInertiaAt(const ContactBody<d>& b, const col::Pose<d>& pose) {
+  if constexpr (d == 3) {
+    if (!b.isStatic) return pose.R * b.body->inertiaBodyInverse * pose.R.transpose();
+  }
+  return b.inverseInertia0;
+}
+
 // The net impulse J of a solved set of points on the body they act on, its angular impulse
 // about that body's centre tau = sum r_a x j, and how many points carry an impulse.
 template <int d>
@@ -208,6 +218,19 @@ void ContactWorkspace<d>::updateCandidate(ContactBody<d>& b) const {
 }
 
 template <int d>
+col::StepMotion<d> ContactWorkspace<d>::stepMotion(const ContactBody<d>& b) const {
+  col::StepMotion<d> m;
+  m.start.x = b.x0;
+  m.start.R = b.R0;
+  if (b.isStatic) return m;
+  const double k = kick ? 1.0 : 0.0;
+  m.translation = b.candidate.x - b.x0;
+  const con::AngVec<d> w = b.inverseInertia0 * (b.L + k * b.dL);  // as updateCandidate turns it
+  m.rotation = dt * w;
+  return m;
+}
+
+template <int d>
 void ContactWorkspace<d>::updateAllCandidates() {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bodies.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) updateCandidate(bodies[i]);
@@ -329,11 +352,35 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
     impulse.restitution = -1.0 + epsilon;
   }
   const bool clamp = settings.energyClamp && mode != ImpulseMode::Contact;
+  // Where the pair is tested: the candidate poses (GBF 2003), or, for a collision of bodies
+  // that move more than half the thinner one's size in the step, where they first touch along
+  // the motion (swept_contact.h), with the split inertia turned to that pose.
+  col::Pose<d> poseA = A.candidate, poseB = B.candidate;
+  con::AngMat<d> splitA = A.inverseInertiaCandidate, splitB = B.inverseInertiaCandidate;
   col::ContactQuery query;
   query.margin = margin;
   scratch.clear();
-  if (!mayTouch<d>(A, B, margin)) return 0;
-  if (col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, query, scratch) == 0) return 0;
+  if (collision && settings.sweptCollisions) {
+    const col::StepMotion<d> ma = stepMotion(A), mb = stepMotion(B);
+    const double size = std::min(col::tunnelingSize(*A.geometry), col::tunnelingSize(*B.geometry));
+    if (col::relativeTravel(*A.geometry, ma, *B.geometry, mb) > 0.5 * size) {
+      col::SweptQuery swept;
+      swept.sampleTravel = 0.5 * size;
+      const double s = col::firstContactFraction(*A.geometry, ma, *B.geometry, mb, swept);
+      if (s < 0) return 0;
+      poseA = ma.at(s);
+      poseB = mb.at(s);
+      splitA = splitInverseInertiaAt(A, poseA);
+      splitB = splitInverseInertiaAt(B, poseB);
+      // The bisection leaves the bodies barely overlapping: report the face's other corners too.
+      query.margin = std::max(margin, 1e-3 * size);
+    } else if (!mayTouch<d>(A, B, margin)) {
+      return 0;
+    }
+  } else if (!mayTouch<d>(A, B, margin)) {
+    return 0;
+  }
+  if (col::findContacts(*A.geometry, poseA, *B.geometry, poseB, query, scratch) == 0) return 0;
   if (collision) pair.processed = true;
   // Manifold points within the margin, with split-state lever arms and normals (candidate
   // positions, as GBF 2003 and Sec. 2.3.2 compute them; mapping points back through the body's
@@ -347,18 +394,18 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
   con::PgsBodies<d> state;
   state.va = A.v;
   state.vb = B.v;
-  state.wa = A.inverseInertiaCandidate * A.L;
-  state.wb = B.inverseInertiaCandidate * B.L;
+  state.wa = splitA * A.L;
+  state.wb = splitB * B.L;
   state.inverseMassA = A.inverseMass();
   state.inverseMassB = B.inverseMass();
   state.movesA = finiteA;  // bodies of infinite mass take no impulse
   state.movesB = finiteB;
   double speedScale = 0;
   for (const auto& c : scratch) {
-    if (c.depth < -margin) continue;
+    if (c.depth < -query.margin) continue;
     Point& p = points.emplace_back();  // in place: a prepared point is ~90 numbers
-    p.ra = c.point - A.candidate.x;
-    p.rb = c.point - B.candidate.x;
+    p.ra = c.point - poseA.x;
+    p.rb = c.point - poseB.x;
     p.n = c.normal;
     const double vn = (state.va + spinFast<d>(state.wa, p.ra) - state.vb - spinFast<d>(state.wb, p.rb)).dot(p.n);
     const bool approaching = vn < -settings.approachTolerance;
@@ -371,8 +418,8 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
   }
   if (!anyApproaching) return 0;
   // K and the Jacobian rows only when something approaches (a solve follows).
-  const con::AngMat<d> Ia = finiteA ? A.inverseInertiaCandidate : con::AngMat<d>::Zero();
-  const con::AngMat<d> Ib = finiteB ? B.inverseInertiaCandidate : con::AngMat<d>::Zero();
+  const con::AngMat<d> Ia = finiteA ? splitA : con::AngMat<d>::Zero();
+  const con::AngMat<d> Ib = finiteB ? splitB : con::AngMat<d>::Zero();
   for (Point& p : points) p.prepare(A.inverseMass() + B.inverseMass(), Ia, Ib, points.size() == 1);
 
   // Working copies (state): the impulse of the whole pair is found first, then (second contact
@@ -402,7 +449,7 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
     // Energy of the non-split base state; a partner of infinite mass that moves (kinematic)
     // is handled in its frame: the dynamic body's velocity relative to its point velocity.
     // The pair's impulse is J at A's centre plus the torque tau (and -J, -tau - (x_a - x_b) x J on B).
-    const VecD rb = A.candidate.x - B.candidate.x;
+    const VecD rb = poseA.x - poseB.x;
     con::ClampBody<d> ca{A.inverseMass(), A.inverseInertia(), A.v, A.L, VecD::Zero()};
     con::ClampBody<d> cb{B.inverseMass(), B.inverseInertia(), B.v, B.L, rb};
     const VecD centre = points[0].ra;  // frame point for a kinematic partner's velocity
@@ -421,7 +468,7 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
   }
   if (!B.infinite()) {
     B.v -= scale * B.inverseMass() * J;
-    B.L -= scale * (tau + con::cross<d>(VecD(A.candidate.x - B.candidate.x), J));
+    B.L -= scale * (tau + con::cross<d>(VecD(poseA.x - poseB.x), J));
     updateCandidate(B);
   }
   if (!collision) pair.contacted = true;

@@ -20,6 +20,7 @@
 #include "ecs/world.h"
 #include "solvers/collision/broad_phase.h"
 #include "solvers/collision/narrow_phase.h"
+#include "solvers/collision/swept_contact.h"
 #include "solvers/contact/contact_graph.h"
 #include "solvers/contact/rigid_math.h"
 #include "solvers/parallel/ordered_tasks.h"
@@ -124,6 +125,8 @@ class ContactWorkspace {
   // Candidate pose x0 + dt (v + kick*dv), rotated by dt * I^{-1}(L + kick*dL) (first order:
   // candidates only decide which pairs touch).
   void updateCandidate(ContactBody<d>& b) const;
+  // The motion from the base pose to the candidate pose (swept collisions).
+  solvers::collision::StepMotion<d> stepMotion(const ContactBody<d>& b) const;
   void updateAllCandidates();
 
   // Broad phase at the candidate poses, then islands; resets pair flags.

@@ -304,10 +304,15 @@ TEST(MixedPile, EveryShapeSettlesWithoutEnergyGainOrDeepOverlap) {
   Simulation<3> sim(loadScene(kScenes + "mixed_pile.json"), registry);
   EnergyWatch watch;
   EXPECT_LE(runToEndWatching(sim, watch), 0.01);
+  // Settled: the energy left at t = 4 s is a snapshot of a chaotic pile, in which a sphere or
+  // cylinder may still be rolling off it (no rolling resistance). Over 16 runs with dt and
+  // gravity changed by 1-3 % (docs/benchmarks.md, "Swept collisions") it was 0.002-0.17 J, and
+  // above the 0.02 J this test once asserted in 3 of them -- 1 in 8 for the build that chose
+  // that bound too. 0.5 J is 0.17 % of the 286 J the pile starts with.
   double ke = 0;
   for (const auto& b : sim.world().pool<RigidBody<3>>().components())
     ke += b.translationalKineticEnergy() + b.rotationalKineticEnergy();
-  EXPECT_LT(ke, 0.02) << "the pile should have settled (it starts with 286 J of total energy)";
+  EXPECT_LT(ke, 0.5) << "the pile should have settled (it starts with 286 J of total energy)";
   watch.expectNoGain(std::abs(watch.initialTotal));
 }
 
@@ -317,10 +322,15 @@ TEST(ContactDeterminism, EveryShapePairGivesTheSameStateOnOneAndTwoThreads) {
 }
 
 TEST(EnergyClamp, SliverShardsGainEnergyOnlyWithoutTheClamp) {
+  // The thesis's collision test at the candidate poses (swept collisions off): there the split
+  // state's lever arms of slivers sunk deep into each other make impulses that gain energy.
+  // Swept collisions test the slivers where they first touch instead, and in this scene no
+  // impulse gains energy even without the clamp (docs/benchmarks.md, "Swept collisions").
   const Registry registry = builtins();
   auto run = [&](bool clamp) {
     const SceneSpec scene = loadScene(kScenes + "sliver_shards.json",
-                                      {{"solvers.contact.energy_clamp", clamp ? "true" : "false"}});
+                                      {{"solvers.contact.energy_clamp", clamp ? "true" : "false"},
+                                       {"solvers.contact.swept_collisions", "false"}});
     Simulation<3> sim(scene, registry);
     EnergyWatch watch;
     while (!sim.finished()) watch.observe(sim.step());
@@ -330,6 +340,40 @@ TEST(EnergyClamp, SliverShardsGainEnergyOnlyWithoutTheClamp) {
   on.expectNoGain(std::abs(on.initialTotal));
   EXPECT_GT(std::max(off.worstCollisionGain, off.worstContactGain), 1e-6)
       << "without the clamp frame-rate slivers should show energy gain in some impulse";
+}
+
+TEST(SweptCollisions, PlatesThrownAtAThinShelfStopOnItAtFrameRate) {
+  // A 4 cm plate thrown down at a static 4 cm shelf, dt = 1/30: from 3, 6 and 20 m/s it moves
+  // 2.5 to 17 thicknesses per step. Tested only at the candidate poses (the thesis's Step II)
+  // it is past the shelf there from 6 m/s on and falls through to the ground; tested where it
+  // first touches along its motion (swept_contact.h) it lands on the shelf every time.
+  const Registry registry = builtins();
+  auto finalHeight = [&](double speed, bool swept) {
+    std::ostringstream text;
+    text << R"({"dimension": 3, "time": {"dt": 0.03333333333333333, "end": 1.0}, "gravity": [0, -9.81, 0],
+      "entities": [
+        {"name": "ground", "shape": {"type": "plane", "normal": [0, 1, 0]}, "rigid_body": {"static": true},
+         "collider": {"restitution": 0, "friction": 0.5}},
+        {"name": "shelf", "shape": {"type": "box", "half_extents": [0.5, 0.02, 0.25]},
+         "rigid_body": {"static": true, "position": [0, 2, 0]}, "collider": {"restitution": 0, "friction": 0.5}},
+        {"name": "plate", "shape": {"type": "box", "half_extents": [0.5, 0.02, 0.25]},
+         "rigid_body": {"mass": 0.5, "position": [0.1, 3, 0.05], "velocity": [0, )"
+         << -speed << R"(, 0]}, "collider": {"restitution": 0, "friction": 0.5}}]})";
+    const SceneSpec scene = parseScene(text.str(), "plates.json",
+                                       {{"solvers.contact.swept_collisions", swept ? "true" : "false"}});
+    Simulation<3> sim(scene, registry);
+    EnergyWatch watch;
+    EXPECT_LE(runToEndWatching(sim, watch), 0.01);
+    watch.expectNoGain(std::abs(watch.initialTotal));
+    EXPECT_LT(bodyOf(sim, "plate").v.norm(), 1e-3);
+    return positionOf(sim, "plate").y();
+  };
+  for (double speed : {3.0, 6.0, 20.0}) {
+    EXPECT_NEAR(finalHeight(speed, true), 2.04, 1e-3) << "thrown at " << speed << " m/s: resting on the shelf";
+    if (speed > 5) {
+      EXPECT_NEAR(finalHeight(speed, false), 0.02, 1e-3) << "the candidate test lets it through";
+    }
+  }
 }
 
 TEST(MeshGround, SphereAndBoxComeToRestOnAnObjMesh) {
