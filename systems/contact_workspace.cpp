@@ -360,13 +360,15 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
   col::ContactQuery query;
   query.margin = margin;
   scratch.clear();
+  bool swept = false;
   if (collision && settings.sweptCollisions) {
     const col::StepMotion<d> ma = stepMotion(A), mb = stepMotion(B);
     const double size = std::min(col::tunnelingSize(*A.geometry), col::tunnelingSize(*B.geometry));
-    if (col::relativeTravel(*A.geometry, ma, *B.geometry, mb) > 0.5 * size) {
-      col::SweptQuery swept;
-      swept.sampleTravel = 0.5 * size;
-      const double s = col::firstContactFraction(*A.geometry, ma, *B.geometry, mb, swept);
+    swept = col::relativeTravel(*A.geometry, ma, *B.geometry, mb) > 0.5 * size;
+    if (swept) {
+      col::SweptQuery first;
+      first.sampleTravel = 0.5 * size;
+      const double s = col::firstContactFraction(*A.geometry, ma, *B.geometry, mb, first);
       if (s < 0) return 0;
       poseA = ma.at(s);
       poseB = mb.at(s);
@@ -374,12 +376,9 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
       splitB = splitInverseInertiaAt(B, poseB);
       // The bisection leaves the bodies barely overlapping: report the face's other corners too.
       query.margin = std::max(margin, 1e-3 * size);
-    } else if (!mayTouch<d>(A, B, margin)) {
-      return 0;
     }
-  } else if (!mayTouch<d>(A, B, margin)) {
-    return 0;
   }
+  if (!swept && !mayTouch<d>(A, B, margin)) return 0;
   if (col::findContacts(*A.geometry, poseA, *B.geometry, poseB, query, scratch) == 0) return 0;
   if (collision) pair.processed = true;
   // Manifold points within the margin, with split-state lever arms and normals (candidate
