@@ -39,13 +39,17 @@ void Collisions<d>::run(World<d>& world, StepContext& ctx) {
   ws.unpack(false);
   ws.kick = false;  // from here on the working velocity already is the n+1/2 one
 
-  int processed = 0, impulseCount = 0, clampCount = 0;
-  for (const auto& p : ws.pairs) processed += p.processed ? 1 : 0;
+  int processed = 0, swept = 0, impulseCount = 0, clampCount = 0;
+  for (const auto& p : ws.pairs) {
+    processed += p.processed ? 1 : 0;
+    swept += p.swept ? 1 : 0;
+  }
   for (int n : impulses) impulseCount += n;
   for (int n : clamps) clampCount += n;
   auto& out = ctx.diagnostics;
   out.set("contact_pairs_broad_phase", static_cast<double>(ws.pairs.size()));
   out.set("collision_pairs_processed", processed);
+  out.set("collision_pairs_swept", swept);  // fast pairs met where they first touch (swept_contact.h)
   out.set("collision_impulses", impulseCount);
   out.set("collision_energy_clamps", clampCount);
   out.set("contact_islands", static_cast<double>(ws.islands.members.size()));

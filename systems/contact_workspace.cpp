@@ -370,6 +370,7 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
       first.sampleTravel = 0.5 * size;
       const double s = col::firstContactFraction(*A.geometry, ma, *B.geometry, mb, first);
       if (s < 0) return 0;
+      pair.swept = true;
       poseA = ma.at(s);
       poseB = mb.at(s);
       splitA = splitInverseInertiaAt(A, poseA);

@@ -86,6 +86,7 @@ struct ContactPairState {
   int a = 0, b = 0;
   bool processed = false;  // interpenetrated at candidate positions during Step II
   bool contacted = false;  // received a contact impulse in Step III (used by Step V)
+  bool swept = false;      // a collision update found it touching along the step's motion (swept_contact.h)
   long checkedStamp = -1;
   int level = 0;
 };
