@@ -40,9 +40,11 @@ struct SweptQuery {
 };
 
 // The smallest sampled s in [0, 1] at which A and B overlap, refined by bisection so that the
-// returned s overlaps and s - 2^-bisections / samples does not; -1 if no sample overlaps. With
-// sampleTravel below the thinner body's tunnelingSize no pass-through is missed (any crossing
-// overlaps for a stretch of travel at least that thickness), unless maxSamples caps the count.
+// returned s overlaps and s - 2^-bisections of a sample interval does not; -1 if no sample
+// overlaps. Only the stretch in which the bodies' bounding balls meet is sampled (none at all if
+// they never meet). With sampleTravel below the thinner body's tunnelingSize no pass-through is
+// missed (any crossing overlaps for a stretch of travel at least that thickness), unless
+// maxSamples caps the count.
 template <int d>
 double firstContactFraction(const PreparedGeometry<d>& a, const StepMotion<d>& ma, const PreparedGeometry<d>& b,
                             const StepMotion<d>& mb, const SweptQuery& query);
