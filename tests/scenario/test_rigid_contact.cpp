@@ -393,6 +393,31 @@ TEST(SweptCollisions, PlatesThrownAtAThinShelfStopOnItAtFrameRate) {
   }
 }
 
+TEST(SweptCollisions, InTwoDimensionsADiskThrownAtAThinBarStopsOnIt) {
+  // The same in 2-D: a disk (r 0.1) thrown down at 15 m/s, 2.5 diameters per step at dt = 1/30,
+  // at a static bar 2 cm thick. With the candidate test alone it ends on the ground below.
+  const Registry registry = builtins();
+  auto finalHeight = [&](bool swept) {
+    const std::string text = R"({"dimension": 2, "time": {"dt": 0.03333333333333333, "end": 1.0}, "gravity": [0, -9.81],
+      "entities": [
+        {"name": "ground", "shape": {"type": "plane", "normal": [0, 1]}, "rigid_body": {"static": true},
+         "collider": {"restitution": 0, "friction": 0.5}},
+        {"name": "bar", "shape": {"type": "box", "half_extents": [1.0, 0.01]},
+         "rigid_body": {"static": true, "position": [0, 2]}, "collider": {"restitution": 0, "friction": 0.5}},
+        {"name": "disk", "shape": {"type": "disk", "radius": 0.1},
+         "rigid_body": {"mass": 1, "position": [0.05, 3], "velocity": [0, -15]},
+         "collider": {"restitution": 0, "friction": 0.5}}]})";
+    Simulation<2> sim(parseScene(text, "disk.json", {{"solvers.contact.swept_collisions", swept ? "true" : "false"}}),
+                      registry);
+    EnergyWatch watch;
+    while (!sim.finished()) watch.observe(sim.step());
+    watch.expectNoGain(std::abs(watch.initialTotal));
+    return positionOf(sim, "disk").y();
+  };
+  EXPECT_NEAR(finalHeight(true), 2.11, 1e-3) << "resting on the bar (its top at 2.01)";
+  EXPECT_NEAR(finalHeight(false), 0.1, 1e-3) << "the candidate test lets it through to the ground";
+}
+
 TEST(MeshGround, SphereAndBoxComeToRestOnAnObjMesh) {
   // A ground read from a Wavefront OBJ file (two triangles, path relative to the scene):
   // a sphere and a box dropped on it rest at their half heights.
