@@ -8,6 +8,7 @@
 #include "solvers/collision/collision_impl.h"
 #include "solvers/collision/box_box_impl.h"
 #include "solvers/collision/contact_axis_impl.h"
+#include "support/collision_shapes.h"
 
 #include <fcl/geometry/shape/box.h>
 #include <fcl/geometry/shape/capsule.h>
@@ -26,6 +27,7 @@
 namespace {
 
 using namespace monolith::solvers::collision;
+using namespace monolith::test;  // box3, sphere3, capsule3, cylinder3, halfSpace, box2, disk
 using Vec3 = Eigen::Vector3d;
 using Vec2 = Eigen::Vector2d;
 using Mat3 = Eigen::Matrix3d;
@@ -35,38 +37,6 @@ const double kSqrt2 = std::sqrt(2.0);
 constexpr double kPi = 3.14159265358979323846;
 
 // --- shapes and poses ----------------------------------------------------------------------
-Geometry<3> box3(double hx, double hy, double hz) {
-  Geometry<3> g;
-  g.type = GeometryType::Box;
-  g.halfExtents = Vec3(hx, hy, hz);
-  return g;
-}
-Geometry<3> sphere3(double r) {
-  Geometry<3> g;
-  g.type = GeometryType::Sphere;
-  g.radius = r;
-  return g;
-}
-Geometry<3> capsule3(double r, double h) {
-  Geometry<3> g;
-  g.type = GeometryType::Capsule;
-  g.radius = r;
-  g.halfHeight = h;
-  return g;
-}
-Geometry<3> cylinder3(double r, double h) {
-  Geometry<3> g = capsule3(r, h);
-  g.type = GeometryType::Cylinder;
-  return g;
-}
-template <int d>
-Geometry<d> halfSpace(const Eigen::Matrix<double, d, 1>& n, double offset) {
-  Geometry<d> g;
-  g.type = GeometryType::HalfSpace;
-  g.normal = n;
-  g.offset = offset;
-  return g;
-}
 // Cube corners in a scrambled order plus interior points: the hull must drop the latter.
 Geometry<3> convexCube(double h) {
   Geometry<3> g;
@@ -84,19 +54,6 @@ Geometry<3> groundMesh() {
   g.triangles = {{0, 2, 1}, {0, 3, 2}};
   return g;
 }
-Geometry<2> box2(double hx, double hy) {
-  Geometry<2> g;
-  g.type = GeometryType::Box;
-  g.halfExtents = Vec2(hx, hy);
-  return g;
-}
-Geometry<2> disk(double r) {
-  Geometry<2> g;
-  g.type = GeometryType::Sphere;
-  g.radius = r;
-  return g;
-}
-
 Pose<3> at(const Vec3& x, const Mat3& R = Mat3::Identity()) {
   Pose<3> p;
   p.x = x;

@@ -9,33 +9,14 @@
 #include <limits>
 
 #include "solvers/collision/narrow_phase.h"
+#include "support/collision_shapes.h"
 
 namespace {
 
 using namespace monolith::solvers::collision;
+using namespace monolith::test;  // box3, sphere3, halfSpace, box2, disk
 using Vec3 = Eigen::Vector3d;
 constexpr double kPi = 3.14159265358979323846;
-
-Geometry<3> box(double hx, double hy, double hz) {
-  Geometry<3> g;
-  g.type = GeometryType::Box;
-  g.halfExtents = Vec3(hx, hy, hz);
-  return g;
-}
-
-Geometry<3> sphere(double r) {
-  Geometry<3> g;
-  g.type = GeometryType::Sphere;
-  g.radius = r;
-  return g;
-}
-
-Geometry<3> ground() {
-  Geometry<3> g;
-  g.type = GeometryType::HalfSpace;
-  g.normal = Vec3::UnitY();
-  return g;
-}
 
 StepMotion<3> still(const Vec3& x) {
   StepMotion<3> m;
@@ -59,7 +40,7 @@ SweptQuery queryFor(double size) {
 TEST(SweptContact, PlateThrownThroughAThinShelfIsCaughtWhereItFirstTouches) {
   // A 4 cm plate moves 0.5 m down in the step, from 0.1 m above a 4 cm shelf to 0.36 m below
   // its top: neither end pose overlaps the shelf, so the candidate test misses it entirely.
-  const PreparedGeometry<3> plate(box(0.5, 0.02, 0.25)), shelf(box(0.5, 0.02, 0.25));
+  const PreparedGeometry<3> plate(box3(0.5, 0.02, 0.25)), shelf(box3(0.5, 0.02, 0.25));
   const StepMotion<3> a = moving(Vec3(0.1, 0.14, 0.05), Vec3(0, -0.5, 0)), b = still(Vec3::Zero());
   ASSERT_FALSE(overlaps<3>(plate, a.at(0), shelf, b.at(0)));
   ASSERT_FALSE(overlaps<3>(plate, a.at(1), shelf, b.at(1)));
@@ -72,7 +53,7 @@ TEST(SweptContact, PlateThrownThroughAThinShelfIsCaughtWhereItFirstTouches) {
 }
 
 TEST(SweptContact, SphereOntoTheGroundAndMisses) {
-  const PreparedGeometry<3> ball(sphere(0.1)), plane(ground());
+  const PreparedGeometry<3> ball(sphere3(0.1)), plane(halfSpace<3>(Vec3::UnitY(), 0));
   // Centre from 1 m to 0.05 m: touches at 1 - 0.1 = 0.9 m of travel out of 0.95.
   const double s = firstContactFraction<3>(ball, moving(Vec3(0, 1, 0), Vec3(0, -0.95, 0)), plane,
                                            still(Vec3::Zero()), queryFor(0.2));
@@ -81,13 +62,13 @@ TEST(SweptContact, SphereOntoTheGroundAndMisses) {
   EXPECT_EQ(-1.0, firstContactFraction<3>(ball, moving(Vec3(0, 0.5, 0), Vec3(3, 0, 0)), plane, still(Vec3::Zero()),
                                           queryFor(0.2)));
   // Flying past a thin plate beside it: never touches.
-  const PreparedGeometry<3> plate(box(0.5, 0.02, 0.25));
+  const PreparedGeometry<3> plate(box3(0.5, 0.02, 0.25));
   EXPECT_EQ(-1.0, firstContactFraction<3>(ball, moving(Vec3(1.0, 1, 0), Vec3(0, -2, 0)), plate, still(Vec3::Zero()),
                                           queryFor(0.04)));
 }
 
 TEST(SweptContact, OverlappingAtTheStartIsContactAtZero) {
-  const PreparedGeometry<3> a(box(0.5, 0.5, 0.5)), b(box(0.5, 0.5, 0.5));
+  const PreparedGeometry<3> a(box3(0.5, 0.5, 0.5)), b(box3(0.5, 0.5, 0.5));
   EXPECT_EQ(0.0, firstContactFraction<3>(a, moving(Vec3(0, 0.99, 0), Vec3(0, -1, 0)), b, still(Vec3::Zero()),
                                          queryFor(1.0)));
 }
@@ -95,7 +76,7 @@ TEST(SweptContact, OverlappingAtTheStartIsContactAtZero) {
 TEST(SweptContact, TurningBarSweepsThroughAThinPostAtTheRightAngle) {
   // A 2 m bar (4 cm thick) turns by 90 degrees about its centre in the step; a thin post stands
   // 0.6 m from the centre at 45 degrees. End poses (bar along x, then along z) miss the post.
-  const PreparedGeometry<3> bar(box(1.0, 0.02, 0.02)), post(box(0.02, 0.5, 0.02));
+  const PreparedGeometry<3> bar(box3(1.0, 0.02, 0.02)), post(box3(0.02, 0.5, 0.02));
   const Vec3 postAt(0.6 * std::cos(kPi / 4), 0, -0.6 * std::sin(kPi / 4));  // turning about +y takes +x to -z
   const StepMotion<3> a = moving(Vec3::Zero(), Vec3::Zero(), Vec3(0, kPi / 2, 0)), b = still(postAt);
   ASSERT_FALSE(overlaps<3>(bar, a.at(0), post, b.at(0)));
@@ -110,7 +91,7 @@ TEST(SweptContact, TurningBarSweepsThroughAThinPostAtTheRightAngle) {
 }
 
 TEST(SweptContact, SizesAndTravelFollowTheRulesTheCollisionStepUses) {
-  const PreparedGeometry<3> plate(box(0.5, 0.02, 0.25)), plane(ground()), ball(sphere(0.1));
+  const PreparedGeometry<3> plate(box3(0.5, 0.02, 0.25)), plane(halfSpace<3>(Vec3::UnitY(), 0)), ball(sphere3(0.1));
   EXPECT_DOUBLE_EQ(0.04, tunnelingSize<3>(plate));
   EXPECT_DOUBLE_EQ(0.2, tunnelingSize<3>(ball));
   EXPECT_EQ(std::numeric_limits<double>::infinity(), tunnelingSize<3>(plane));
@@ -128,13 +109,7 @@ TEST(SweptContact, SizesAndTravelFollowTheRulesTheCollisionStepUses) {
 }
 
 TEST(SweptContact, TwoDimensionalDiskThroughAThinBar) {
-  Geometry<2> disk;
-  disk.type = GeometryType::Sphere;
-  disk.radius = 0.05;
-  Geometry<2> bar;
-  bar.type = GeometryType::Box;
-  bar.halfExtents = Eigen::Vector2d(1.0, 0.01);
-  const PreparedGeometry<2> a(disk), b(bar);
+  const PreparedGeometry<2> a(disk(0.05)), b(box2(1.0, 0.01));
   StepMotion<2> m, fixed;
   m.start.x = Eigen::Vector2d(0, 0.3);
   m.translation = Eigen::Vector2d(0, -0.6);
