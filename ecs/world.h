@@ -77,6 +77,10 @@ struct ContactSettings {
   bool pushOut = true;               // interpenetration resolution, Sec. 4.6.1 / App. B
   int pushOutLevelIterations = 3;    // thesis code: 2; measured on box_stack_scatter (docs/benchmarks.md)
   int pushOutBodyIterations = 5;
+  // Push-out also separates pairs that Steps II-III never saw interpenetrating (not "processed")
+  // but that overlap after Step IV's positions: a body moved by contact or by another push-out
+  // into a neighbour (not in the thesis, whose push-out keeps to the saved pairs; Sec. 4.6.1).
+  bool pushOutNewOverlaps = true;
   bool velocityContact = true;       // second contact step in Step V (Sec. 2.3.2 "Contact Clamping")
   bool energyClamp = true;           // Sec. 2.3.2 for collisions and the second contact step
   // Step II: a pair moving more than half its thinner body's size in the step is tested at its

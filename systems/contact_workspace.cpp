@@ -281,7 +281,8 @@ void ContactWorkspace<d>::computeLevels() {
   // "a below b" when b, re-advanced with its new velocity (with the Step I kick), overlaps a
   // advanced with its old one (notes 1.6). Bodies of infinite mass are never re-advanced, so
   // they end up at the bottom.
-  std::vector<std::pair<int, int>> edges;
+  std::vector<std::pair<int, int>>& edges = graphEdges;
+  edges.clear();
   auto poseWith = [&](const ContactBody<d>& b, double k) {
     col::Pose<d> p;
     if (b.isStatic) {

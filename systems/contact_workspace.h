@@ -177,6 +177,7 @@ class ContactWorkspace {
   std::vector<ContactPairState> pairs;
   solvers::contact::Islands islands;
   solvers::contact::ContactLevels levels;
+  std::vector<std::pair<int, int>> graphEdges;  // (below, above): the edges `levels` came from
   // Per island: pair indices sorted by (level, index).
   std::vector<std::vector<int>> islandPairsByLevel;
   double dt = 0;

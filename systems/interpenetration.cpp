@@ -7,6 +7,14 @@
 // only positions and orientations move (App. B.1). Finally the velocity is reset to the
 // post-collision \hat v^n plus the Step I kick, so that Step V's half kick completes the
 // trapezoid update from \hat v^n (the contact impulses of Step III only served the positions).
+//
+// Deviation (ContactSettings::pushOutNewOverlaps, docs/architecture.md "Push-out of new
+// overlaps"): the thesis code pushes apart only the pairs Step II marked as processed. A pair
+// that did not touch at the candidate poses there can overlap after Step III has changed a
+// body's velocity, or after push-out has moved a body out of another one: in sliver_shards a
+// shard was pushed through the ground plane this way (147 % of its thickness). Push-out
+// therefore takes every pair of the broad phase, with the same solves, and a pair overlapping
+// before it starts ties its two bodies into one level.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -48,6 +56,53 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
   const ContactSettings& s = ws.settings;
   std::vector<int> pushes(ws.islands.members.size(), 0);
 
+  // Pairs not processed in Step II that overlap at the advanced positions. Tested in parallel
+  // (the queries only read), each in its own slot.
+  newOverlap_.assign(ws.pairs.size(), 0);
+  if (s.pushOut && s.pushOutNewOverlaps) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ws.pairs.size(), 64),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        thread_local std::vector<col::ContactPoint<d>> scratch;
+                        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                          const ContactPairState& p = ws.pairs[k];
+                          const ContactBody<d>& A = ws.bodies[p.a];
+                          const ContactBody<d>& B = ws.bodies[p.b];
+                          if (p.processed || (A.infinite() && B.infinite())) continue;
+                          scratch.clear();
+                          col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, col::ContactQuery{},
+                                            scratch);
+                          for (const auto& cp : scratch)
+                            if (cp.depth > s.pushOutTolerance) newOverlap_[k] = 1;
+                        }
+                      });
+  }
+  int newOverlaps = 0;
+  for (char c : newOverlap_) newOverlaps += c;
+
+  // The levels push-out runs by. The contact graph has no edge for a new overlap, so it may have
+  // put one of its bodies on a lower level, frozen by the time the other is pushed: a body
+  // wedged between it and the ground could then not move at all. A new overlap is therefore an
+  // edge both ways (its bodies share a cycle, so one level; below the other body if one has
+  // infinite mass), and the levels are recomputed with those edges. Without new overlaps they
+  // are the contact graph's.
+  const con::ContactLevels* levels = &ws.levels;
+  pairLevel_.resize(ws.pairs.size());
+  for (std::size_t k = 0; k < ws.pairs.size(); ++k) pairLevel_[k] = ws.pairs[k].level;
+  if (newOverlaps > 0) {
+    edges_ = ws.graphEdges;
+    for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
+      if (!newOverlap_[k]) continue;
+      const int a = ws.pairs[k].a, b = ws.pairs[k].b;
+      const bool fa = !ws.bodies[a].infinite(), fb = !ws.bodies[b].infinite();
+      if (fb) edges_.emplace_back(a, b);
+      if (fa) edges_.emplace_back(b, a);
+    }
+    pushLevels_ = con::computeLevels(static_cast<int>(ws.bodies.size()), edges_);
+    levels = &pushLevels_;
+    for (std::size_t k = 0; k < ws.pairs.size(); ++k)
+      pairLevel_[k] = std::max(pushLevels_.levelOf[ws.pairs[k].a], pushLevels_.levelOf[ws.pairs[k].b]);
+  }
+
   if (s.pushOut) {
     if (plans_.size() < ws.islands.members.size()) plans_.resize(ws.islands.members.size());
     ws.forEachIsland([&](int island) {
@@ -68,16 +123,24 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
       const auto& members = ws.islands.members[island];
       auto& frozen = plan.frozen;
       frozen.assign(members.size(), 0);
-      const auto& list = ws.islandPairsByLevel[island];
+      // The pairs to push apart in level order, by the rule of ws.islandPairsByLevel (island
+      // order, then a stable sort by level): the processed pairs, or with pushOutNewOverlaps
+      // every pair of the island's broad phase, since push-out itself can move a body into a
+      // neighbour that touched nothing before (a pair that does not overlap costs one query).
+      auto& list = plan.pairsByLevel;
+      list.clear();
+      for (int p : ws.islands.pairs[island])
+        if (ws.pairs[p].processed || s.pushOutNewOverlaps) list.push_back(p);
+      std::stable_sort(list.begin(), list.end(), [&](int x, int y) { return pairLevel_[x] < pairLevel_[y]; });
       for (std::size_t begin = 0; begin < list.size();) {
-        const int level = ws.pairs[list[begin]].level;
+        const int level = pairLevel_[list[begin]];
         std::size_t end = begin;
-        while (end < list.size() && ws.pairs[list[end]].level == level) ++end;
+        while (end < list.size() && pairLevel_[list[end]] == level) ++end;
         // This island's bodies on the level, ascending (a level is one component of the contact
         // graph), and each one's pairs on the level in order: found by grouping, since scanning
         // the level's pairs for every body made large piles (a cycle of many bodies) quadratic.
         levelMembers.clear();
-        for (int c : ws.levels.nodes[level])
+        for (int c : levels->nodes[level])
           if (ws.islands.islandOf[c] == island) levelMembers.push_back(c);
         bodyPair.clear();
         for (std::size_t k = begin; k < end; ++k) {
@@ -180,17 +243,17 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
     });
   }
 
-  // Deepest remaining overlap of the pairs in contact, relative to the smaller body's size.
-  // Per pair in parallel (the queries only read), then the largest: a maximum does not depend on
-  // the order it is taken in.
+  // Deepest remaining overlap of any pair of the broad phase (processed in Step II or not),
+  // relative to the smaller body's size. Per pair in parallel (the queries only read), then the
+  // largest: a maximum does not depend on the order it is taken in.
   std::vector<double> pairDepth(ws.pairs.size(), 0.0), pairRatio(ws.pairs.size(), 0.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ws.pairs.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
     thread_local std::vector<col::ContactPoint<d>> scratch;
     for (std::size_t k = range.begin(); k != range.end(); ++k) {
       const ContactPairState& p = ws.pairs[k];
-      if (!p.processed) continue;
       const ContactBody<d>& A = ws.bodies[p.a];
       const ContactBody<d>& B = ws.bodies[p.b];
+      if (A.infinite() && B.infinite()) continue;
       scratch.clear();
       col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, col::ContactQuery{}, scratch);
       const double size = std::min(A.geometry->minimumSize(), B.geometry->minimumSize());
@@ -215,6 +278,7 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
   int total = 0;
   for (int n : pushes) total += n;
   ctx.diagnostics.set("push_out_solves", total);
+  ctx.diagnostics.set("push_out_new_overlaps", newOverlaps);
   ctx.diagnostics.set("max_penetration", worstDepth);
   ctx.diagnostics.set("max_penetration_ratio", worst);
 }

@@ -88,11 +88,16 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
     std::vector<int> touched, levelMembers, solves;
     std::vector<std::pair<int, int>> bodyPair;  // (level member, pair), grouped by member
     std::vector<std::pair<int, int>> range;     // per level member: its pairs in centralPairs
+    std::vector<int> pairsByLevel;  // the island's pairs to push apart, ascending level
     solvers::parallel::OrderedTasks order;
   };
 
  private:
   std::vector<IslandPlan> plans_;
+  std::vector<char> newOverlap_;  // per pair: not processed in Step II, yet overlapping now
+  std::vector<int> pairLevel_;    // per pair: its level in push-out
+  std::vector<std::pair<int, int>> edges_;
+  solvers::contact::ContactLevels pushLevels_;
 };
 
 template <int d>
