@@ -29,7 +29,7 @@ void Collisions<d>::run(World<d>& world, StepContext& ctx) {
     b.vCollided = b.v;
     b.LCollided = b.L;
   }
-  ws.computeLevels();
+  const int pairsAdded = ws.computeLevels();
   // Step II item 3: \hat v^{n+1/2} = \hat v^n + (\tilde v^{n+1/2} - v^n).
   for (auto& b : ws.bodies) {
     if (b.infinite()) continue;
@@ -48,6 +48,8 @@ void Collisions<d>::run(World<d>& world, StepContext& ctx) {
   for (int n : clamps) clampCount += n;
   auto& out = ctx.diagnostics;
   out.set("contact_pairs_broad_phase", static_cast<double>(ws.pairs.size()));
+  // Pairs the broad phase found again where the collision impulses sent the bodies.
+  out.set("broad_phase_pairs_added_after_collisions", pairsAdded);
   out.set("collision_pairs_processed", processed);
   out.set("collision_pairs_swept", swept);  // fast pairs met where they first touch (swept_contact.h)
   out.set("collision_impulses", impulseCount);

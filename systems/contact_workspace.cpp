@@ -1,6 +1,7 @@
 #include "systems/contact_workspace.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -277,23 +278,65 @@ void ContactWorkspace<d>::findPairs() {
 }
 
 template <int d>
-void ContactWorkspace<d>::computeLevels() {
+col::Pose<d> ContactWorkspace<d>::reAdvanced(const ContactBody<d>& b, double k) const {
+  col::Pose<d> p;
+  if (b.isStatic) {
+    p.x = b.x0;
+    p.R = b.R0;
+    return p;
+  }
+  p.x = b.x0 + dt * (b.v + k * b.dv);
+  p.R = rotationOf<d>(rotatedBy<d>(b.q0, dt * (b.inverseInertia0 * (b.L + k * b.dL))));
+  return p;
+}
+
+template <int d>
+void ContactWorkspace<d>::rebuildPairsFrom(const std::vector<std::pair<int, int>>& found) {
+  // `found` is sorted and contains every known pair (the boxes only grew): walk both lists.
+  std::vector<ContactPairState> merged(found.size());
+  std::size_t old = 0;
+  for (std::size_t k = 0; k < found.size(); ++k) {
+    if (old < pairs.size() && pairs[old].a == found[k].first && pairs[old].b == found[k].second) {
+      merged[k] = pairs[old++];
+    } else {
+      merged[k].a = found[k].first;
+      merged[k].b = found[k].second;
+      merged[k].level = levels.levelOf.empty() ? 0 : std::max(levels.levelOf[merged[k].a], levels.levelOf[merged[k].b]);
+    }
+  }
+  if (old != pairs.size()) throw std::logic_error("ContactWorkspace: a grown broad phase lost a pair");
+  pairs = std::move(merged);
+  const int n = static_cast<int>(bodies.size());
+  islands = con::computeIslands(n, found, infinite_);
+  memberIndex_.assign(n, -1);
+  for (const auto& members : islands.members)
+    for (std::size_t k = 0; k < members.size(); ++k) memberIndex_[members[k]] = static_cast<int>(k);
+  schedules_.resize(islands.members.size());
+  sortIslandPairsByLevel();
+}
+
+template <int d>
+void ContactWorkspace<d>::sortIslandPairsByLevel() {
+  islandPairsByLevel.resize(islands.pairs.size());
+  for (std::size_t i = 0; i < islands.pairs.size(); ++i) {
+    auto& list = islandPairsByLevel[i];
+    list.clear();
+    for (int p : islands.pairs[i])
+      if (pairs[p].processed) list.push_back(p);
+    std::stable_sort(list.begin(), list.end(), [&](int x, int y) { return pairs[x].level < pairs[y].level; });
+  }
+}
+
+template <int d>
+int ContactWorkspace<d>::computeLevels() {
   // "a below b" when b, re-advanced with its new velocity (with the Step I kick), overlaps a
   // advanced with its old one (notes 1.6). Bodies of infinite mass are never re-advanced, so
   // they end up at the bottom.
   std::vector<std::pair<int, int>>& edges = graphEdges;
   edges.clear();
-  auto poseWith = [&](const ContactBody<d>& b, double k) {
-    col::Pose<d> p;
-    if (b.isStatic) {
-      p.x = b.x0;
-      p.R = b.R0;
-      return p;
-    }
-    p.x = b.x0 + dt * (b.v + k * b.dv);
-    p.R = rotationOf<d>(rotatedBy<d>(b.q0, dt * (b.inverseInertia0 * (b.L + k * b.dL))));
-    return p;
-  };
+  const int added =
+      growPairs([&](const ContactBody<d>& b) { return std::array<col::Pose<d>, 2>{reAdvanced(b, 0.0), reAdvanced(b, 1.0)}; });
+  auto poseWith = [&](const ContactBody<d>& b, double k) { return reAdvanced(b, k); };
   // The same test also completes the processed list (notes 1.4, "contact pairs" gathered on the
   // last collision sweep): bodies resting on each other fall together in the candidate
   // positions, so only moving one of them with its new velocity shows that they touch. A
@@ -326,14 +369,8 @@ void ContactWorkspace<d>::computeLevels() {
   }
   levels = con::computeLevels(static_cast<int>(bodies.size()), edges);
   for (ContactPairState& pair : pairs) pair.level = std::max(levels.levelOf[pair.a], levels.levelOf[pair.b]);
-  islandPairsByLevel.resize(islands.pairs.size());
-  for (std::size_t i = 0; i < islands.pairs.size(); ++i) {
-    auto& list = islandPairsByLevel[i];
-    list.clear();
-    for (int p : islands.pairs[i])
-      if (pairs[p].processed) list.push_back(p);
-    std::stable_sort(list.begin(), list.end(), [&](int x, int y) { return pairs[x].level < pairs[y].level; });
-  }
+  sortIslandPairsByLevel();
+  return added;
 }
 
 template <int d>

@@ -132,8 +132,21 @@ class ContactWorkspace {
 
   // Broad phase at the candidate poses, then islands; resets pair flags.
   void findPairs();
-  // Contact-graph levels from the processed pairs (Step III item 1, notes 1.6).
-  void computeLevels();
+  // Contact-graph levels from the processed pairs (Step III item 1, notes 1.6). First grows the
+  // pair list to where the collision impulses sent the bodies (growPairs); returns the pairs
+  // that added.
+  int computeLevels();
+  // Grows each body's broad-phase box to cover `poses(body)` too (a list of poses). If any box
+  // grew, the broad phase runs again: its pairs are a superset of the known ones, which keep
+  // their state; new ones start unprocessed. Islands and the per-island level lists follow.
+  // Returns the number of new pairs. Not in the thesis: the boxes of findPairs cover the motion
+  // with the velocities before Step II, and a body an impulse sends elsewhere (a bounce) could
+  // otherwise meet a body it was never paired with, unseen by every later stage
+  // (docs/architecture.md, "Pairs found again after the impulses").
+  template <typename PosesOf>
+  int growPairs(PosesOf&& poses);
+  // The pose at x^n + dt (v + k dv): k = 1 re-advances with the Step I kick (notes 1.6).
+  solvers::collision::Pose<d> reAdvanced(const ContactBody<d>& b, double k) const;
 
   // One pair update: up to `iterations` impulses at the deepest approaching point.
   // Returns the number of impulses applied.
@@ -230,6 +243,11 @@ class ContactWorkspace {
   std::vector<std::unique_ptr<solvers::collision::PreparedGeometry<d>>> geometries_;
   std::unique_ptr<solvers::collision::BroadPhase<d>> broadPhase_;
   std::vector<Eigen::AlignedBox<double, d>> boxes_;
+  // Takes `found` (sorted, a superset of `pairs`) as the pair list, keeping the known pairs'
+  // state; recomputes the islands and the per-island level lists.
+  void rebuildPairsFrom(const std::vector<std::pair<int, int>>& found);
+  // Per island: its processed pairs, stably sorted by level.
+  void sortIslandPairsByLevel();
   std::vector<char> infinite_;
 };
 

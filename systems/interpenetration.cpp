@@ -19,6 +19,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <utility>
 
 #include "solvers/contact/push_out.h"
@@ -54,8 +55,11 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
   if (ws.bodies.empty()) return;
   for (auto& b : ws.bodies) setBasePose<d>(b, b.body->x, b.body->orientation);
   const ContactSettings& s = ws.settings;
-  std::vector<int> pushes(ws.islands.members.size(), 0);
 
+  // The pairs where Step IV put the bodies (Step III's impulses moved them too), then those that
+  // overlap there though Step II did not process them.
+  int newPairs = ws.growPairs([](const ContactBody<d>& b) { return std::array<col::Pose<d>, 1>{b.candidate}; });
+  std::vector<int> pushes(ws.islands.members.size(), 0);
   // Pairs not processed in Step II that overlap at the advanced positions. Tested in parallel
   // (the queries only read), each in its own slot.
   newOverlap_.assign(ws.pairs.size(), 0);
@@ -243,6 +247,9 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
     });
   }
 
+  // Push-out moved bodies as well: the pairs where it left them, for the measurement below and
+  // for Step V's islands.
+  newPairs += ws.growPairs([](const ContactBody<d>& b) { return std::array<col::Pose<d>, 1>{b.candidate}; });
   // Deepest remaining overlap of any pair of the broad phase (processed in Step II or not),
   // relative to the smaller body's size. Per pair in parallel (the queries only read), then the
   // largest: a maximum does not depend on the order it is taken in.
@@ -279,6 +286,7 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
   for (int n : pushes) total += n;
   ctx.diagnostics.set("push_out_solves", total);
   ctx.diagnostics.set("push_out_new_overlaps", newOverlaps);
+  ctx.diagnostics.set("broad_phase_pairs_added_in_push_out", newPairs);
   ctx.diagnostics.set("max_penetration", worstDepth);
   ctx.diagnostics.set("max_penetration_ratio", worst);
 }
