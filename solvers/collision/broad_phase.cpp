@@ -139,11 +139,12 @@ struct BroadPhase<d>::Impl {
   static bool onCandidate(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
     const Context& c = *static_cast<const Context*>(data);
     const int i = BoxProxy::indexOf(o1), j = BoxProxy::indexOf(o2);
-    if (!bothFlagged(*c.flags, i, j) && touch<d>((*c.boxes)[i], (*c.boxes)[j])) add(i, j, *c.pairs);
+    if (i != j && !bothFlagged(*c.flags, i, j) && touch<d>((*c.boxes)[i], (*c.boxes)[j])) add(i, j, *c.pairs);
     return false;  // keep going: we want every pair
   }
 
-  void dynamicTree(const std::vector<Box>& boxes, const std::vector<char>& flags, std::vector<std::pair<int, int>>& pairs) {
+  // The tree over the bounded boxes, refitted or rebuilt; false if there is nothing in it.
+  bool refreshTree(const std::vector<Box>& boxes) {
     while (proxies.size() < bounded.size()) proxies.push_back(std::make_unique<BoxProxy>(placeholder));
     for (std::size_t k = 0; k < bounded.size(); ++k) {
       const Box& b = boxes[bounded[k]];
@@ -159,12 +160,26 @@ struct BroadPhase<d>::Impl {
       registered.clear();
       for (std::size_t k = 0; k < bounded.size(); ++k) registered.push_back(proxies[k].get());
       registeredIndices = bounded;
-      if (registered.empty()) return;
+      if (registered.empty()) return false;
       manager.registerObjects(registered);
       manager.setup();
     }
+    return true;
+  }
+
+  void dynamicTree(const std::vector<Box>& boxes, const std::vector<char>& flags, std::vector<std::pair<int, int>>& pairs) {
+    if (!refreshTree(boxes)) return;
     Context context{&boxes, &flags, &pairs};
     manager.collide(&context, &Impl::onCandidate);
+  }
+
+  // The bounded pairs with a box of `subset` in them: one tree query per such box.
+  void dynamicTreeTouching(const std::vector<Box>& boxes, const std::vector<char>& flags,
+                           const std::vector<char>& subset, std::vector<std::pair<int, int>>& pairs) {
+    if (!refreshTree(boxes)) return;
+    Context context{&boxes, &flags, &pairs};
+    for (std::size_t k = 0; k < bounded.size(); ++k)
+      if (subset[bounded[k]]) manager.collide(proxies[k].get(), &context, &Impl::onCandidate);
   }
 };
 
@@ -197,6 +212,45 @@ const std::vector<std::pair<int, int>>& BroadPhase<d>::findPairs(const std::vect
   for (int u : impl.unbounded)
     for (int j = 0; j < n; ++j) {
       if (j == u || (j < u && isUnbounded<d>(boxes[j]))) continue;  // each unbounded pair once
+      if (!Impl::bothFlagged(isInfinite, u, j) && touch<d>(boxes[u], boxes[j])) Impl::add(u, j, pairs_);
+    }
+  std::sort(pairs_.begin(), pairs_.end());
+  pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
+  return pairs_;
+}
+
+template <int d>
+const std::vector<std::pair<int, int>>& BroadPhase<d>::findPairsTouching(
+    const std::vector<Eigen::AlignedBox<double, d>>& boxes, const std::vector<char>& isInfinite,
+    const std::vector<char>& subset) {
+  const int n = static_cast<int>(boxes.size());
+  if (static_cast<int>(subset.size()) != n)
+    throw std::invalid_argument("broad phase: subset has " + std::to_string(subset.size()) + " flags for " +
+                                std::to_string(n) + " boxes");
+  if (method_ == BroadPhaseMethod::SweepAndPrune) {
+    // Below the size where the tree pays, a full sweep filtered.
+    findPairs(boxes, isInfinite);
+    pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
+                                [&](const std::pair<int, int>& p) { return !subset[p.first] && !subset[p.second]; }),
+                 pairs_.end());
+    return pairs_;
+  }
+  if (!isInfinite.empty() && static_cast<int>(isInfinite.size()) != n)
+    throw std::invalid_argument("broad phase: isInfinite has " + std::to_string(isInfinite.size()) + " flags for " +
+                                std::to_string(n) + " boxes");
+  Impl& impl = *impl_;
+  impl.bounded.clear();
+  impl.unbounded.clear();
+  for (int i = 0; i < n; ++i) {
+    if (boxes[i].min().hasNaN() || boxes[i].max().hasNaN())
+      throw std::invalid_argument("broad phase: box " + std::to_string(i) + " has a NaN bound");
+    (isUnbounded<d>(boxes[i]) ? impl.unbounded : impl.bounded).push_back(i);
+  }
+  pairs_.clear();
+  impl.dynamicTreeTouching(boxes, isInfinite, subset, pairs_);
+  for (int u : impl.unbounded)
+    for (int j = 0; j < n; ++j) {
+      if (j == u || (j < u && isUnbounded<d>(boxes[j])) || (!subset[u] && !subset[j])) continue;
       if (!Impl::bothFlagged(isInfinite, u, j) && touch<d>(boxes[u], boxes[j])) Impl::add(u, j, pairs_);
     }
   std::sort(pairs_.begin(), pairs_.end());

@@ -26,6 +26,12 @@ class BroadPhase {
   // Reuses internal storage across calls (no allocation per step once warmed up).
   const std::vector<std::pair<int, int>>& findPairs(const std::vector<Eigen::AlignedBox<double, d>>& boxes,
                                                     const std::vector<char>& isInfinite);
+  // The pairs of findPairs that involve at least one box flagged in `subset` (one flag per box),
+  // sorted the same way: after a few boxes grew, their new pairs without a full pass (the tree
+  // is queried with those boxes only).
+  const std::vector<std::pair<int, int>>& findPairsTouching(const std::vector<Eigen::AlignedBox<double, d>>& boxes,
+                                                            const std::vector<char>& isInfinite,
+                                                            const std::vector<char>& subset);
   BroadPhaseMethod method() const { return method_; }
 
  private:

@@ -79,6 +79,37 @@ void expectBothMethodsMatchBruteForce(int n, unsigned seed) {
 TEST(BroadPhase, BothMethodsMatchBruteForceIn3D) { expectBothMethodsMatchBruteForce<3>(500, 1); }
 TEST(BroadPhase, BothMethodsMatchBruteForceIn2D) { expectBothMethodsMatchBruteForce<2>(500, 2); }
 
+// findPairsTouching: the brute-force pairs with at least one box of the subset, after the tree
+// has seen the boxes before some of them grew (as ContactWorkspace::growPairs uses it), with
+// unbounded boxes in and out of the subset.
+template <int d>
+void expectTouchingPairsMatchBruteForce(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<Box<d>> boxes;
+  std::vector<char> flags;
+  randomScene<d>(600, 2 * std::pow(600, 1.0 / d), rng, boxes, flags);
+  BroadPhase<d> sap(BroadPhaseMethod::SweepAndPrune), tree(BroadPhaseMethod::FclDynamicTree);
+  sap.findPairs(boxes, flags);
+  tree.findPairs(boxes, flags);
+  std::uniform_real_distribution<double> coin(0, 1), grow(0, 1.5);
+  std::vector<char> subset(boxes.size(), 0);
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    if (coin(rng) > 0.1 && i % 97 != 5) continue;
+    subset[i] = 1;
+    if (boxes[i].max()[0] < 1e29) boxes[i].max()[0] += grow(rng);  // grown along +x
+  }
+  Pairs expected;
+  for (const auto& p : bruteForce<d>(boxes, flags))
+    if (subset[p.first] || subset[p.second]) expected.push_back(p);
+  ASSERT_GT(expected.size(), 100u);
+  EXPECT_EQ(sap.findPairsTouching(boxes, flags, subset), expected);
+  EXPECT_EQ(tree.findPairsTouching(boxes, flags, subset), expected);
+  EXPECT_THROW(tree.findPairsTouching(boxes, flags, std::vector<char>(3, 1)), std::invalid_argument);
+}
+
+TEST(BroadPhase, PairsTouchingASubsetMatchBruteForceIn3D) { expectTouchingPairsMatchBruteForce<3>(5); }
+TEST(BroadPhase, PairsTouchingASubsetMatchBruteForceIn2D) { expectTouchingPairsMatchBruteForce<2>(6); }
+
 TEST(BroadPhase, MovingAndChangingScenesStayExact) {
   // The tree refits when only bounds move and rebuilds when boxes come and go.
   std::mt19937 rng(3);
