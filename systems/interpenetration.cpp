@@ -49,6 +49,31 @@ void setBasePose(ContactBody<d>& b, const Eigen::Matrix<double, d, 1>& x, const 
 }  // namespace
 
 template <int d>
+template <typename Which>
+void ResolveInterpenetration<d>::measurePairs(const ContactWorkspace<d>& ws, Which&& which) {
+  depth_.resize(ws.pairs.size(), 0.0);
+  ratio_.resize(ws.pairs.size(), 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ws.pairs.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
+    thread_local std::vector<col::ContactPoint<d>> scratch;
+    for (std::size_t k = range.begin(); k != range.end(); ++k) {
+      if (!which(k)) continue;
+      const ContactPairState& p = ws.pairs[k];
+      const ContactBody<d>& A = ws.bodies[p.a];
+      const ContactBody<d>& B = ws.bodies[p.b];
+      depth_[k] = ratio_[k] = 0;
+      if (A.infinite() && B.infinite()) continue;
+      scratch.clear();
+      col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, col::ContactQuery{}, scratch);
+      const double size = std::min(A.geometry->minimumSize(), B.geometry->minimumSize());
+      for (const auto& cp : scratch) {
+        depth_[k] = std::max(depth_[k], cp.depth);
+        ratio_[k] = std::max(ratio_[k], cp.depth / size);
+      }
+    }
+  });
+}
+
+template <int d>
 void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
   (void)world;
   ContactWorkspace<d>& ws = *this->ws_;
@@ -60,26 +85,16 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
   // overlap there though Step II did not process them.
   int newPairs = ws.growPairs([](const ContactBody<d>& b) { return std::array<col::Pose<d>, 1>{b.candidate}; });
   std::vector<int> pushes(ws.islands.members.size(), 0);
-  // Pairs not processed in Step II that overlap at the advanced positions. Tested in parallel
-  // (the queries only read), each in its own slot.
+  // Every pair's deepest overlap where Step IV put the bodies (the queries only read: in
+  // parallel, each in its own slot). It finds the pairs Step II did not process that overlap
+  // (newOverlap_), the islands with nothing to push apart (skipped below: every task there
+  // would find no overlap and stop), and, for pairs push-out does not move, the measurement at
+  // the end.
+  measurePairs(ws, [](std::size_t) { return true; });
   newOverlap_.assign(ws.pairs.size(), 0);
-  if (s.pushOut && s.pushOutNewOverlaps) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ws.pairs.size(), 64),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        thread_local std::vector<col::ContactPoint<d>> scratch;
-                        for (std::size_t k = range.begin(); k != range.end(); ++k) {
-                          const ContactPairState& p = ws.pairs[k];
-                          const ContactBody<d>& A = ws.bodies[p.a];
-                          const ContactBody<d>& B = ws.bodies[p.b];
-                          if (p.processed || (A.infinite() && B.infinite())) continue;
-                          scratch.clear();
-                          col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, col::ContactQuery{},
-                                            scratch);
-                          for (const auto& cp : scratch)
-                            if (cp.depth > s.pushOutTolerance) newOverlap_[k] = 1;
-                        }
-                      });
-  }
+  if (s.pushOut && s.pushOutNewOverlaps)
+    for (std::size_t k = 0; k < ws.pairs.size(); ++k)
+      newOverlap_[k] = !ws.pairs[k].processed && depth_[k] > s.pushOutTolerance;
   int newOverlaps = 0;
   for (char c : newOverlap_) newOverlaps += c;
 
@@ -107,9 +122,22 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
       pairLevel_[k] = std::max(pushLevels_.levelOf[ws.pairs[k].a], pushLevels_.levelOf[ws.pairs[k].b]);
   }
 
+  // An island is pushed apart if one of the pairs push-out takes overlaps.
+  std::vector<char> active(ws.islands.members.size(), 0);
+  moved_.assign(ws.bodies.size(), 0);
+  if (s.pushOut) {
+    for (std::size_t i = 0; i < ws.islands.pairs.size(); ++i) {
+      for (int p : ws.islands.pairs[i])
+        if ((ws.pairs[p].processed || s.pushOutNewOverlaps) && depth_[p] > s.pushOutTolerance) active[i] = 1;
+      if (active[i])
+        for (int m : ws.islands.members[i]) moved_[m] = 1;
+    }
+  }
+
   if (s.pushOut) {
     if (plans_.size() < ws.islands.members.size()) plans_.resize(ws.islands.members.size());
     ws.forEachIsland([&](int island) {
+      if (!active[island]) return;
       // Recorded first as ordered tasks (one per central body and level iteration, then the
       // level's freezes) and run on the arena's threads with the sequential result, as the
       // contact sweeps are (systems/contact_workspace.h). Each island has its own plan slot.
@@ -248,32 +276,18 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
   }
 
   // Push-out moved bodies as well: the pairs where it left them, for the measurement below and
-  // for Step V's islands.
-  newPairs += ws.growPairs([](const ContactBody<d>& b) { return std::array<col::Pose<d>, 1>{b.candidate}; });
-  // Deepest remaining overlap of any pair of the broad phase (processed in Step II or not),
-  // relative to the smaller body's size. Per pair in parallel (the queries only read), then the
-  // largest: a maximum does not depend on the order it is taken in.
-  std::vector<double> pairDepth(ws.pairs.size(), 0.0), pairRatio(ws.pairs.size(), 0.0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ws.pairs.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
-    thread_local std::vector<col::ContactPoint<d>> scratch;
-    for (std::size_t k = range.begin(); k != range.end(); ++k) {
-      const ContactPairState& p = ws.pairs[k];
-      const ContactBody<d>& A = ws.bodies[p.a];
-      const ContactBody<d>& B = ws.bodies[p.b];
-      if (A.infinite() && B.infinite()) continue;
-      scratch.clear();
-      col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, col::ContactQuery{}, scratch);
-      const double size = std::min(A.geometry->minimumSize(), B.geometry->minimumSize());
-      for (const auto& cp : scratch) {
-        pairDepth[k] = std::max(pairDepth[k], cp.depth);
-        pairRatio[k] = std::max(pairRatio[k], cp.depth / size);
-      }
-    }
-  });
+  // for Step V's islands. Then the deepest remaining overlap of any pair of the broad phase
+  // (processed in Step II or not), relative to the smaller body's size: measured again where a
+  // body moved (all pairs, if the list changed), and the largest taken (a maximum does not
+  // depend on the order it is taken in).
+  const int added = ws.growPairs([](const ContactBody<d>& b) { return std::array<col::Pose<d>, 1>{b.candidate}; });
+  newPairs += added;
+  if (added > 0) measurePairs(ws, [](std::size_t) { return true; });
+  else measurePairs(ws, [&](std::size_t k) { return moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]; });
   double worst = 0, worstDepth = 0;
   for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
-    worstDepth = std::max(worstDepth, pairDepth[k]);
-    worst = std::max(worst, pairRatio[k]);
+    worstDepth = std::max(worstDepth, depth_[k]);
+    worst = std::max(worst, ratio_[k]);
   }
 
   for (auto& b : ws.bodies) {

@@ -94,6 +94,12 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
 
  private:
   std::vector<IslandPlan> plans_;
+  // Per pair: its deepest overlap (m) and that over the smaller body's size, as last measured.
+  // `which(k)` picks the pairs measured again; the others keep their values.
+  template <typename Which>
+  void measurePairs(const ContactWorkspace<d>& ws, Which&& which);
+  std::vector<double> depth_, ratio_;
+  std::vector<char> moved_;       // per body: in an island push-out worked on
   std::vector<char> newOverlap_;  // per pair: not processed in Step II, yet overlapping now
   std::vector<int> pairLevel_;    // per pair: its level in push-out
   std::vector<std::pair<int, int>> edges_;

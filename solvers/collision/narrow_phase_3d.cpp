@@ -178,12 +178,43 @@ void generalPair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
   }
 }
 
+// A sphere (a) against a sphere or a half-space (b) in closed form: the contact featureContacts
+// gives them (a's centre as a feature point of a's radius against b's exact signed distance),
+// computed in the world frame without the relative pose and the feature list. These are most
+// of the queries of a pour; the general route costs several times more.
+void sphereContacts(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb, double margin,
+                    std::vector<CP>& out) {
+  const Geometry<3>& gb = b.geometry();
+  Vec3 normal, onB;  // normal out of b, towards a's centre
+  double distance;   // of a's centre from b's surface
+  if (gb.type == GeometryType::Sphere) {
+    const Vec3 q = pa.x - pb.x;
+    const double len = q.norm();
+    normal = len > 0 ? Vec3(q / len) : Vec3(pb.R.col(1));  // coincident: b's y axis, as signedDistance
+    distance = len - gb.radius;
+    onB = pb.x + gb.radius * normal;
+  } else {
+    normal = pb.R * gb.normal;
+    distance = normal.dot(pa.x - pb.x) - gb.offset;
+    onB = pa.x - distance * normal;
+  }
+  const double radius = a.geometry().radius, depth = radius - distance;
+  if (!(depth >= -margin)) return;
+  CP c;
+  c.point = 0.5 * (onB + (pa.x - radius * normal));
+  c.normal = normal;
+  c.depth = depth;
+  out.push_back(c);
+}
+
 // A and B in the order the routines expect: a half-space is B, a sphere is A (unless the other is
 // a mesh), a mesh is B.
 void orderedContacts(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb, double margin, double scale,
                      Scratch& s) {
   const GeometryType ta = typeOf(a), tb = typeOf(b);
-  if (tb == GeometryType::HalfSpace || (ta == GeometryType::Sphere && tb != GeometryType::Mesh)) {
+  if (ta == GeometryType::Sphere && (tb == GeometryType::Sphere || tb == GeometryType::HalfSpace)) {
+    sphereContacts(a, pa, b, pb, margin, s.result);
+  } else if (tb == GeometryType::HalfSpace || (ta == GeometryType::Sphere && tb != GeometryType::Mesh)) {
     const Vec3 towardsB = tb == GeometryType::HalfSpace ? Vec3(-(pb.R * b.geometry().normal)) : Vec3(pb.x - pa.x);
     featureContacts<3>(a, pa, towardsB, b, pb, margin, false, s.features, s.result);
   } else if (ta == GeometryType::Capsule && tb == GeometryType::Capsule) {

@@ -418,6 +418,21 @@ TEST(NarrowPhase3, SeparatedEdgesWithinMarginUseTheDistance) {
   EXPECT_NEAR((got[0].point - Vec3(0, kSqrt2 / 2 + 0.002, 0)).norm(), 0, 1e-5);
 }
 
+TEST(NarrowPhase3, SphereAgainstARotatedOffsetHalfSpaceAndACoincidentSphere) {
+  // The closed-form sphere route (sphereContacts) in the world frame: a half-space with local
+  // normal y and offset 0.2, turned 90 degrees about z and moved to x = 1, so its surface is the
+  // plane x = 0.8 with normal -x; a sphere of radius 0.3 at x = 0.6 is 0.1 deep.
+  const Geometry<3> wall = halfSpace<3>(Vec3::UnitY(), 0.2);
+  auto got = contacts<3>(sphere3(0.3), at(Vec3(0.6, 5, 7)), wall, at(Vec3(1, 0, 0), rot(kPi / 2, Vec3::UnitZ())));
+  expectManifold<3>(got, {Vec3(0.85, 5, 7)}, -Vec3::UnitX(), 0.1, 1e-12);
+  // Coincident centres: the normal is b's y axis (here world z), as the general route's
+  // signedDistance takes it; the depth is the sum of the radii.
+  got = contacts<3>(sphere3(0.5), at(Vec3(1, 2, 3)), sphere3(0.4), at(Vec3(1, 2, 3), rot(kPi / 2, Vec3::UnitX())));
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_LT((got[0].normal - Vec3::UnitZ()).norm(), 1e-12);
+  EXPECT_NEAR(got[0].depth, 0.9, 1e-12);
+}
+
 TEST(NarrowPhase3, MarginAroundHalfSpacesAndSpheres) {
   const Geometry<3> ground = halfSpace<3>(Vec3::UnitY(), 0);
   auto got = contacts<3>(box3(0.5, 0.5, 0.5), at(Vec3(0, 0.503, 0)), ground, at(Vec3::Zero()), 0.005);
