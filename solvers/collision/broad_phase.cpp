@@ -194,47 +194,30 @@ BroadPhase<d>::~BroadPhase() {
 template <int d>
 const std::vector<std::pair<int, int>>& BroadPhase<d>::findPairs(const std::vector<Eigen::AlignedBox<double, d>>& boxes,
                                                                  const std::vector<char>& isInfinite) {
-  const int n = static_cast<int>(boxes.size());
-  if (!isInfinite.empty() && static_cast<int>(isInfinite.size()) != n)
-    throw std::invalid_argument("broad phase: isInfinite has " + std::to_string(isInfinite.size()) + " flags for " +
-                                std::to_string(n) + " boxes");
-  Impl& impl = *impl_;
-  impl.bounded.clear();
-  impl.unbounded.clear();
-  for (int i = 0; i < n; ++i) {
-    if (boxes[i].min().hasNaN() || boxes[i].max().hasNaN())
-      throw std::invalid_argument("broad phase: box " + std::to_string(i) + " has a NaN bound");
-    (isUnbounded<d>(boxes[i]) ? impl.unbounded : impl.bounded).push_back(i);
-  }
-  pairs_.clear();
-  if (method_ == BroadPhaseMethod::SweepAndPrune) impl.sweepAndPrune(boxes, isInfinite, pairs_);
-  else impl.dynamicTree(boxes, isInfinite, pairs_);
-  for (int u : impl.unbounded)
-    for (int j = 0; j < n; ++j) {
-      if (j == u || (j < u && isUnbounded<d>(boxes[j]))) continue;  // each unbounded pair once
-      if (!Impl::bothFlagged(isInfinite, u, j) && touch<d>(boxes[u], boxes[j])) Impl::add(u, j, pairs_);
-    }
-  std::sort(pairs_.begin(), pairs_.end());
-  pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
-  return pairs_;
+  return collect(boxes, isInfinite, nullptr);
 }
 
 template <int d>
 const std::vector<std::pair<int, int>>& BroadPhase<d>::findPairsTouching(
     const std::vector<Eigen::AlignedBox<double, d>>& boxes, const std::vector<char>& isInfinite,
     const std::vector<char>& subset) {
-  const int n = static_cast<int>(boxes.size());
-  if (static_cast<int>(subset.size()) != n)
+  if (subset.size() != boxes.size())
     throw std::invalid_argument("broad phase: subset has " + std::to_string(subset.size()) + " flags for " +
-                                std::to_string(n) + " boxes");
-  if (method_ == BroadPhaseMethod::SweepAndPrune) {
-    // Below the size where the tree pays, a full sweep filtered.
-    findPairs(boxes, isInfinite);
-    pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
-                                [&](const std::pair<int, int>& p) { return !subset[p.first] && !subset[p.second]; }),
-                 pairs_.end());
-    return pairs_;
-  }
+                                std::to_string(boxes.size()) + " boxes");
+  if (method_ == BroadPhaseMethod::FclDynamicTree) return collect(boxes, isInfinite, &subset);
+  // Below the size where the tree pays, a full sweep, filtered.
+  collect(boxes, isInfinite, nullptr);
+  pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
+                              [&](const std::pair<int, int>& p) { return !subset[p.first] && !subset[p.second]; }),
+               pairs_.end());
+  return pairs_;
+}
+
+template <int d>
+const std::vector<std::pair<int, int>>& BroadPhase<d>::collect(const std::vector<Eigen::AlignedBox<double, d>>& boxes,
+                                                               const std::vector<char>& isInfinite,
+                                                               const std::vector<char>* subset) {
+  const int n = static_cast<int>(boxes.size());
   if (!isInfinite.empty() && static_cast<int>(isInfinite.size()) != n)
     throw std::invalid_argument("broad phase: isInfinite has " + std::to_string(isInfinite.size()) + " flags for " +
                                 std::to_string(n) + " boxes");
@@ -247,10 +230,13 @@ const std::vector<std::pair<int, int>>& BroadPhase<d>::findPairsTouching(
     (isUnbounded<d>(boxes[i]) ? impl.unbounded : impl.bounded).push_back(i);
   }
   pairs_.clear();
-  impl.dynamicTreeTouching(boxes, isInfinite, subset, pairs_);
+  if (subset) impl.dynamicTreeTouching(boxes, isInfinite, *subset, pairs_);
+  else if (method_ == BroadPhaseMethod::SweepAndPrune) impl.sweepAndPrune(boxes, isInfinite, pairs_);
+  else impl.dynamicTree(boxes, isInfinite, pairs_);
   for (int u : impl.unbounded)
     for (int j = 0; j < n; ++j) {
-      if (j == u || (j < u && isUnbounded<d>(boxes[j])) || (!subset[u] && !subset[j])) continue;
+      if (j == u || (j < u && isUnbounded<d>(boxes[j]))) continue;  // each unbounded pair once
+      if (subset && !(*subset)[u] && !(*subset)[j]) continue;
       if (!Impl::bothFlagged(isInfinite, u, j) && touch<d>(boxes[u], boxes[j])) Impl::add(u, j, pairs_);
     }
   std::sort(pairs_.begin(), pairs_.end());

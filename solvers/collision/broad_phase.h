@@ -35,6 +35,9 @@ class BroadPhase {
   BroadPhaseMethod method() const { return method_; }
 
  private:
+  // Both queries: the pairs of all boxes, or (tree only) those with a box of `subset`.
+  const std::vector<std::pair<int, int>>& collect(const std::vector<Eigen::AlignedBox<double, d>>& boxes,
+                                                  const std::vector<char>& isInfinite, const std::vector<char>* subset);
   BroadPhaseMethod method_;
   struct Impl;
   Impl* impl_;
