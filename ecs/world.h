@@ -75,7 +75,7 @@ struct ContactSettings {
   int shockLevelIterations = 2;      // the thesis code's (8 were needed before projectFriction)
   int shockPairIterations = 40;      // measured: a 2-D pyramid's joint solves need them (docs/benchmarks.md)
   bool pushOut = true;               // interpenetration resolution, Sec. 4.6.1 / App. B
-  int pushOutLevelIterations = 3;    // thesis code: 2; measured on box_stack_scatter (docs/benchmarks.md)
+  int pushOutLevelIterations = 6;    // thesis code: 2; measured on piles (docs/benchmarks.md, "Six push-out passes")
   int pushOutBodyIterations = 5;
   // Push-out also separates pairs that Steps II-III never saw interpenetrating (not "processed")
   // but that overlap after Step IV's positions: a body moved by contact or by another push-out

@@ -307,8 +307,9 @@ TEST(MixedPile, EveryShapeSettlesWithoutEnergyGainOrDeepOverlap) {
   // only pairs Step II had processed were measured, 0.28 % here). Measured that way it is 1.28 %
   // (steps 149-167: a body wedged between two static walls and a neighbour); over 8 runs with
   // dt and gravity changed by 1-3 % it was 0.20-1.28 %, and 0.47-1.49 % with the thesis's
-  // push-out (docs/benchmarks.md, "Push-out of new overlaps"). With the pairs also found again
-  // where the impulses sent the bodies (growPairs), 0.28 %, and 0.17-0.79 % over those 8 runs.
+  // push-out (docs/benchmarks.md, "Overlaps no stage saw"). With the pairs also found again
+  // where the impulses sent the bodies (growPairs), 0.28 %, and 0.17-0.79 % over those 8 runs;
+  // with 6 push-out passes 0.10 % and 0.01-0.36 %.
   EXPECT_LE(runToEndWatching(sim, watch), 0.01);
   // Settled: the energy left at t = 4 s is a snapshot of a chaotic pile, in which a sphere or
   // cylinder may still be rolling off it (no rolling resistance). Over 16 runs with dt and
@@ -365,9 +366,8 @@ TEST(PushOutNewOverlaps, APushIntoAnUntouchedNeighbourIsUndoneInTheSameStep) {
 
 TEST(PushOutNewOverlaps, SliverShardsNoLongerSinkThroughEachOther) {
   // The frame-rate sliver scene: with the thesis's push-out (processed pairs only) a shard was
-  // driven 18 % of its thickness into another that Step II had not seen touching, which the
-  // overlap metric (every broad-phase pair) shows; with the new overlaps pushed apart too, the
-  // deepest is 0.52 % (docs/benchmarks.md, "Push-out of new overlaps").
+  // driven deep into another that Step II had not seen touching, which the overlap metric
+  // (every broad-phase pair) shows; with the new overlaps pushed apart too, it is not.
   const Registry registry = builtins();
   auto deepest = [&](bool newOverlaps) {
     Simulation<3> sim(loadScene(kScenes + "sliver_shards.json",
@@ -378,8 +378,8 @@ TEST(PushOutNewOverlaps, SliverShardsNoLongerSinkThroughEachOther) {
     watch.expectNoGain(std::abs(watch.initialTotal));
     return worst;
   };
-  // 17.9 % and 1.56 %; over 8 runs with dt and gravity changed by 1-3 %, 12.6-103 % and
-  // 0.34-6.68 % (docs/benchmarks.md, "Pairs found again after the impulses").
+  // 44 % and 1.16 %; over 8 runs with dt and gravity changed by 1-3 %, 12.7-119 % and
+  // 0.30-1.93 % (docs/benchmarks.md, "Overlaps no stage saw" and "Six push-out passes").
   EXPECT_GT(deepest(false), 0.10);
   EXPECT_LT(deepest(true), 0.02);
 }
