@@ -336,7 +336,6 @@ int ContactWorkspace<d>::computeLevels() {
   edges.clear();
   const int added =
       growPairs([&](const ContactBody<d>& b) { return std::array<col::Pose<d>, 2>{reAdvanced(b, 0.0), reAdvanced(b, 1.0)}; });
-  auto poseWith = [&](const ContactBody<d>& b, double k) { return reAdvanced(b, k); };
   // The same test also completes the processed list (notes 1.4, "contact pairs" gathered on the
   // last collision sweep): bodies resting on each other fall together in the candidate
   // positions, so only moving one of them with its new velocity shows that they touch. A
@@ -347,7 +346,7 @@ int ContactWorkspace<d>::computeLevels() {
   auto touches = [&](const ContactBody<d>& mover, const ContactBody<d>& other) {
     thread_local std::vector<col::ContactPoint<d>> scratch;
     scratch.clear();
-    return col::findContacts(*mover.geometry, poseWith(mover, 1.0), *other.geometry, poseWith(other, 0.0), query,
+    return col::findContacts(*mover.geometry, reAdvanced(mover, 1.0), *other.geometry, reAdvanced(other, 0.0), query,
                              scratch) > 0;
   };
   // The tests only read the bodies: each pair's two answers in its own slot, in parallel, then

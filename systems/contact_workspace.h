@@ -249,6 +249,9 @@ class ContactWorkspace {
   // Per island: its processed pairs, stably sorted by level.
   void sortIslandPairsByLevel();
   std::vector<char> infinite_;
+  // growPairs' buffers: which boxes grew, and the merged pair list.
+  std::vector<char> grew_;
+  std::vector<std::pair<int, int>> mergedPairs_;
 };
 
 }  // namespace monolith

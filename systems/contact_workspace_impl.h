@@ -26,7 +26,8 @@ template <int d>
 template <typename PosesOf>
 int ContactWorkspace<d>::growPairs(PosesOf&& poses) {
   const std::size_t n = bodies.size();
-  std::vector<char> grew(n, 0);
+  std::vector<char>& grew = grew_;  // kept across calls: no allocation per step
+  grew.assign(n, 0);
   const VecD pad = VecD::Constant(settings.thickness);
   // Each body's box in its own slot: a plain parallel loop.
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -60,8 +61,8 @@ int ContactWorkspace<d>::growPairs(PosesOf&& poses) {
   }
   // Few grew: only pairs with a grown box can be new, merged with the known ones (both sorted).
   const auto& touching = broadPhase_->findPairsTouching(boxes_, infinite_, grew);
-  std::vector<std::pair<int, int>> all;
-  all.reserve(pairs.size() + touching.size());
+  std::vector<std::pair<int, int>>& all = mergedPairs_;
+  all.clear();
   std::size_t k = 0;
   for (const auto& t : touching) {
     while (k < pairs.size() && std::make_pair(pairs[k].a, pairs[k].b) < t) {

@@ -71,6 +71,15 @@ double runToEndWatching(Simulation<3>& sim, EnergyWatch& watch) {
   return worst;
 }
 
+// Runs a scene to its end, expecting no energy gain; returns its deepest overlap (as above).
+double deepestOverlapWithoutEnergyGain(const SceneSpec& scene, const Registry& registry) {
+  Simulation<3> sim(scene, registry);
+  EnergyWatch watch;
+  const double worst = runToEndWatching(sim, watch);
+  watch.expectNoGain(std::abs(watch.initialTotal));
+  return worst;
+}
+
 template <int d>
 Eigen::Matrix<double, d, 1> positionOf(Simulation<d>& sim, const std::string& name) {
   return sim.world().template get<RigidBody<d>>(*sim.world().find(name))->x;
@@ -377,13 +386,10 @@ TEST(PushOutNewOverlaps, SliverShardsNoLongerSinkThroughEachOther) {
   // (every broad-phase pair) shows; with the new overlaps pushed apart too, it is not.
   const Registry registry = builtins();
   auto deepest = [&](bool newOverlaps) {
-    Simulation<3> sim(loadScene(kScenes + "sliver_shards.json",
-                                {{"solvers.contact.push_out_new_overlaps", newOverlaps ? "true" : "false"}}),
-                      registry);
-    EnergyWatch watch;
-    const double worst = runToEndWatching(sim, watch);
-    watch.expectNoGain(std::abs(watch.initialTotal));
-    return worst;
+    return deepestOverlapWithoutEnergyGain(
+        loadScene(kScenes + "sliver_shards.json",
+                  {{"solvers.contact.push_out_new_overlaps", newOverlaps ? "true" : "false"}}),
+        registry);
   };
   // 44 % and 1.16 %; over 8 runs with dt and gravity changed by 1-3 %, 12.7-119 % and
   // 0.30-1.93 % (docs/benchmarks.md, "Overlaps no stage saw" and "Six push-out passes").
@@ -414,13 +420,10 @@ double randomSliverDrop(unsigned seed, bool newOverlaps, const Registry& registr
          << 8 * unit(rng) << ", " << 8 * unit(rng) << R"(]}, "collider": {"restitution": 0.5, "friction": 0.6}})";
   }
   text << "]}";
-  Simulation<3> sim(parseScene(text.str(), "random_slivers.json",
-                               {{"solvers.contact.push_out_new_overlaps", newOverlaps ? "true" : "false"}}),
-                    registry);
-  EnergyWatch watch;
-  const double worst = runToEndWatching(sim, watch);
-  watch.expectNoGain(std::abs(watch.initialTotal));
-  return worst;
+  return deepestOverlapWithoutEnergyGain(
+      parseScene(text.str(), "random_slivers.json",
+                 {{"solvers.contact.push_out_new_overlaps", newOverlaps ? "true" : "false"}}),
+      registry);
 }
 
 TEST(RandomSliverDrops, MostKeepTheirOverlapsShallow) {

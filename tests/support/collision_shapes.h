@@ -14,12 +14,15 @@ inline solvers::collision::Geometry<3> box3(double hx, double hy, double hz) {
   g.halfExtents = Eigen::Vector3d(hx, hy, hz);
   return g;
 }
-inline solvers::collision::Geometry<3> sphere3(double r) {
-  solvers::collision::Geometry<3> g;
+// A sphere in 3-D, a disk in 2-D.
+template <int d>
+solvers::collision::Geometry<d> ball(double r) {
+  solvers::collision::Geometry<d> g;
   g.type = solvers::collision::GeometryType::Sphere;
   g.radius = r;
   return g;
 }
+inline solvers::collision::Geometry<3> sphere3(double r) { return ball<3>(r); }
 inline solvers::collision::Geometry<3> capsule3(double r, double h) {
   solvers::collision::Geometry<3> g;
   g.type = solvers::collision::GeometryType::Capsule;
@@ -46,11 +49,6 @@ inline solvers::collision::Geometry<2> box2(double hx, double hy) {
   g.halfExtents = Eigen::Vector2d(hx, hy);
   return g;
 }
-inline solvers::collision::Geometry<2> disk(double r) {
-  solvers::collision::Geometry<2> g;
-  g.type = solvers::collision::GeometryType::Sphere;
-  g.radius = r;
-  return g;
-}
+inline solvers::collision::Geometry<2> disk(double r) { return ball<2>(r); }
 
 }  // namespace monolith::test
