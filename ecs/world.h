@@ -81,6 +81,9 @@ struct ContactSettings {
   // but that overlap after Step IV's positions: a body moved by contact or by another push-out
   // into a neighbour (not in the thesis, whose push-out keeps to the saved pairs; Sec. 4.6.1).
   bool pushOutNewOverlaps = true;
+  // With pushOutNewOverlaps: rounds of push-out while a push carries a body into one it was not
+  // paired with (found only by the broad phase grown after the round; not in the thesis).
+  int pushOutRounds = 4;
   bool velocityContact = true;       // second contact step in Step V (Sec. 2.3.2 "Contact Clamping")
   bool energyClamp = true;           // Sec. 2.3.2 for collisions and the second contact step
   // Step II: a pair moving more than half its thinner body's size in the step is tested at its

@@ -89,6 +89,7 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
     std::vector<std::pair<int, int>> bodyPair;  // (level member, pair), grouped by member
     std::vector<std::pair<int, int>> range;     // per level member: its pairs in centralPairs
     std::vector<int> pairsByLevel;  // the island's pairs to push apart, ascending level
+    std::vector<std::pair<int, int>> focusByLevel;  // a focused round's bodies: (level, body)
     solvers::parallel::OrderedTasks order;
   };
 
@@ -99,6 +100,20 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   template <typename Which>
   void measurePairs(const ContactWorkspace<d>& ws, Which&& which);
   std::vector<double> depth_, ratio_;
+  // Per pair: whether it overlaps though Step II did not process it (newOverlap_); returns how
+  // many do.
+  int markNewOverlaps(const ContactWorkspace<d>& ws);
+  // The levels push-out runs by (pairLevel_ per pair): the contact graph's, or with new overlaps
+  // those of its copy with an edge both ways per new overlap.
+  const solvers::contact::ContactLevels& pushLevels(const ContactWorkspace<d>& ws, int newOverlaps);
+  // One round of push-out over the islands marked in active_; returns the central-body solves.
+  // focused: only the pairs with a body in focus_ (the rounds after the first).
+  int pushApart(ContactWorkspace<d>& ws, const solvers::contact::ContactLevels& levels, bool focused);
+  std::vector<char> active_;      // per island: pushed apart in this round
+  std::vector<char> focus_;       // per body: worked on in the next round
+  std::vector<std::pair<int, int>> knownPairs_;  // the pairs before a round's growth
+  std::vector<double> knownDepth_, knownRatio_;  // and their measurements
+  std::vector<int> knownIndex_;                  // per pair after the growth: its index before, or -1
   std::vector<char> moved_;       // per body: in an island push-out worked on
   std::vector<char> newOverlap_;  // per pair: not processed in Step II, yet overlapping now
   std::vector<int> pairLevel_;    // per pair: its level in push-out

@@ -380,6 +380,48 @@ TEST(PushOutNewOverlaps, APushIntoAnUntouchedNeighbourIsUndoneInTheSameStep) {
   }
 }
 
+TEST(PushOutRounds, APushPastTheBroadPhaseBoxIsUndoneInTheSameStep) {
+  // As above, but D sits 2 cm above C's bounding box (a 1 m cube 1.97 m up), so the pair
+  // (C, D) is not in the broad phase when push-out starts. Lifting C 5 cm out of A drives it 3 cm
+  // into D; only the broad phase grown after that push finds the pair. One round leaves the
+  // overlap (the figure is reported but not pushed apart); a second round, on the bodies of the
+  // pair it found, separates them in the same step.
+  const Registry registry = builtins();
+  auto run = [&](int rounds) {
+    const std::string text = R"({"dimension": 3, "time": {"dt": 0.03333333333333333, "end": 0.03333333333333333},
+      "gravity": [0, 0, 0], "entities": [
+      {"name": "A", "shape": {"type": "box", "half_extents": [0.5, 0.5, 0.5]},
+       "rigid_body": {"static": true}, "collider": {"restitution": 0, "friction": 0.5}},
+      {"name": "C", "shape": {"type": "sphere", "radius": 0.5},
+       "rigid_body": {"mass": 1, "position": [0, 0.95, 0]}, "collider": {"restitution": 0, "friction": 0.5}},
+      {"name": "D", "shape": {"type": "box", "half_extents": [0.5, 0.5, 0.5]},
+       "rigid_body": {"mass": 1, "position": [0, 1.97, 0]}, "collider": {"restitution": 0, "friction": 0.5}}]})";
+    const SceneSpec scene =
+        parseScene(text, "past_the_box.json", {{"solvers.contact.push_out_rounds", std::to_string(rounds)}});
+    Simulation<3> sim(scene, registry);
+    const auto diag = sim.step();
+    struct Result {
+      double depth, rounds, left, cY, dY, ke;
+    } r{diag.at("max_penetration"),         diag.at("push_out_rounds"), diag.at("push_out_overlaps_found_after"),
+        bodyOf(sim, "C").x.y(),             bodyOf(sim, "D").x.y(),     diag.at("kinetic_energy")};
+    return r;
+  };
+  const auto one = run(1), four = run(4);
+  // One round: C out of A (top at 1.5 m), D untouched, 1.5 - 1.47 = 3 cm deep in it.
+  EXPECT_NEAR(one.cY, 1.0, 1e-4);
+  EXPECT_EQ(one.dY, 1.97);
+  EXPECT_NEAR(one.depth, 0.03, 1e-4);
+  EXPECT_EQ(one.left, 1.0);
+  // Up to four (the default): a second round separates them; nothing deeper than push-out's
+  // tolerance (1e-5 m) is left, C is still out of A and no velocity was made.
+  EXPECT_EQ(four.rounds, 2.0);
+  EXPECT_EQ(four.left, 0.0);
+  EXPECT_LT(four.depth, 1e-5);
+  EXPECT_GT(four.dY, 1.97 + 0.02);
+  EXPECT_GT(four.cY, 1.0 - 1e-4);
+  EXPECT_EQ(four.ke, 0.0);
+}
+
 TEST(PushOutNewOverlaps, SliverShardsNoLongerSinkThroughEachOther) {
   // The frame-rate sliver scene: with the thesis's push-out (processed pairs only) a shard was
   // driven deep into another that Step II had not seen touching, which the overlap metric
