@@ -153,6 +153,12 @@ bool ContactWorkspace<d>::pack(World<d>& world, double stepDt, bool subtractKick
         b.L -= b.dL;
       }
       b.movedStamp = 0;
+      b.turnFree = false;
+      if constexpr (d == 3) {
+        const auto& I = rb->inertiaBodyInverse;
+        b.turnFree = b.geometry->geometry().type == col::GeometryType::Sphere && I.isDiagonal(0) &&
+                     I(0, 0) == I(1, 1) && I(1, 1) == I(2, 2);
+      }
       updateCandidate(b);
     }
   };
@@ -212,6 +218,11 @@ void ContactWorkspace<d>::updateCandidate(ContactBody<d>& b) const {
   }
   const double k = kick ? 1.0 : 0.0;
   b.candidate.x = b.x0 + dt * (b.v + k * b.dv);
+  if (b.turnFree) {
+    b.candidate.R = b.R0;
+    b.inverseInertiaCandidate = b.body->inertiaBodyInverse;  // c I, the same in every frame
+    return;
+  }
   const con::AngVec<d> w = b.inverseInertia0 * (b.L + k * b.dL);
   b.candidate.R = rotationOf<d>(rotatedBy<d>(b.q0, dt * w));
   if constexpr (d == 3) b.inverseInertiaCandidate = b.candidate.R * b.body->inertiaBodyInverse * b.candidate.R.transpose();
@@ -286,7 +297,7 @@ col::Pose<d> ContactWorkspace<d>::reAdvanced(const ContactBody<d>& b, double k) 
     return p;
   }
   p.x = b.x0 + dt * (b.v + k * b.dv);
-  p.R = rotationOf<d>(rotatedBy<d>(b.q0, dt * (b.inverseInertia0 * (b.L + k * b.dL))));
+  p.R = b.turnFree ? b.R0 : rotationOf<d>(rotatedBy<d>(b.q0, dt * (b.inverseInertia0 * (b.L + k * b.dL))));
   return p;
 }
 
@@ -457,7 +468,9 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
   // K and the Jacobian rows only when something approaches (a solve follows).
   const con::AngMat<d> Ia = finiteA ? splitA : con::AngMat<d>::Zero();
   const con::AngMat<d> Ib = finiteB ? splitB : con::AngMat<d>::Zero();
-  for (Point& p : points) p.prepare(A.inverseMass() + B.inverseMass(), Ia, Ib, points.size() == 1);
+  if (points.size() == 1) points[0].prepareOnePoint(A.inverseMass() + B.inverseMass(), Ia, Ib);
+  else
+    for (Point& p : points) p.prepare(A.inverseMass() + B.inverseMass(), Ia, Ib);
 
   // Working copies (state): the impulse of the whole pair is found first, then (second contact
   // step, collisions) clamped as one against the state before it (Sec. 2.3.2) and applied.
@@ -565,7 +578,7 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
   const con::AngMat<d> none = con::AngMat<d>::Zero();
   double speedScale = 0;
   for (Point& p : points) {
-    p.prepare(C.inverseMass(), Iinv, none, false);
+    p.prepare(C.inverseMass(), Iinv, none);
     speedScale = std::max(speedScale, std::abs(p.target));
   }
   const double tolerance = 1e-7 * speedScale + 1e-12;

@@ -53,6 +53,10 @@ struct ContactBody {
   const solvers::collision::PreparedGeometry<d>* geometry = nullptr;
   bool isStatic = false, kinematic = false;
   bool frozen = false;  // shock propagation / push-out: treated as infinitely massive for now
+  // A sphere with isotropic inertia (3-D): its orientation changes neither its shape in the
+  // world nor its world inertia, so candidate poses skip turning it (a sphere pour spent about
+  // 15 % of its time there).
+  bool turnFree = false;
   double mass = 1, restitution = 0, friction = 0;
   // The base configuration (time n in Steps II-IV, time n+1 in Step V).
   VecD x0 = VecD::Zero();

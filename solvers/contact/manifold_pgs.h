@@ -29,7 +29,7 @@ struct PgsPoint {
   using AngTangent = Eigen::Matrix<double, kAngularDim<d>, d - 1>;
 
   VecD ra = VecD::Zero(), rb = VecD::Zero(), n = VecD::Zero();  // lever arms, normal out of b
-  Mat<d> K = Mat<d>::Zero();  // K_a + K_b at the point (impulse.h), prepared for one-point manifolds
+  Mat<d> K = Mat<d>::Zero();  // K_a + K_b at the point (impulse.h): prepareOnePoint only
   double target = 0, mu = 0;  // target normal velocity, Coulomb coefficient
   // Constant velocity of the partner at the point (joint solve against frozen bodies), else 0.
   VecD partnerVelocity = VecD::Zero();
@@ -58,15 +58,9 @@ struct PgsPoint {
   // inverseMasses: m_a^{-1} + m_b^{-1}; Ia, Ib: the inverse inertias the impulses are applied
   // with (zero for a body of infinite mass). K's blocks come from the Jacobian rows:
   // u.K v = (m_a^{-1} + m_b^{-1}) u.v + (r_a x u).I_a^{-1}(r_a x v) + (r_b x u).I_b^{-1}(r_b x v),
-  // with T^T n = 0 and T^T T = 1 (K itself, 3x3, only for a one-point manifold: withK).
-  void prepare(double inverseMasses, const AngMat<d>& Ia, const AngMat<d>& Ib, bool withK) {
-    if constexpr (d == 3) {
-      const VecD t1 = (std::abs(n.x()) < 0.6 ? VecD::UnitX() : VecD::UnitY()).cross(n).normalized();
-      T.col(0) = t1;
-      T.col(1) = n.cross(t1);
-    } else {
-      T.col(0) = VecD(-n.y(), n.x());
-    }
+  // with T^T n = 0 and T^T T = 1 (K itself, 3x3, only for a one-point manifold: prepareOnePoint).
+  void prepare(double inverseMasses, const AngMat<d>& Ia, const AngMat<d>& Ib) {
+    setTangentBasis();
     // A body of infinite mass (zero inverse inertia) adds nothing to K: its terms are skipped,
     // its I^{-1}(r x u) stay zero (a fresh point).
     const bool rotatesA = !Ia.isZero(0), rotatesB = !Ib.isZero(0);
@@ -111,10 +105,26 @@ struct PgsPoint {
       tangentStiffness[0] = Ktt(0, 0);
     }
     inverseTangentMassNorm2 = 1 / tangentMass.squaredNorm();
-    if (withK) {
-      const CrossMat<d> ca = crossMatrix<d>(ra), cb = crossMatrix<d>(rb);
-      K = inverseMasses * Mat<d>::Identity() + ca.transpose() * Ia * ca + cb.transpose() * Ib * cb;
+  }
+  // What a one-point manifold's closed-form impulse (impulse.h) needs, and nothing else: the
+  // tangent basis and K. The Jacobian rows and the tangent-plane blocks are the sweeps' (about
+  // 10 % of a sphere pour's time went into preparing them for points that never swept).
+  void prepareOnePoint(double inverseMasses, const AngMat<d>& Ia, const AngMat<d>& Ib) {
+    setTangentBasis();
+    setK(inverseMasses, Ia, Ib);
+  }
+  void setTangentBasis() {
+    if constexpr (d == 3) {
+      const VecD t1 = (std::abs(n.x()) < 0.6 ? VecD::UnitX() : VecD::UnitY()).cross(n).normalized();
+      T.col(0) = t1;
+      T.col(1) = n.cross(t1);
+    } else {
+      T.col(0) = VecD(-n.y(), n.x());
     }
+  }
+  void setK(double inverseMasses, const AngMat<d>& Ia, const AngMat<d>& Ib) {
+    const CrossMat<d> ca = crossMatrix<d>(ra), cb = crossMatrix<d>(rb);
+    K = inverseMasses * Mat<d>::Identity() + ca.transpose() * Ia * ca + cb.transpose() * Ib * cb;
   }
   static AngVec<d> crossOf(const VecD& r, const VecD& u) {
     if constexpr (d == 3) return r.cross(u);

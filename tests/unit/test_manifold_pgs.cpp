@@ -37,7 +37,7 @@ struct CubeOnPlane {
         p.target = 0;  // approaching corners stop; the others must not start to approach
         points.push_back(p);
       }
-    for (auto& p : points) p.prepare(1 / mass, inverseInertia, M3::Zero(), false);
+    for (auto& p : points) p.prepare(1 / mass, inverseInertia, M3::Zero());
   }
 };
 
@@ -151,7 +151,7 @@ TEST(ManifoldPgs, TwoMovingBodiesKeepTheirTotalMomentum) {
       points.push_back(p);
     }
   const M3 I = 6.0 * M3::Identity();
-  for (auto& p : points) p.prepare(2.0, I, I, false);
+  for (auto& p : points) p.prepare(2.0, I, I);
   const V3 momentum = s.va + s.vb;
   pgsSolve<3>(points, s, 500, 1e-15);
   EXPECT_LT((s.va + s.vb - momentum).norm(), 1e-12);
@@ -198,7 +198,7 @@ TEST(ProjectFriction, IsTheDiskPointOfLeastSlipEnergyAndOpposesTheSlipItLeaves) 
     M3 A = M3::Random(), B = M3::Random();
     const M3 Ia = A * A.transpose() + 0.1 * M3::Identity();
     const M3 Ib = trial % 2 ? M3(B * B.transpose() + 0.1 * M3::Identity()) : M3::Zero();
-    p.prepare(trial % 2 ? 2.0 : 1.0, Ia, Ib, false);
+    p.prepare(trial % 2 ? 2.0 : 1.0, Ia, Ib);
     const M2 Ktt = p.tangentMass.inverse();
     if (Ktt(0, 0) + Ktt(1, 1) > 0 && std::abs(p.tangentStiffness[0] - p.tangentStiffness[1]) >
                                          0.3 * (p.tangentStiffness[0] + p.tangentStiffness[1]))
@@ -242,7 +242,7 @@ TEST(ProjectFriction, ClampsIn2DAndVanishesWithoutLoad) {
   PgsPoint<2> p;
   p.n = Eigen::Vector2d(0, 1);
   p.ra = Eigen::Vector2d(0.3, -0.5);
-  p.prepare(1.0, Eigen::Matrix<double, 1, 1>(6.0), Eigen::Matrix<double, 1, 1>::Zero(), false);
+  p.prepare(1.0, Eigen::Matrix<double, 1, 1>(6.0), Eigen::Matrix<double, 1, 1>::Zero());
   double f[1] = {-2.0};
   projectFriction<2>(p, f, 0.5);
   EXPECT_EQ(f[0], -0.5);
@@ -250,7 +250,7 @@ TEST(ProjectFriction, ClampsIn2DAndVanishesWithoutLoad) {
   PgsPoint<3> q;
   q.n = V3::UnitY();
   q.ra = V3(0.5, -0.5, 0.5);
-  q.prepare(1.0, 6.0 * M3::Identity(), M3::Zero(), false);
+  q.prepare(1.0, 6.0 * M3::Identity(), M3::Zero());
   projectFriction<3>(q, g, 0.0);
   EXPECT_EQ(g[0], 0.0);
   EXPECT_EQ(g[1], 0.0);
@@ -262,7 +262,7 @@ TEST(ProjectFriction, StaysFiniteOnADiskOfVanishingRadius) {
   PgsPoint<3> q;
   q.n = V3::UnitY();
   q.ra = V3(0.5, -0.5, 0.5);
-  q.prepare(1.0, 6.0 * M3::Identity(), M3::Zero(), false);
+  q.prepare(1.0, 6.0 * M3::Identity(), M3::Zero());
   for (const double limit : {1e-310, 1e-200, 1e-20}) {
     double f[2] = {3.0, -4.0};
     projectFriction<3>(q, f, limit);
