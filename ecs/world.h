@@ -84,6 +84,8 @@ struct ContactSettings {
   // With pushOutNewOverlaps: rounds of push-out while a push carries a body into one it was not
   // paired with (found only by the broad phase grown after the round; not in the thesis).
   int pushOutRounds = 4;
+  // ... and while a pair still overlaps by more than this fraction of its smaller body's size.
+  double pushOutRoundOverlap = 0.02;
   bool velocityContact = true;       // second contact step in Step V (Sec. 2.3.2 "Contact Clamping")
   bool energyClamp = true;           // Sec. 2.3.2 for collisions and the second contact step
   // Step II: a pair moving more than half its thinner body's size in the step is tested at its

@@ -16,7 +16,8 @@
 // therefore takes every pair of the broad phase, with the same solves, and a pair overlapping
 // before it starts ties its two bodies into one level. A push that carries a body into one the
 // broad phase had not paired it with is found by the growth after the round; further rounds
-// (ContactSettings::pushOutRounds) push apart the bodies of such pairs.
+// (ContactSettings::pushOutRounds) push apart the bodies of such pairs and of pairs still deeper
+// than pushOutRoundOverlap, and a round that leaves what it touched deeper is undone.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -305,7 +306,7 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
       for (int p : ws.islands.pairs[i])
         if ((ws.pairs[p].processed || s.pushOutNewOverlaps) && depth_[p] > s.pushOutTolerance) active_[i] = 1;
 
-  int newOverlaps = 0, solves = 0, rounds = 0, missed = 0;
+  int newOverlaps = 0, solves = 0, rounds = 0, missed = 0, undone = 0;
   for (;;) {
     const int marked = markNewOverlaps(ws);
     if (rounds == 0) newOverlaps = marked;
@@ -322,6 +323,16 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
         const ContactPairState& q = ws.pairs[p];
         if (focus_[q.a] || focus_[q.b]) moved_[q.a] = moved_[q.b] = 1;
       }
+    }
+    // A later round must not leave things worse than it found them: the poses it may change and
+    // the deepest overlap among their pairs, to undo it otherwise (below).
+    double worstBefore = 0;
+    if (rounds > 0) {
+      savedPoses_.clear();
+      for (std::size_t b = 0; b < ws.bodies.size(); ++b)
+        if (moved_[b]) savedPoses_.push_back({static_cast<int>(b), ws.bodies[b].x0, ws.bodies[b].q0});
+      for (std::size_t k = 0; k < ws.pairs.size(); ++k)
+        if (moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]) worstBefore = std::max(worstBefore, ratio_[k]);
     }
     if (s.pushOut) solves += pushApart(ws, levels, rounds > 0);
     ++rounds;
@@ -347,17 +358,35 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
       for (std::size_t k = 0; k < ws.pairs.size(); ++k)
         if (knownIndex_[k] >= 0) depth_[k] = knownDepth_[knownIndex_[k]], ratio_[k] = knownRatio_[knownIndex_[k]];
     }
-    measurePairs(ws, [&](std::size_t k) { return knownIndex_[k] < 0 || moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]; });
+    const auto remeasured = [&](std::size_t k) {
+      return knownIndex_[k] < 0 || moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b];
+    };
+    measurePairs(ws, remeasured);
+    if (rounds > 1) {
+      // Pushing the bodies of a few pairs apart can drive them into others: a round whose
+      // deepest overlap among the pairs it touched (the new ones included) is deeper than before
+      // is undone, and the rounds end.
+      double worstAfter = 0;
+      for (std::size_t k = 0; k < ws.pairs.size(); ++k)
+        if (remeasured(k)) worstAfter = std::max(worstAfter, ratio_[k]);
+      if (worstAfter > worstBefore) {
+        for (const SavedPose& p : savedPoses_) setBasePose<d>(ws.bodies[p.body], p.x, p.q);
+        measurePairs(ws, remeasured);
+        ++undone;  // `missed` keeps the previous round's count: those pairs are left
+        break;
+      }
+    }
 
-    // A push can carry a body past the box the broad phase knew for it, into a body it was not
-    // paired with: such a pair is found only by that growth. Another round pushes apart the
-    // bodies of such pairs (as new overlaps), and after that also those of pairs the round
-    // pushed deeper (a body moved into a neighbour outside the round), up to pushOutRounds. In
-    // the 4000-sphere pour the deepest overlaps were of the first kind (docs/benchmarks.md,
-    // "Push-out in rounds").
+    // Another round (up to pushOutRounds) works on the bodies of the pairs that
+    // - the growth just added and that overlap: a push carried a body past the box the broad
+    //   phase knew for it, into a body it was not paired with (the deepest overlaps of the
+    //   4000-sphere pour were of this kind, docs/benchmarks.md "Push-out in rounds");
+    // - a later round pushed deeper (a body moved into a neighbour outside that round);
+    // - still overlap by more than pushOutRoundOverlap of the smaller body's size (the level
+    //   passes did not converge: a jam of thin shards, a pile's compressed cycle).
     missed = 0;
-    int deeper = 0;
-    if (added > 0 || rounds > 1) {
+    int deeper = 0, residual = 0;
+    {
       active_.assign(ws.islands.members.size(), 0);
       focus_.assign(ws.bodies.size(), 0);
       for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
@@ -366,13 +395,14 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
         if (!(depth_[k] > s.pushOutTolerance)) continue;
         if (j < 0) ++missed;
         else if (rounds > 1 && depth_[k] > knownDepth_[j] + s.pushOutTolerance) ++deeper;
+        else if (ratio_[k] > s.pushOutRoundOverlap) ++residual;
         else continue;
         focus_[p.a] = focus_[p.b] = 1;
         const int island = ws.islands.islandOf[ws.bodies[p.a].infinite() ? p.b : p.a];
         if (island >= 0) active_[island] = 1;
       }
     }
-    if (missed + deeper == 0 || !s.pushOut || !s.pushOutNewOverlaps || rounds >= s.pushOutRounds) break;
+    if (missed + deeper + residual == 0 || !s.pushOut || !s.pushOutNewOverlaps || rounds >= s.pushOutRounds) break;
   }
   double worst = 0, worstDepth = 0;
   for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
@@ -388,7 +418,8 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
   ws.unpack(true);
   ctx.diagnostics.set("push_out_solves", solves);
   ctx.diagnostics.set("push_out_new_overlaps", newOverlaps);
-  ctx.diagnostics.set("push_out_rounds", rounds);
+  ctx.diagnostics.set("push_out_rounds", rounds - undone);
+  ctx.diagnostics.set("push_out_rounds_undone", undone);
   ctx.diagnostics.set("push_out_overlaps_found_after", missed);
   ctx.diagnostics.set("broad_phase_pairs_added_in_push_out", newPairs);
   ctx.diagnostics.set("max_penetration", worstDepth);

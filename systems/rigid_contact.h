@@ -109,6 +109,12 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   // One round of push-out over the islands marked in active_; returns the central-body solves.
   // focused: only the pairs with a body in focus_ (the rounds after the first).
   int pushApart(ContactWorkspace<d>& ws, const solvers::contact::ContactLevels& levels, bool focused);
+  struct SavedPose {
+    int body;
+    Eigen::Matrix<double, d, 1> x;
+    Orientation<d> q;
+  };
+  std::vector<SavedPose> savedPoses_;  // a later round's bodies before it, to undo it
   std::vector<char> active_;      // per island: pushed apart in this round
   std::vector<char> focus_;       // per body: worked on in the next round
   std::vector<std::pair<int, int>> knownPairs_;  // the pairs before a round's growth
