@@ -493,6 +493,31 @@ TEST(RandomSliverDrops, MostKeepTheirOverlapsShallow) {
   EXPECT_GT(median(off), 0.10);  // measured 52 %
 }
 
+TEST(PushOutRounds, APushPastTheBroadPhaseBoxIsUndoneInTheSameStepIn2D) {
+  // The same in 2-D: a disk sunk 5 cm into a static square, a square 2 cm above its box.
+  const Registry registry = builtins();
+  auto run = [&](int rounds) {
+    const std::string text = R"({"dimension": 2, "time": {"dt": 0.03333333333333333, "end": 0.03333333333333333},
+      "gravity": [0, 0], "entities": [
+      {"name": "A", "shape": {"type": "box", "half_extents": [0.5, 0.5]},
+       "rigid_body": {"static": true}, "collider": {"restitution": 0, "friction": 0.5}},
+      {"name": "C", "shape": {"type": "disk", "radius": 0.5},
+       "rigid_body": {"mass": 1, "position": [0, 0.95]}, "collider": {"restitution": 0, "friction": 0.5}},
+      {"name": "D", "shape": {"type": "box", "half_extents": [0.5, 0.5]},
+       "rigid_body": {"mass": 1, "position": [0, 1.97]}, "collider": {"restitution": 0, "friction": 0.5}}]})";
+    Simulation<2> sim(parseScene(text, "past_the_box_2d.json", {{"solvers.contact.push_out_rounds", std::to_string(rounds)}}),
+                      registry);
+    const auto diag = sim.step();
+    return std::make_pair(diag.at("max_penetration"), bodyOf(sim, "D").x.y());
+  };
+  const auto [oneDepth, oneD] = run(1);
+  const auto [fourDepth, fourD] = run(4);
+  EXPECT_NEAR(oneDepth, 0.03, 1e-4);
+  EXPECT_EQ(oneD, 1.97);
+  EXPECT_LT(fourDepth, 1e-5);
+  EXPECT_GT(fourD, 1.97 + 0.02);
+}
+
 TEST(PushOutRounds, JamsTheLevelPassesLeaveAreReducedByFurtherRounds) {
   // The drops of the generator above whose deepest overlap exceeds 5 % of a shard's thickness
   // when only missed pairs start another round (seeds 1-60, push_out_round_overlap = 1e9): shards
