@@ -227,6 +227,9 @@ class ContactWorkspace {
     double* energyOut = nullptr;  // the caller's clamp diagnostics, added to in task order
     int* clampsOut = nullptr;
     int impulseSum = 0;           // when the tasks run as they are recorded
+    // The recorded tasks are this step's collision sweep of the island: a later sweep has the
+    // same tasks and dependencies (only the stamps differ) and runs them again unrecorded.
+    bool collisionSweepRecorded = false;
     std::vector<solvers::collision::ContactPoint<d>> scratch;  // narrow phase, when run in order
   };
   IslandSchedule& startSchedule(int island, ImpulseMode mode, double* clampEnergyChange, int* clampsApplied);
