@@ -435,6 +435,7 @@ void parseContactSettings(const Config& c, ContactSettings& s) {
   s.shockPropagation = c.boolean("shock_propagation", s.shockPropagation);
   count("shock_level_iterations", s.shockLevelIterations, 1);
   count("shock_pair_iterations", s.shockPairIterations, 1);
+  s.exactManifoldFinish = c.boolean("exact_manifold_finish", s.exactManifoldFinish);
   s.pushOut = c.boolean("push_out", s.pushOut);
   count("push_out_level_iterations", s.pushOutLevelIterations, 1);
   count("push_out_body_iterations", s.pushOutBodyIterations, 1);

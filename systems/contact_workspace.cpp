@@ -468,6 +468,9 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
   // K and the Jacobian rows only when something approaches (a solve follows).
   const con::AngMat<d> Ia = finiteA ? splitA : con::AngMat<d>::Zero();
   const con::AngMat<d> Ib = finiteB ? splitB : con::AngMat<d>::Zero();
+  state.inverseInertiaA = Ia;
+  state.inverseInertiaB = Ib;
+  state.exactFinish = settings.exactManifoldFinish;
   if (points.size() == 1) points[0].prepareOnePoint(A.inverseMass() + B.inverseMass(), Ia, Ib);
   else
     for (Point& p : points) p.prepare(A.inverseMass() + B.inverseMass(), Ia, Ib);
@@ -582,6 +585,8 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
     speedScale = std::max(speedScale, std::abs(p.target));
   }
   const double tolerance = 1e-7 * speedScale + 1e-12;
+  state.inverseInertiaA = Iinv;
+  state.exactFinish = settings.exactManifoldFinish;
   con::pgsSolve<d>(points, state, iterations, tolerance);
   VecD J;
   con::AngVec<d> tau;

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <vector>
 
+#include "solvers/contact/manifold_polish.h"
 #include "solvers/contact/rigid_math.h"
 
 namespace monolith::solvers::contact {
@@ -140,7 +141,12 @@ struct PgsBodies {
   Vec<d> va = Vec<d>::Zero(), vb = Vec<d>::Zero();
   AngVec<d> wa = AngVec<d>::Zero(), wb = AngVec<d>::Zero();
   double inverseMassA = 0, inverseMassB = 0;
+  // The inverse inertias the points were prepared with (PgsPoint::prepare's Ia, Ib).
+  AngMat<d> inverseInertiaA = AngMat<d>::Zero(), inverseInertiaB = AngMat<d>::Zero();
   bool movesA = false, movesB = false;  // bodies of infinite mass take no impulse
+  // Finish with the exact active-set step of manifold_polish.h once it applies (after sweeps
+  // 3, 6, 12, 24, ...); off: sweeps only, to the stop test or the sweep limit.
+  bool exactFinish = false;
 };
 
 // Part of the relative velocity at p that no impulse of this solve changes: the partner's
@@ -301,11 +307,16 @@ void pgsSweeps(std::vector<PgsPoint<d>>& points, PgsBodies<d>& s, int iterations
   const double tolerance2 = tolerance * tolerance;
   Vec<d> va = s.va, vb = s.vb;
   AngVec<d> wa = s.wa, wb = s.wb;
-  for (int sweep = 0; sweep < iterations; ++sweep) {
+  int nextFinish = 3;
+  for (int sweep = 1; sweep <= iterations; ++sweep) {
     double change2 = 0;
     for (PgsPoint<d>& p : points)
       change2 = std::max(change2, pgsStep<d, movesA, movesB>(p, s.inverseMassA, s.inverseMassB, va, wa, vb, wb));
     if (change2 < tolerance2) break;
+    if (s.exactFinish && sweep == nextFinish && sweep < iterations) {
+      if (polishManifold<d, movesA, movesB>(points, s, va, wa, vb, wb, tolerance)) break;
+      nextFinish *= 2;
+    }
   }
   s.va = va;
   s.vb = vb;

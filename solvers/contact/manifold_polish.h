@@ -1,0 +1,288 @@
+#pragma once
+// The exact end of a manifold solve once projected Gauss-Seidel has found which points carry
+// load and which slide (issue 3; docs/architecture.md "One pair update", docs/benchmarks.md
+// "Manifold solves finished exactly"). Not in the thesis; scene switch
+// solvers.contact.exact_manifold_finish (off by default).
+//
+// Why: the points of a face contact are redundant. Four corners of a box on a face, or the eight
+// of a pyramid box on the two below it, put 12 or 24 impulse components against the 6 degrees
+// of freedom of the relative motion, and on such a singular problem Gauss-Seidel converges
+// linearly (about 0.4 per sweep) down to a floor of about 1e-9 set by the friction projection's
+// own tolerance: shock propagation's joint solves ran all their 40 sweeps and were half of a
+// short-schedule pyramid step. Once the states of the points are known, the answer is a small
+// linear problem in the relative motion instead.
+//
+// With the points' accumulated impulses after some sweeps (3, then 6, 12, ...):
+//   1. states: unloaded (normal impulse 0), sticking (friction strictly inside its disk),
+//      sliding (on the rim), frictionless;
+//   2. the relative twist meeting every active row -- normal velocity at its target for loaded
+//      points, zero slip for sticking ones -- by least squares on the 6 x 6 (3 x 3 in 2-D) normal
+//      equations N = G G^T. Rows that cannot all be met, too few rows to fix the relative motion
+//      (fewer than 6, or rank-deficient) and unloaded points left approaching fail;
+//   3. a sliding point's friction is mu lambda against the slip that twist leaves there, so its
+//      impulse is lambda (n + mu T dir), one unknown;
+//   4. the wrench about x_a that gives the twist (W^{-1} times the change, W the effective
+//      inverse mass of the relative twist) and the impulse change of least norm giving it;
+//   5. a sticking point whose impulse leaves its disk, or slips at that twist, becomes sliding,
+//      and a point whose normal impulse would turn negative becomes unloaded: steps 2-5 again
+//      (at most 4 passes);
+//   6. accepted only if the bodies end with no more kinetic energy than before the solve.
+//      With sliding friction the complementarity problem can have spurious solutions with large
+//      impulses that feed energy in (Painleve's paradox): without this test pyramid_20 blew up
+//      to 18 J at the thesis's schedule. The sweeps never find those.
+// An accepted result meets every condition of the problem the sweeps converge to (to rounding,
+// instead of to the sweeps' stop test), and the sweeps stop. Otherwise nothing changes and the
+// sweeps go on.
+//
+// The twist: D = (v_a - v_b - w_b x (x_a - x_b), w_a - w_b), the relative velocity field at A's
+// centre, so that the relative velocity at a point along u is u.D_lin + (r_a x u).D_ang + const:
+// the row of a point along u is g = (u, r_a x u), the wrench about x_a of a unit impulse along u.
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <cmath>
+#include <vector>
+
+#include "solvers/contact/rigid_math.h"
+
+namespace monolith::solvers::contact {
+
+template <int d>
+constexpr int kTwistDim = d + kAngularDim<d>;
+template <int d>
+using Twist = Eigen::Matrix<double, kTwistDim<d>, 1>;
+template <int d>
+using TwistMat = Eigen::Matrix<double, kTwistDim<d>, kTwistDim<d>>;
+
+// M += weight g g^T on the lower triangle (Eigen's rankUpdate is slower on these fixed 6 x 6).
+template <int d>
+inline void addOuterLower(TwistMat<d>& M, const Twist<d>& g, double weight = 1.0) {
+  for (int c = 0; c < kTwistDim<d>; ++c) {
+    const double gc = weight * g[c];
+    for (int r = c; r < kTwistDim<d>; ++r) M(r, c) += g[r] * gc;
+  }
+}
+
+// Point: PgsPoint<d> (prepared, offsets set); Bodies: PgsBodies<d>. va..wb: the sweeps' working
+// velocities, updated on success. Returns true if the solve is finished.
+template <int d, bool movesA, bool movesB, class Point, class Bodies>
+bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, AngVec<d>& wa, Vec<d>& vb,
+                    AngVec<d>& wb, double tolerance) {
+  constexpr int D = kTwistDim<d>, A = kAngularDim<d>, m = d - 1;
+  using Tangent = Eigen::Matrix<double, m, 1>;
+  constexpr int Lower = Eigen::Lower;
+  const Vec<d> arm = points.front().rb - points.front().ra;  // x_a - x_b
+  // The current relative twist (moving bodies only: a fixed body's velocity is in the offsets).
+  Twist<d> twist = Twist<d>::Zero();
+  if constexpr (movesA) twist.template head<d>() += va, twist.template tail<A>() += wa;
+  if constexpr (movesB)
+    twist.template head<d>() -= vb + angularCross<d>(wb, arm), twist.template tail<A>() -= wb;
+  auto rowOf = [](const Vec<d>& u, const AngVec<d>& raU) {
+    Twist<d> g;
+    g << u, raU;
+    return g;
+  };
+  auto tangentRow = [&rowOf](const Point& p, int k) { return rowOf(p.T.col(k), p.raT.col(k)); };
+  // The column of a sliding point: its impulse is lambda (n + mu T dir).
+  auto slidingColumn = [&rowOf](const Point& p, const Tangent& dir) {
+    Vec<d> u = p.n;
+    AngVec<d> raU = p.raN;
+    for (int k = 0; k < m; ++k) u += p.mu * dir[k] * p.T.col(k), raU += p.mu * dir[k] * p.raT.col(k);
+    return rowOf(u, raU);
+  };
+
+  // The points' states, first as the sweeps left them.
+  enum class State : char { Unloaded, Sticking, Sliding, Frictionless };
+  thread_local std::vector<State> states;
+  thread_local std::vector<Tangent> directions;  // of a sliding point's friction
+  struct Impulse {
+    double normal;
+    Tangent tangent;
+  };
+  thread_local std::vector<Impulse> result;
+  states.resize(points.size());
+  directions.resize(points.size());
+  result.resize(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Point& p = points[i];
+    const double limit = p.mu * p.normalImpulse;
+    states[i] = !(p.normalImpulse > 0)  ? State::Unloaded
+                : !(p.mu > 0)           ? State::Frictionless
+                : p.tangentImpulse.squaredNorm() < (1 - 1e-9) * limit * limit ? State::Sticking
+                                                                                : State::Sliding;
+  }
+  // W = W_A + S^T W_B S: the effective inverse mass of the relative twist for a wrench about x_a
+  // (S: a wrench about x_a to one about x_b; C: F -> (x_a - x_b) x F). Built on first use.
+  Eigen::LLT<TwistMat<d>> mass;
+  bool massReady = false;
+
+  // An active-set iteration: a sticking point that the twist would make slip, or whose impulse
+  // leaves its disk, slides; a point whose impulse would turn negative is unloaded; then again.
+  for (int pass = 0; pass < 4; ++pass) {
+    int rows = 0;
+    for (const State st : states) rows += st == State::Sticking ? d : st == State::Unloaded ? 0 : 1;
+    if (rows < D) return false;  // the active rows cannot fix the relative motion
+
+    // The twist meeting every active row (normal velocity at its target; no slip where sticking),
+    // by least squares on the normal equations N y = G r.
+    TwistMat<d> N = TwistMat<d>::Zero();
+    Twist<d> Gr = Twist<d>::Zero();
+    auto addRow = [&](const Twist<d>& g, double wanted) {
+      addOuterLower<d>(N, g);
+      Gr += (wanted - g.dot(twist)) * g;
+    };
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (states[i] == State::Unloaded) continue;
+      const Point& p = points[i];
+      addRow(rowOf(p.n, p.raN), p.target - p.offsetN);
+      if (states[i] == State::Sticking)
+        for (int k = 0; k < m; ++k) addRow(tangentRow(p, k), -p.offsetT[k]);
+    }
+    const Eigen::LLT<TwistMat<d>, Lower> normal(N);
+    if (normal.info() != Eigen::Success) return false;
+    const auto root = normal.matrixLLT().diagonal();
+    if (!(root.minCoeff() > 1e-6 * root.maxCoeff())) return false;  // rank-deficient rows
+    const Twist<d> next = twist + normal.solve(Gr);
+
+    // Rows that cannot all be met fail; slip at a sticking point turns it to sliding; a sliding
+    // point's friction opposes the slip the twist leaves there.
+    bool changed = false;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Point& p = points[i];
+      const double vn = p.offsetN + rowOf(p.n, p.raN).dot(next);
+      if (states[i] == State::Unloaded) {
+        if (!(vn >= p.target - tolerance)) return false;  // would approach without load
+        continue;
+      }
+      if (!(std::abs(vn - p.target) <= tolerance)) return false;
+      if (states[i] == State::Frictionless) continue;
+      Tangent slip;
+      for (int k = 0; k < m; ++k) slip[k] = p.offsetT[k] + tangentRow(p, k).dot(next);
+      const double size = slip.norm();
+      if (states[i] == State::Sticking) {
+        if (size > tolerance) states[i] = State::Sliding, changed = true;
+        continue;
+      }
+      if (size > tolerance) directions[i] = -slip / size;
+      else if (p.tangentImpulse.squaredNorm() > 0) directions[i] = p.tangentImpulse.normalized();
+      else directions[i] = Tangent::UnitX();
+    }
+    if (changed) continue;
+
+    // The wrench about x_a that changes the twist to `next`, and the impulses that give it:
+    // the change of least norm from reference impulses (the current ones, a sliding point's
+    // turned to its new direction, an unloaded point's zero).
+    if (!massReady) {
+      TwistMat<d> W = TwistMat<d>::Zero();
+      if constexpr (movesA) {
+        W.template topLeftCorner<d, d>().diagonal().array() += s.inverseMassA;
+        W.template bottomRightCorner<A, A>() += s.inverseInertiaA;
+      }
+      if constexpr (movesB) {
+        const CrossMat<d> C = crossMatrix<d>(arm);
+        const AngMat<d>& Ib = s.inverseInertiaB;
+        W.template topLeftCorner<d, d>().diagonal().array() += s.inverseMassB;
+        W.template topLeftCorner<d, d>() += C.transpose() * Ib * C;
+        W.template topRightCorner<d, A>() += C.transpose() * Ib;
+        W.template bottomLeftCorner<A, d>() += Ib * C;
+        W.template bottomRightCorner<A, A>() += Ib;
+      }
+      mass.compute(W);
+      if (mass.info() != Eigen::Success) return false;
+      massReady = true;
+    }
+    Twist<d> wrench = mass.solve(next - twist);
+    // The columns' Gram matrix M: the rows' N unless a point slides (its column is n + mu T dir
+    // instead of the normal row n), so the factorisation of N serves where all points stick.
+    bool anySliding = false;
+    TwistMat<d> M = N;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Point& p = points[i];
+      Impulse& r = result[i];
+      r.normal = 0;
+      r.tangent.setZero();
+      if (states[i] != State::Unloaded) r.normal = p.normalImpulse;
+      if (states[i] == State::Sticking) r.tangent = p.tangentImpulse;
+      if (states[i] == State::Sliding) r.tangent = p.mu * p.normalImpulse * directions[i];
+      // The wrench of moving the current impulse to the reference one.
+      const double dn = r.normal - p.normalImpulse;
+      const Tangent dt = r.tangent - p.tangentImpulse;
+      if (dn != 0 || dt.squaredNorm() != 0) wrench -= rowOf(dn * p.n + p.T * dt, dn * p.raN + p.raT * dt);
+      if (states[i] == State::Sliding) {
+        anySliding = true;
+        addOuterLower<d>(M, slidingColumn(p, directions[i]));
+        addOuterLower<d>(M, rowOf(p.n, p.raN), -1.0);
+      }
+    }
+    Eigen::LLT<TwistMat<d>, Lower> slidingColumns;
+    if (anySliding) {
+      slidingColumns.compute(M);
+      if (slidingColumns.info() != Eigen::Success) return false;
+      const auto columnRoot = slidingColumns.matrixLLT().diagonal();
+      if (!(columnRoot.minCoeff() > 1e-6 * columnRoot.maxCoeff())) return false;
+    }
+    const Twist<d> multiplier = anySliding ? slidingColumns.solve(wrench) : normal.solve(wrench);
+
+    // The impulses must stay in their cones.
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Point& p = points[i];
+      Impulse& r = result[i];
+      switch (states[i]) {
+        case State::Unloaded: continue;
+        case State::Sliding:
+          r.normal += slidingColumn(p, directions[i]).dot(multiplier);
+          r.tangent = p.mu * r.normal * directions[i];
+          break;
+        case State::Sticking:
+          for (int k = 0; k < m; ++k) r.tangent[k] += tangentRow(p, k).dot(multiplier);
+          [[fallthrough]];
+        case State::Frictionless: r.normal += rowOf(p.n, p.raN).dot(multiplier); break;
+      }
+      if (!(r.normal >= 0)) {
+        states[i] = State::Unloaded, changed = true;
+        continue;
+      }
+      const double limit = p.mu * r.normal;
+      if (states[i] == State::Sticking && !(r.tangent.squaredNorm() <= limit * limit))
+        states[i] = State::Sliding, changed = true;
+    }
+    if (changed) continue;
+
+    // The velocities these impulses give, applied as the sweeps apply theirs.
+    Vec<d> va1 = va, vb1 = vb;
+    AngVec<d> wa1 = wa, wb1 = wb;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Point& p = points[i];
+      const double dn = result[i].normal - p.normalImpulse;
+      const Tangent dt = result[i].tangent - p.tangentImpulse;
+      if (dn == 0 && dt.squaredNorm() == 0) continue;
+      const Vec<d> j = dn * p.n + p.T * dt;
+      if constexpr (movesA) va1 += s.inverseMassA * j, wa1 += dn * p.IaRaN + p.IaRaT * dt;
+      if constexpr (movesB) vb1 -= s.inverseMassB * j, wb1 -= dn * p.IbRbN + p.IbRbT * dt;
+    }
+    // With sliding friction the complementarity problem can have spurious solutions of large
+    // impulses that feed energy in (Painleve's paradox; seen in pyramid_20: a pair of boxes given
+    // 3 J); projected Gauss-Seidel does not find them. An exact finish must not give the bodies
+    // more kinetic energy than they had before the solve, or the sweeps go on instead.
+    double before = 0, after = 0;
+    if constexpr (movesA) {
+      const AngMat<d> inertia = s.inverseInertiaA.inverse();
+      before += s.va.squaredNorm() / s.inverseMassA + s.wa.dot(inertia * s.wa);
+      after += va1.squaredNorm() / s.inverseMassA + wa1.dot(inertia * wa1);
+    }
+    if constexpr (movesB) {
+      const AngMat<d> inertia = s.inverseInertiaB.inverse();
+      before += s.vb.squaredNorm() / s.inverseMassB + s.wb.dot(inertia * s.wb);
+      after += vb1.squaredNorm() / s.inverseMassB + wb1.dot(inertia * wb1);
+    }
+    if (!(after <= before * (1 + 1e-9))) return false;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      points[i].normalImpulse = result[i].normal;
+      points[i].tangentImpulse = result[i].tangent;
+    }
+    va = va1, wa = wa1, vb = vb1, wb = wb1;
+    return true;
+  }
+  return false;
+}
+
+}  // namespace monolith::solvers::contact
