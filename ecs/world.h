@@ -76,7 +76,7 @@ struct ContactSettings {
   int shockPairIterations = 40;      // measured: a 2-D pyramid's joint solves need them (docs/benchmarks.md)
   // Manifold and joint solves end with an exact active-set step once it applies
   // (solvers/contact/manifold_polish.h; not in the thesis, whose sweeps stop at their count).
-  // Off by default: at the thesis's schedule it costs 4-8 % more than it saves; on a short
+  // Off by default: at the thesis's schedule it costs 6-28 % more than it saves; on a short
   // schedule it halves the step and leaves a standing pyramid exactly at rest (benchmarks.md).
   bool exactManifoldFinish = false;
   bool pushOut = true;               // interpenetration resolution, Sec. 4.6.1 / App. B

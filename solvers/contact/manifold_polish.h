@@ -70,7 +70,8 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
   constexpr int D = kTwistDim<d>, A = kAngularDim<d>, m = d - 1;
   using Tangent = Eigen::Matrix<double, m, 1>;
   constexpr int Lower = Eigen::Lower;
-  const Vec<d> arm = points.front().rb - points.front().ra;  // x_a - x_b
+  // x_a - x_b, needed only when b moves (a joint solve's points carry no r_b).
+  const Vec<d> arm = movesB ? Vec<d>(points.front().rb - points.front().ra) : Vec<d>::Zero();
   // The current relative twist (moving bodies only: a fixed body's velocity is in the offsets).
   Twist<d> twist = Twist<d>::Zero();
   if constexpr (movesA) twist.template head<d>() += va, twist.template tail<A>() += wa;
