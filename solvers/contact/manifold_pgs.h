@@ -308,6 +308,10 @@ void pgsSweeps(std::vector<PgsPoint<d>>& points, PgsBodies<d>& s, int iterations
   Vec<d> va = s.va, vb = s.vb;
   AngVec<d> wa = s.wa, wb = s.wb;
   int nextFinish = 3;
+  if (s.exactFinish && polishManifold<d, movesA, movesB>(points, s, va, wa, vb, wb, tolerance, true)) {
+    s.va = va, s.vb = vb, s.wa = wa, s.wb = wb;
+    return;
+  }
   for (int sweep = 1; sweep <= iterations; ++sweep) {
     double change2 = 0;
     for (PgsPoint<d>& p : points)

@@ -37,12 +37,12 @@
 // The twist: D = (v_a - v_b - w_b x (x_a - x_b), w_a - w_b), the relative velocity field at A's
 // centre, so that the relative velocity at a point along u is u.D_lin + (r_a x u).D_ang + const:
 // the row of a point along u is g = (u, r_a x u), the wrench about x_a of a unit impulse along u.
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <cmath>
 #include <vector>
 
 #include "solvers/contact/rigid_math.h"
+#include "solvers/contact/small_cholesky.h"
 
 namespace monolith::solvers::contact {
 
@@ -62,14 +62,29 @@ inline void addOuterLower(TwistMat<d>& M, const Twist<d>& g, double weight = 1.0
   }
 }
 
+// M += [[1, C^T], [C, C C^T]] on the lower triangle, C = r* (d x d identity; C C^T = |r|^2 - r r^T
+// in 3-D, |r|^2 in 2-D): the sum of g g^T over the rows g = (u, r x u) of an orthonormal basis u.
+template <int d>
+inline void addStickingBlock(TwistMat<d>& M, const Vec<d>& r) {
+  constexpr int A = kAngularDim<d>;
+  M.template topLeftCorner<d, d>().diagonal().array() += 1.0;
+  M.template bottomLeftCorner<A, d>() += crossMatrix<d>(r);
+  const double r2 = r.squaredNorm();
+  if constexpr (d == 3) {
+    for (int c = 0; c < 3; ++c)
+      for (int q = c; q < 3; ++q) M(d + q, d + c) += (q == c ? r2 : 0.0) - r[q] * r[c];
+  } else {
+    M(d, d) += r2;
+  }
+}
+
 // Point: PgsPoint<d> (prepared, offsets set); Bodies: PgsBodies<d>. va..wb: the sweeps' working
 // velocities, updated on success. Returns true if the solve is finished.
 template <int d, bool movesA, bool movesB, class Point, class Bodies>
 bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, AngVec<d>& wa, Vec<d>& vb,
-                    AngVec<d>& wb, double tolerance) {
+                    AngVec<d>& wb, double tolerance, bool guessLoaded = false) {
   constexpr int D = kTwistDim<d>, A = kAngularDim<d>, m = d - 1;
   using Tangent = Eigen::Matrix<double, m, 1>;
-  constexpr int Lower = Eigen::Lower;
   // x_a - x_b, needed only when b moves (a joint solve's points carry no r_b).
   const Vec<d> arm = movesB ? Vec<d>(points.front().rb - points.front().ra) : Vec<d>::Zero();
   // The current relative twist (moving bodies only: a fixed body's velocity is in the offsets).
@@ -103,17 +118,24 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
   states.resize(points.size());
   directions.resize(points.size());
   result.resize(points.size());
+  const State loaded = State::Sticking, frictionless = State::Frictionless;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Point& p = points[i];
+    if (guessLoaded) {
+      // Before any sweep: a point carries load if it would otherwise end below its target.
+      const bool carries = p.offsetN + rowOf(p.n, p.raN).dot(twist) < p.target + tolerance;
+      states[i] = !carries ? State::Unloaded : p.mu > 0 ? loaded : frictionless;
+      continue;
+    }
     const double limit = p.mu * p.normalImpulse;
     states[i] = !(p.normalImpulse > 0)  ? State::Unloaded
-                : !(p.mu > 0)           ? State::Frictionless
-                : p.tangentImpulse.squaredNorm() < (1 - 1e-9) * limit * limit ? State::Sticking
+                : !(p.mu > 0)           ? frictionless
+                : p.tangentImpulse.squaredNorm() < (1 - 1e-9) * limit * limit ? loaded
                                                                                 : State::Sliding;
   }
   // W = W_A + S^T W_B S: the effective inverse mass of the relative twist for a wrench about x_a
   // (S: a wrench about x_a to one about x_b; C: F -> (x_a - x_b) x F). Built on first use.
-  Eigen::LLT<TwistMat<d>> mass;
+  SmallCholesky<D> mass;
   bool massReady = false;
 
   // An active-set iteration: a sticking point that the twist would make slip, or whose impulse
@@ -127,21 +149,26 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
     // by least squares on the normal equations N y = G r.
     TwistMat<d> N = TwistMat<d>::Zero();
     Twist<d> Gr = Twist<d>::Zero();
-    auto addRow = [&](const Twist<d>& g, double wanted) {
-      addOuterLower<d>(N, g);
-      Gr += (wanted - g.dot(twist)) * g;
-    };
     for (std::size_t i = 0; i < points.size(); ++i) {
       if (states[i] == State::Unloaded) continue;
       const Point& p = points[i];
-      addRow(rowOf(p.n, p.raN), p.target - p.offsetN);
-      if (states[i] == State::Sticking)
-        for (int k = 0; k < m; ++k) addRow(tangentRow(p, k), -p.offsetT[k]);
+      const Twist<d> gn = rowOf(p.n, p.raN);
+      Gr += (p.target - p.offsetN - gn.dot(twist)) * gn;
+      if (states[i] != State::Sticking) {
+        addOuterLower<d>(N, gn);
+        continue;
+      }
+      // A sticking point's d rows (u, r_a x u) over the orthonormal (n, T): their sum of
+      // g g^T is [[1, C^T], [C, C C^T]] with C = r_a*, in closed form.
+      addStickingBlock<d>(N, p.ra);
+      for (int k = 0; k < m; ++k) {
+        const Twist<d> g = tangentRow(p, k);
+        Gr += (-p.offsetT[k] - g.dot(twist)) * g;
+      }
     }
-    const Eigen::LLT<TwistMat<d>, Lower> normal(N);
-    if (normal.info() != Eigen::Success) return false;
-    const auto root = normal.matrixLLT().diagonal();
-    if (!(root.minCoeff() > 1e-6 * root.maxCoeff())) return false;  // rank-deficient rows
+    SmallCholesky<D> normal;
+    if (!normal.compute(N)) return false;
+    if (!normal.wellConditioned(1e-6)) return false;  // rank-deficient rows
     const Twist<d> next = twist + normal.solve(Gr);
 
     // Rows that cannot all be met fail; slip at a sticking point turns it to sliding; a sliding
@@ -151,7 +178,8 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       const Point& p = points[i];
       const double vn = p.offsetN + rowOf(p.n, p.raN).dot(next);
       if (states[i] == State::Unloaded) {
-        if (!(vn >= p.target - tolerance)) return false;  // would approach without load
+        // It would end below its target without load: it carries some.
+        if (!(vn >= p.target - tolerance)) states[i] = p.mu > 0 ? loaded : frictionless, changed = true;
         continue;
       }
       if (!(std::abs(vn - p.target) <= tolerance)) return false;
@@ -187,8 +215,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
         W.template bottomLeftCorner<A, d>() += Ib * C;
         W.template bottomRightCorner<A, A>() += Ib;
       }
-      mass.compute(W);
-      if (mass.info() != Eigen::Success) return false;
+      if (!mass.compute(W)) return false;
       massReady = true;
     }
     Twist<d> wrench = mass.solve(next - twist);
@@ -214,13 +241,8 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
         addOuterLower<d>(M, rowOf(p.n, p.raN), -1.0);
       }
     }
-    Eigen::LLT<TwistMat<d>, Lower> slidingColumns;
-    if (anySliding) {
-      slidingColumns.compute(M);
-      if (slidingColumns.info() != Eigen::Success) return false;
-      const auto columnRoot = slidingColumns.matrixLLT().diagonal();
-      if (!(columnRoot.minCoeff() > 1e-6 * columnRoot.maxCoeff())) return false;
-    }
+    SmallCholesky<D> slidingColumns;
+    if (anySliding && !(slidingColumns.compute(M) && slidingColumns.wellConditioned(1e-6))) return false;
     const Twist<d> multiplier = anySliding ? slidingColumns.solve(wrench) : normal.solve(wrench);
 
     // The impulses must stay in their cones.
