@@ -135,15 +135,137 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
   }
   // W = W_A + S^T W_B S: the effective inverse mass of the relative twist for a wrench about x_a
   // (S: a wrench about x_a to one about x_b; C: F -> (x_a - x_b) x F). Built on first use.
+  TwistMat<d> W;
   SmallCholesky<D> mass;
   bool massReady = false;
+  auto buildMass = [&]() {
+    if (massReady) return true;
+    W.setZero();
+    if constexpr (movesA) {
+      W.template topLeftCorner<d, d>().diagonal().array() += s.inverseMassA;
+      W.template bottomRightCorner<A, A>() += s.inverseInertiaA;
+    }
+    if constexpr (movesB) {
+      const CrossMat<d> C = crossMatrix<d>(arm);
+      const AngMat<d>& Ib = s.inverseInertiaB;
+      W.template topLeftCorner<d, d>().diagonal().array() += s.inverseMassB;
+      W.template topLeftCorner<d, d>() += C.transpose() * Ib * C;
+      W.template topRightCorner<d, A>() += C.transpose() * Ib;
+      W.template bottomLeftCorner<A, d>() += Ib * C;
+      W.template bottomRightCorner<A, A>() += Ib;
+    }
+    return massReady = mass.compute(W);
+  };
+
+  // The velocities the impulses in `result` give, applied as the sweeps apply theirs, if the
+  // bodies gain no kinetic energy.
+  auto accept = [&]() {
+    Vec<d> va1 = va, vb1 = vb;
+    AngVec<d> wa1 = wa, wb1 = wb;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Point& p = points[i];
+      const double dn = result[i].normal - p.normalImpulse;
+      const Tangent dt = result[i].tangent - p.tangentImpulse;
+      if (dn == 0 && dt.squaredNorm() == 0) continue;
+      const Vec<d> j = dn * p.n + p.T * dt;
+      if constexpr (movesA) va1 += s.inverseMassA * j, wa1 += dn * p.IaRaN + p.IaRaT * dt;
+      if constexpr (movesB) vb1 -= s.inverseMassB * j, wb1 -= dn * p.IbRbN + p.IbRbT * dt;
+    }
+    // With sliding friction the complementarity problem can have spurious solutions of large
+    // impulses that feed energy in (Painleve's paradox; seen in pyramid_20: a pair of boxes given
+    // 3 J); projected Gauss-Seidel does not find them. An exact finish must not give the bodies
+    // more kinetic energy than they had before the solve, or the sweeps go on instead.
+    double before = 0, after = 0;
+    if constexpr (movesA) {
+      const AngMat<d> inertia = s.inverseInertiaA.inverse();
+      before += s.va.squaredNorm() / s.inverseMassA + s.wa.dot(inertia * s.wa);
+      after += va1.squaredNorm() / s.inverseMassA + wa1.dot(inertia * wa1);
+    }
+    if constexpr (movesB) {
+      const AngMat<d> inertia = s.inverseInertiaB.inverse();
+      before += s.vb.squaredNorm() / s.inverseMassB + s.wb.dot(inertia * s.wb);
+      after += vb1.squaredNorm() / s.inverseMassB + wb1.dot(inertia * wb1);
+    }
+    if (!(after <= before * (1 + 1e-9))) return false;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      points[i].normalImpulse = result[i].normal;
+      points[i].tangentImpulse = result[i].tangent;
+    }
+    va = va1, wa = wa1, vb = vb1, wb = wb1;
+    return true;
+  };
 
   // An active-set iteration: a sticking point that the twist would make slip, or whose impulse
   // leaves its disk, slides; a point whose impulse would turn negative is unloaded; then again.
   for (int pass = 0; pass < 4; ++pass) {
     int rows = 0;
     for (const State st : states) rows += st == State::Sticking ? d : st == State::Unloaded ? 0 : 1;
-    if (rows < D) return false;  // the active rows cannot fix the relative motion
+    if (rows < D) {
+      // Too few rows to fix the relative motion (a box pivoting on one corner): the bodies'
+      // masses decide the rest. For loaded points that all stick (or have no friction) the
+      // impulse changes x on the rows' own columns solve (G^T W G) x = wanted - G^T twist,
+      // positive definite when the rows are independent.
+      for (const State st : states)
+        if (st == State::Sliding) return false;
+      if (!buildMass()) return false;
+      // Reference impulses: the current ones, an unloaded point's removed.
+      Twist<d> base = twist;
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const Point& p = points[i];
+        result[i].normal = states[i] == State::Unloaded ? 0.0 : p.normalImpulse;
+        result[i].tangent = states[i] == State::Sticking ? p.tangentImpulse : Tangent::Zero();
+        const double dn = result[i].normal - p.normalImpulse;
+        const Tangent dt = result[i].tangent - p.tangentImpulse;
+        if (dn != 0 || dt.squaredNorm() != 0) base += W * rowOf(dn * p.n + p.T * dt, dn * p.raN + p.raT * dt);
+      }
+      Twist<d> g[D], Wg[D];
+      Twist<d> wanted = Twist<d>::Zero();
+      int k = 0;
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        if (states[i] == State::Unloaded) continue;
+        const Point& p = points[i];
+        g[k] = rowOf(p.n, p.raN);
+        wanted[k++] = p.target - p.offsetN;
+        if (states[i] == State::Sticking)
+          for (int t = 0; t < m; ++t) g[k] = tangentRow(p, t), wanted[k++] = -p.offsetT[t];
+      }
+      TwistMat<d> system = TwistMat<d>::Zero();
+      double scale = 0;
+      for (int c = 0; c < k; ++c) {
+        Wg[c] = W * g[c];
+        for (int r = c; r < k; ++r) system(r, c) = g[r].dot(Wg[c]);
+        scale += system(c, c);
+        wanted[c] -= g[c].dot(base);
+      }
+      // Padded to D x D with the mean pivot, so that the rank test compares like with like.
+      for (int c = k; c < D; ++c) system(c, c) = scale / k;
+      SmallCholesky<D> few;
+      if (!(few.compute(system) && few.wellConditioned(1e-6))) return false;
+      const Twist<d> x = few.solve(wanted);
+      Twist<d> next = base;
+      for (int c = 0; c < k; ++c) next += x[c] * Wg[c];
+      bool changed = false;
+      k = 0;
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const Point& p = points[i];
+        if (states[i] == State::Unloaded) {
+          const double vn = p.offsetN + rowOf(p.n, p.raN).dot(next);
+          if (!(vn >= p.target - tolerance)) states[i] = p.mu > 0 ? loaded : frictionless, changed = true;
+          continue;
+        }
+        result[i].normal += x[k++];
+        if (states[i] == State::Sticking)
+          for (int t = 0; t < m; ++t) result[i].tangent[t] += x[k++];
+        if (!(result[i].normal >= 0)) {
+          states[i] = State::Unloaded, changed = true;
+          continue;
+        }
+        const double limit = p.mu * result[i].normal;
+        if (states[i] == State::Sticking && !(result[i].tangent.squaredNorm() <= limit * limit)) return false;
+      }
+      if (changed) continue;
+      return accept();
+    }
 
     // The twist meeting every active row (normal velocity at its target; no slip where sticking),
     // by least squares on the normal equations N y = G r.
@@ -200,24 +322,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
     // The wrench about x_a that changes the twist to `next`, and the impulses that give it:
     // the change of least norm from reference impulses (the current ones, a sliding point's
     // turned to its new direction, an unloaded point's zero).
-    if (!massReady) {
-      TwistMat<d> W = TwistMat<d>::Zero();
-      if constexpr (movesA) {
-        W.template topLeftCorner<d, d>().diagonal().array() += s.inverseMassA;
-        W.template bottomRightCorner<A, A>() += s.inverseInertiaA;
-      }
-      if constexpr (movesB) {
-        const CrossMat<d> C = crossMatrix<d>(arm);
-        const AngMat<d>& Ib = s.inverseInertiaB;
-        W.template topLeftCorner<d, d>().diagonal().array() += s.inverseMassB;
-        W.template topLeftCorner<d, d>() += C.transpose() * Ib * C;
-        W.template topRightCorner<d, A>() += C.transpose() * Ib;
-        W.template bottomLeftCorner<A, d>() += Ib * C;
-        W.template bottomRightCorner<A, A>() += Ib;
-      }
-      if (!mass.compute(W)) return false;
-      massReady = true;
-    }
+    if (!buildMass()) return false;
     Twist<d> wrench = mass.solve(next - twist);
     // The columns' Gram matrix M: the rows' N unless a point slides (its column is n + mu T dir
     // instead of the normal row n), so the factorisation of N serves where all points stick.
@@ -270,40 +375,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
     }
     if (changed) continue;
 
-    // The velocities these impulses give, applied as the sweeps apply theirs.
-    Vec<d> va1 = va, vb1 = vb;
-    AngVec<d> wa1 = wa, wb1 = wb;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const Point& p = points[i];
-      const double dn = result[i].normal - p.normalImpulse;
-      const Tangent dt = result[i].tangent - p.tangentImpulse;
-      if (dn == 0 && dt.squaredNorm() == 0) continue;
-      const Vec<d> j = dn * p.n + p.T * dt;
-      if constexpr (movesA) va1 += s.inverseMassA * j, wa1 += dn * p.IaRaN + p.IaRaT * dt;
-      if constexpr (movesB) vb1 -= s.inverseMassB * j, wb1 -= dn * p.IbRbN + p.IbRbT * dt;
-    }
-    // With sliding friction the complementarity problem can have spurious solutions of large
-    // impulses that feed energy in (Painleve's paradox; seen in pyramid_20: a pair of boxes given
-    // 3 J); projected Gauss-Seidel does not find them. An exact finish must not give the bodies
-    // more kinetic energy than they had before the solve, or the sweeps go on instead.
-    double before = 0, after = 0;
-    if constexpr (movesA) {
-      const AngMat<d> inertia = s.inverseInertiaA.inverse();
-      before += s.va.squaredNorm() / s.inverseMassA + s.wa.dot(inertia * s.wa);
-      after += va1.squaredNorm() / s.inverseMassA + wa1.dot(inertia * wa1);
-    }
-    if constexpr (movesB) {
-      const AngMat<d> inertia = s.inverseInertiaB.inverse();
-      before += s.vb.squaredNorm() / s.inverseMassB + s.wb.dot(inertia * s.wb);
-      after += vb1.squaredNorm() / s.inverseMassB + wb1.dot(inertia * wb1);
-    }
-    if (!(after <= before * (1 + 1e-9))) return false;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      points[i].normalImpulse = result[i].normal;
-      points[i].tangentImpulse = result[i].tangent;
-    }
-    va = va1, wa = wa1, vb = vb1, wb = wb1;
-    return true;
+    return accept();
   }
   return false;
 }

@@ -321,6 +321,23 @@ TEST(ExactManifoldFinish, ACubeSlidingOnAllCornersIsLeftToTheSweeps) {
   EXPECT_GT(exact.residual(), 1e-8);
 }
 
+TEST(ExactManifoldFinish, ACubeTippingOntoOneCornerIsSolvedOnTheFewRowsOfThatCorner) {
+  // The cube ends loaded on one sticking corner: three rows (its normal and friction), too few
+  // to fix the twist, so the finish solves (G^T W G) x = wanted on that corner's rows. With one
+  // sweep allowed, the answer must already be the converged one (20000 sweeps), with the other
+  // corners unloaded and not approaching; one sweep alone is far from it.
+  const V3 v(-0.02, -0.10, 0.28), w(0.77, 0.01, -0.79);
+  const double mu = 0.53;
+  const ExactCube exact(v, w, mu, 1, true), reference(v, w, mu, 20000, false), sweep(v, w, mu, 1, false);
+  int loaded = 0;
+  for (const auto& p : exact.cube.points) loaded += p.normalImpulse > 0;
+  EXPECT_EQ(loaded, 1);
+  EXPECT_LT(exact.residual(), 1e-14);
+  expectConeAndComplementarity(exact.cube.points, exact.s, 1e-14);
+  EXPECT_LT((exact.s.va - reference.s.va).norm() + (exact.s.wa - reference.s.wa).norm(), 1e-11);
+  EXPECT_GT((sweep.s.va - reference.s.va).norm() + (sweep.s.wa - reference.s.wa).norm(), 0.1);
+}
+
 TEST(ExactManifoldFinish, TwoMovingBodiesEndExactlyWithoutApproachAndKeepTheirMomentum) {
   PgsBodies<3> s;
   s.va = V3(0.3, -2, 0.1);

@@ -262,6 +262,31 @@ TEST(NarrowPhase3, SmallBoxRestingOnBoxGivesFourCorners) {
   expectManifold<3>(swapped, corners, -Vec3::UnitY(), 0.01);
 }
 
+TEST(NarrowPhase3, PyramidBoxesWithCoplanarSidesGiveOnlyTheFaceCorners) {
+  // The pairs of pyramid_20 (unit boxes at the scene's positions, each layer sunk 0.0015 into
+  // the one below, turned by rounding-sized angles), their z sides coplanar. A corner lying on the other box's side plane must
+  // not come back as an extra contact with that side's normal (perpendicular to the contact, at
+  // depth 0 to rounding): only the four corners of the overlap, along the vertical, within a
+  // margin as the contact stages use it.
+  int pairs = 0;
+  for (int layer = 0; layer + 1 < 20; ++layer)
+    for (int i = 0; i + layer + 1 < 20; ++i)
+      for (const int side : {0, 1}) {
+        const int count = 20 - layer;
+        const Vec3 lower((i + side - 0.5 * (count - 1)) * 1.02, layer + 0.5 - 0.0015 * layer, 0);
+        const Vec3 upper((i - 0.5 * (count - 2)) * 1.02, layer + 1.5 - 0.0015 * (layer + 1), 0);
+        // Orientations off the identity by rounding, as a simulated pyramid's are.
+        const Mat3 tiltUpper = rot(1e-16 * (1 + i % 3), Vec3(1, 0.5 - side, 0.3 * layer - 2));
+        const Mat3 tiltLower = rot(2e-16 * (1 + layer % 2), Vec3(0.2 * i - 1, 1, side - 0.5));
+        const auto got =
+            contacts<3>(box3(0.5, 0.5, 0.5), at(upper, tiltUpper), box3(0.5, 0.5, 0.5), at(lower, tiltLower), 0.01);
+        ASSERT_EQ(got.size(), 4u) << layer << " " << i << " " << side;
+        for (const auto& c : got) EXPECT_NEAR(c.normal.y(), 1.0, 1e-12);
+        ++pairs;
+      }
+  EXPECT_EQ(pairs, 380);
+}
+
 TEST(NarrowPhase3, RotatedBoxOnBoxGivesItsRotatedCorners) {
   const Mat3 R = rot(kPi / 6, Vec3::UnitY());
   const auto got = contacts<3>(box3(0.3, 0.2, 0.3), at(Vec3(0, 1.19, 0), R), box3(1, 1, 1), at(Vec3::Zero()));
