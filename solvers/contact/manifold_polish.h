@@ -1,7 +1,7 @@
 #pragma once
 // The exact end of a manifold solve once projected Gauss-Seidel has found which points carry
 // load and which slide (issue 3; docs/architecture.md "One pair update", docs/benchmarks.md
-// "Manifold solves finished exactly"). Not in the thesis; scene switch
+// "Manifold solves finished exactly" and "Exact finish before the first sweep"). Not in the thesis; scene switch
 // solvers.contact.exact_manifold_finish (off by default).
 //
 // Why: the points of a face contact are redundant. Four corners of a box on a face, or the eight
@@ -12,13 +12,17 @@
 // short-schedule pyramid step. Once the states of the points are known, the answer is a small
 // linear problem in the relative motion instead.
 //
-// With the points' accumulated impulses after some sweeps (3, then 6, 12, ...):
-//   1. states: unloaded (normal impulse 0), sticking (friction strictly inside its disk),
-//      sliding (on the rim), frictionless;
+// Tried before the first sweep, then after sweeps 3, 6, 12, ...:
+//   1. states: before any sweep, a point whose normal velocity is at or below its target is
+//      taken as loaded and sticking, the others as unloaded (a resting manifold is then solved
+//      without sweeping at all); after sweeps, as their impulses say: unloaded (normal impulse
+//      0), sticking (friction strictly inside its disk), sliding (on the rim), frictionless;
 //   2. the relative twist meeting every active row -- normal velocity at its target for loaded
 //      points, zero slip for sticking ones -- by least squares on the 6 x 6 (3 x 3 in 2-D) normal
-//      equations N = G G^T. Rows that cannot all be met, too few rows to fix the relative motion
-//      (fewer than 6, or rank-deficient) and unloaded points left approaching fail;
+//      equations N = G G^T. Rows that cannot all be met and rank-deficient rows fail; an
+//      unloaded point left approaching takes load (next pass). Fewer rows than 6 (a box on one
+//      corner) cannot fix the twist: if no point slides, the impulse changes on the rows' own
+//      columns solve (G^T W G) x = wanted - G^T twist directly instead (steps 3-4 skipped);
 //   3. a sliding point's friction is mu lambda against the slip that twist leaves there, so its
 //      impulse is lambda (n + mu T dir), one unknown;
 //   4. the wrench about x_a that gives the twist (W^{-1} times the change, W the effective

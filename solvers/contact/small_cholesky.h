@@ -4,10 +4,10 @@
 // equations and effective inverse mass (3 x 3 in 2-D), a few of each per pair update.
 //
 // Why not Eigen::LLT: on these fixed 6 x 6 matrices Eigen runs its general unblocked loop with
-// run-time bounds and a separate triangular solve per side; with the sizes known at compile
-// time the loops below unroll, and the reciprocals of the pivots are kept so that the solves
-// multiply. In a short-schedule pyramid_20 step the LLT calls were 15 % of the time
-// (docs/benchmarks.md, "Exact finish before the first sweep").
+// run-time bounds; here the sizes are compile-time constants and the pivots' reciprocals are kept
+// so that the solves multiply. Eigen's LLT calls were 15 % of a short-schedule pyramid_20 step;
+// this one made the step about 2 % faster (docs/benchmarks.md, "Exact finish before the first
+// sweep"): most of that time is the pivots' dependent square roots, which both pay.
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
