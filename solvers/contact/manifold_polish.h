@@ -42,6 +42,7 @@
 // centre, so that the relative velocity at a point along u is u.D_lin + (r_a x u).D_ang + const:
 // the row of a point along u is g = (u, r_a x u), the wrench about x_a of a unit impulse along u.
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -96,38 +97,59 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
   if constexpr (movesA) twist.template head<d>() += va, twist.template tail<A>() += wa;
   if constexpr (movesB)
     twist.template head<d>() -= vb + angularCross<d>(wb, arm), twist.template tail<A>() -= wb;
-  auto rowOf = [](const Vec<d>& u, const AngVec<d>& raU) {
-    Twist<d> g;
-    g << u, raU;
-    return g;
-  };
-  auto tangentRow = [&rowOf](const Point& p, int k) { return rowOf(p.T.col(k), p.raT.col(k)); };
-  // The column of a sliding point: its impulse is lambda (n + mu T dir).
-  auto slidingColumn = [&rowOf](const Point& p, const Tangent& dir) {
-    Vec<d> u = p.n;
-    AngVec<d> raU = p.raN;
-    for (int k = 0; k < m; ++k) u += p.mu * dir[k] * p.T.col(k), raU += p.mu * dir[k] * p.raT.col(k);
-    return rowOf(u, raU);
-  };
-
-  // The points' states, first as the sweeps left them.
+  // The points' states, first as the sweeps left them; per point its rows (u, r_a x u) for
+  // u = n, T_1, ..., built once per call (the loops below read them many times). One
+  // thread-local block: each lookup of a thread_local costs a call.
   enum class State : char { Unloaded, Sticking, Sliding, Frictionless };
-  thread_local std::vector<State> states;
-  thread_local std::vector<Tangent> directions;  // of a sliding point's friction
   struct Impulse {
     double normal;
     Tangent tangent;
   };
-  thread_local std::vector<Impulse> result;
+  struct Scratch {
+    std::vector<State> states;
+    std::vector<Tangent> directions;  // of a sliding point's friction
+    std::vector<Impulse> result;
+    std::vector<std::array<Twist<d>, d>> rows;
+  };
+  thread_local Scratch scratch;
+  std::vector<State>& states = scratch.states;
+  std::vector<Tangent>& directions = scratch.directions;
+  std::vector<Impulse>& result = scratch.result;
+  std::vector<std::array<Twist<d>, d>>& rows = scratch.rows;
   states.resize(points.size());
   directions.resize(points.size());
   result.resize(points.size());
+  rows.resize(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Point& p = points[i];
+    rows[i][0].template head<d>() = p.n;
+    rows[i][0].template tail<A>() = p.raN;
+    for (int k = 0; k < m; ++k) {
+      rows[i][1 + k].template head<d>() = p.T.col(k);
+      rows[i][1 + k].template tail<A>() = p.raT.col(k);
+    }
+  }
+  auto rowN = [&rows](std::size_t i) -> const Twist<d>& { return rows[i][0]; };
+  auto tangentRow = [&rows](std::size_t i, int k) -> const Twist<d>& { return rows[i][1 + k]; };
+  // The column of a sliding point: its impulse is lambda (n + mu T dir).
+  auto slidingColumn = [&](std::size_t i, const Tangent& dir) {
+    Twist<d> c = rows[i][0];
+    for (int k = 0; k < m; ++k) c += points[i].mu * dir[k] * rows[i][1 + k];
+    return c;
+  };
+  // The wrench about x_a of the impulse dn n + T dt at point i.
+  auto impulseWrench = [&rows](std::size_t i, double dn, const Tangent& dt) {
+    Twist<d> w = dn * rows[i][0];
+    for (int k = 0; k < m; ++k) w += dt[k] * rows[i][1 + k];
+    return w;
+  };
+
   const State loaded = State::Sticking, frictionless = State::Frictionless;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Point& p = points[i];
     if (guessLoaded) {
       // Before any sweep: a point carries load if it would otherwise end below its target.
-      const bool carries = p.offsetN + rowOf(p.n, p.raN).dot(twist) < p.target + tolerance;
+      const bool carries = p.offsetN + rowN(i).dot(twist) < p.target + tolerance;
       states[i] = !carries ? State::Unloaded : p.mu > 0 ? loaded : frictionless;
       continue;
     }
@@ -220,7 +242,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
         result[i].tangent = states[i] == State::Sticking ? p.tangentImpulse : Tangent::Zero();
         const double dn = result[i].normal - p.normalImpulse;
         const Tangent dt = result[i].tangent - p.tangentImpulse;
-        if (dn != 0 || dt.squaredNorm() != 0) base += W * rowOf(dn * p.n + p.T * dt, dn * p.raN + p.raT * dt);
+        if (dn != 0 || dt.squaredNorm() != 0) base += W * impulseWrench(i, dn, dt);
       }
       Twist<d> g[D], Wg[D];
       Twist<d> wanted = Twist<d>::Zero();
@@ -228,10 +250,10 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       for (std::size_t i = 0; i < points.size(); ++i) {
         if (states[i] == State::Unloaded) continue;
         const Point& p = points[i];
-        g[k] = rowOf(p.n, p.raN);
+        g[k] = rowN(i);
         wanted[k++] = p.target - p.offsetN;
         if (states[i] == State::Sticking)
-          for (int t = 0; t < m; ++t) g[k] = tangentRow(p, t), wanted[k++] = -p.offsetT[t];
+          for (int t = 0; t < m; ++t) g[k] = tangentRow(i, t), wanted[k++] = -p.offsetT[t];
       }
       TwistMat<d> system = TwistMat<d>::Zero();
       double scale = 0;
@@ -253,7 +275,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       for (std::size_t i = 0; i < points.size(); ++i) {
         const Point& p = points[i];
         if (states[i] == State::Unloaded) {
-          const double vn = p.offsetN + rowOf(p.n, p.raN).dot(next);
+          const double vn = p.offsetN + rowN(i).dot(next);
           if (!(vn >= p.target - tolerance)) states[i] = p.mu > 0 ? loaded : frictionless, changed = true;
           continue;
         }
@@ -278,7 +300,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
     for (std::size_t i = 0; i < points.size(); ++i) {
       if (states[i] == State::Unloaded) continue;
       const Point& p = points[i];
-      const Twist<d> gn = rowOf(p.n, p.raN);
+      const Twist<d> gn = rowN(i);
       Gr += (p.target - p.offsetN - gn.dot(twist)) * gn;
       if (states[i] != State::Sticking) {
         addOuterLower<d>(N, gn);
@@ -288,7 +310,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       // g g^T is [[1, C^T], [C, C C^T]] with C = r_a*, in closed form.
       addStickingBlock<d>(N, p.ra);
       for (int k = 0; k < m; ++k) {
-        const Twist<d> g = tangentRow(p, k);
+        const Twist<d> g = tangentRow(i, k);
         Gr += (-p.offsetT[k] - g.dot(twist)) * g;
       }
     }
@@ -302,7 +324,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
     bool changed = false;
     for (std::size_t i = 0; i < points.size(); ++i) {
       const Point& p = points[i];
-      const double vn = p.offsetN + rowOf(p.n, p.raN).dot(next);
+      const double vn = p.offsetN + rowN(i).dot(next);
       if (states[i] == State::Unloaded) {
         // It would end below its target without load: it carries some.
         if (!(vn >= p.target - tolerance)) states[i] = p.mu > 0 ? loaded : frictionless, changed = true;
@@ -311,7 +333,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       if (!(std::abs(vn - p.target) <= tolerance)) return false;
       if (states[i] == State::Frictionless) continue;
       Tangent slip;
-      for (int k = 0; k < m; ++k) slip[k] = p.offsetT[k] + tangentRow(p, k).dot(next);
+      for (int k = 0; k < m; ++k) slip[k] = p.offsetT[k] + tangentRow(i, k).dot(next);
       const double size = slip.norm();
       if (states[i] == State::Sticking) {
         if (size > tolerance) states[i] = State::Sliding, changed = true;
@@ -343,11 +365,11 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       // The wrench of moving the current impulse to the reference one.
       const double dn = r.normal - p.normalImpulse;
       const Tangent dt = r.tangent - p.tangentImpulse;
-      if (dn != 0 || dt.squaredNorm() != 0) wrench -= rowOf(dn * p.n + p.T * dt, dn * p.raN + p.raT * dt);
+      if (dn != 0 || dt.squaredNorm() != 0) wrench -= impulseWrench(i, dn, dt);
       if (states[i] == State::Sliding) {
         anySliding = true;
-        addOuterLower<d>(M, slidingColumn(p, directions[i]));
-        addOuterLower<d>(M, rowOf(p.n, p.raN), -1.0);
+        addOuterLower<d>(M, slidingColumn(i, directions[i]));
+        addOuterLower<d>(M, rowN(i), -1.0);
       }
     }
     SmallCholesky<D> slidingColumns;
@@ -361,13 +383,13 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       switch (states[i]) {
         case State::Unloaded: continue;
         case State::Sliding:
-          r.normal += slidingColumn(p, directions[i]).dot(multiplier);
+          r.normal += slidingColumn(i, directions[i]).dot(multiplier);
           r.tangent = p.mu * r.normal * directions[i];
           break;
         case State::Sticking:
-          for (int k = 0; k < m; ++k) r.tangent[k] += tangentRow(p, k).dot(multiplier);
+          for (int k = 0; k < m; ++k) r.tangent[k] += tangentRow(i, k).dot(multiplier);
           [[fallthrough]];
-        case State::Frictionless: r.normal += rowOf(p.n, p.raN).dot(multiplier); break;
+        case State::Frictionless: r.normal += rowN(i).dot(multiplier); break;
       }
       if (!(r.normal >= 0)) {
         states[i] = State::Unloaded, changed = true;
