@@ -471,7 +471,11 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
   state.inverseInertiaA = Ia;
   state.inverseInertiaB = Ib;
   state.exactFinish = settings.exactManifoldFinish;
+  // With the exact finish, K's blocks wait until a sweep needs them (pgsSweeps).
+  state.sweepsPrepared = !state.exactFinish;
   if (points.size() == 1) points[0].prepareOnePoint(A.inverseMass() + B.inverseMass(), Ia, Ib);
+  else if (state.exactFinish)
+    for (Point& p : points) p.prepareRows(A.inverseMass() + B.inverseMass(), Ia, Ib);
   else
     for (Point& p : points) p.prepare(A.inverseMass() + B.inverseMass(), Ia, Ib);
 
@@ -580,13 +584,15 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
   if (!anyApproaching) return 0;
   const con::AngMat<d> none = con::AngMat<d>::Zero();
   double speedScale = 0;
+  state.exactFinish = settings.exactManifoldFinish;
+  state.sweepsPrepared = !state.exactFinish;  // as in updatePair
   for (Point& p : points) {
-    p.prepare(C.inverseMass(), Iinv, none);
+    if (state.exactFinish) p.prepareRows(C.inverseMass(), Iinv, none);
+    else p.prepare(C.inverseMass(), Iinv, none);
     speedScale = std::max(speedScale, std::abs(p.target));
   }
   const double tolerance = 1e-7 * speedScale + 1e-12;
   state.inverseInertiaA = Iinv;
-  state.exactFinish = settings.exactManifoldFinish;
   con::pgsSolve<d>(points, state, iterations, tolerance);
   VecD J;
   con::AngVec<d> tau;

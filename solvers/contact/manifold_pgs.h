@@ -55,36 +55,55 @@ struct PgsPoint {
   // Set by pgsSolve: the constant part of the relative normal and tangent velocities.
   double offsetN = 0;
   TangentVec offsetT = TangentVec::Zero();
+  // What prepareRows leaves for prepareSweeps.
+  double inverseMasses_ = 0;
+  bool rotatesA_ = false, rotatesB_ = false;
 
   // inverseMasses: m_a^{-1} + m_b^{-1}; Ia, Ib: the inverse inertias the impulses are applied
   // with (zero for a body of infinite mass). K's blocks come from the Jacobian rows:
   // u.K v = (m_a^{-1} + m_b^{-1}) u.v + (r_a x u).I_a^{-1}(r_a x v) + (r_b x u).I_b^{-1}(r_b x v),
   // with T^T n = 0 and T^T T = 1 (K itself, 3x3, only for a one-point manifold: prepareOnePoint).
   void prepare(double inverseMasses, const AngMat<d>& Ia, const AngMat<d>& Ib) {
+    prepareRows(inverseMasses, Ia, Ib);
+    prepareSweeps();
+  }
+  // The Jacobian rows and what the exact finish needs (manifold_polish.h).
+  void prepareRows(double inverseMasses, const AngMat<d>& Ia, const AngMat<d>& Ib) {
     setTangentBasis();
     // A body of infinite mass (zero inverse inertia) adds nothing to K: its terms are skipped,
     // its I^{-1}(r x u) stay zero (a fresh point).
-    const bool rotatesA = !Ia.isZero(0), rotatesB = !Ib.isZero(0);
+    rotatesA_ = !Ia.isZero(0), rotatesB_ = !Ib.isZero(0);
+    inverseMasses_ = inverseMasses;
     raN = crossOf(ra, n);
     rbN = crossOf(rb, n);
-    kn = inverseMasses;
-    if (rotatesA) IaRaN = Ia * raN, kn += raN.dot(IaRaN);
-    if (rotatesB) IbRbN = Ib * rbN, kn += rbN.dot(IbRbN);
-    inverseKn = 1 / kn;
+    if (rotatesA_) IaRaN = Ia * raN;
+    if (rotatesB_) IbRbN = Ib * rbN;
     biasN = n.dot(partnerVelocity);
-    TangentMat Ktt = inverseMasses * TangentMat::Identity();
     for (int k = 0; k < d - 1; ++k) {
       raT.col(k) = crossOf(ra, T.col(k));
       rbT.col(k) = crossOf(rb, T.col(k));
-      TKn[k] = 0;
-      if (rotatesA) IaRaT.col(k) = Ia * raT.col(k), TKn[k] += raT.col(k).dot(IaRaN);
-      if (rotatesB) IbRbT.col(k) = Ib * rbT.col(k), TKn[k] += rbT.col(k).dot(IbRbN);
+      if (rotatesA_) IaRaT.col(k) = Ia * raT.col(k);
+      if (rotatesB_) IbRbT.col(k) = Ib * rbT.col(k);
       biasT[k] = T.col(k).dot(partnerVelocity);
+    }
+  }
+  // K's normal and tangent-plane blocks, which only the sweeps use (after prepareRows). A solve
+  // that the exact finish ends before its first sweep never needs them.
+  void prepareSweeps() {
+    kn = inverseMasses_;
+    if (rotatesA_) kn += raN.dot(IaRaN);
+    if (rotatesB_) kn += rbN.dot(IbRbN);
+    inverseKn = 1 / kn;
+    TangentMat Ktt = inverseMasses_ * TangentMat::Identity();
+    for (int k = 0; k < d - 1; ++k) {
+      TKn[k] = 0;
+      if (rotatesA_) TKn[k] += raT.col(k).dot(IaRaN);
+      if (rotatesB_) TKn[k] += rbT.col(k).dot(IbRbN);
     }
     for (int k = 0; k < d - 1; ++k)
       for (int l = 0; l < d - 1; ++l) {
-        if (rotatesA) Ktt(k, l) += raT.col(k).dot(IaRaT.col(l));
-        if (rotatesB) Ktt(k, l) += rbT.col(k).dot(IbRbT.col(l));
+        if (rotatesA_) Ktt(k, l) += raT.col(k).dot(IaRaT.col(l));
+        if (rotatesB_) Ktt(k, l) += rbT.col(k).dot(IbRbT.col(l));
       }
     tangentMass = Ktt.inverse();
     if constexpr (d == 3) {
@@ -147,6 +166,8 @@ struct PgsBodies {
   // Finish with the exact active-set step of manifold_polish.h once it applies (after sweeps
   // 3, 6, 12, 24, ...); off: sweeps only, to the stop test or the sweep limit.
   bool exactFinish = false;
+  // The points had only prepareRows (exact finish): pgsSweeps prepares the rest before sweeping.
+  bool sweepsPrepared = true;
 };
 
 // Part of the relative velocity at p that no impulse of this solve changes: the partner's
@@ -312,6 +333,8 @@ void pgsSweeps(std::vector<PgsPoint<d>>& points, PgsBodies<d>& s, int iterations
     s.va = va, s.vb = vb, s.wa = wa, s.wb = wb;
     return;
   }
+  if (!s.sweepsPrepared)
+    for (PgsPoint<d>& p : points) p.prepareSweeps();
   for (int sweep = 1; sweep <= iterations; ++sweep) {
     double change2 = 0;
     for (PgsPoint<d>& p : points)
