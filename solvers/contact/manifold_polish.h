@@ -159,11 +159,19 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
                 : p.tangentImpulse.squaredNorm() < (1 - 1e-9) * limit * limit ? loaded
                                                                                 : State::Sliding;
   }
+  // A's inertia (the inverse of the inverse inertia the points were prepared with), for the
+  // energy test and, when only A moves, for W^{-1}.
+  AngMat<d> inertiaA;
+  bool inertiaReady = false;
+  auto inertiaOfA = [&]() -> const AngMat<d>& {
+    if (!inertiaReady) inertiaA = s.inverseInertiaA.inverse(), inertiaReady = true;
+    return inertiaA;
+  };
   // W = W_A + S^T W_B S: the effective inverse mass of the relative twist for a wrench about x_a
   // (S: a wrench about x_a to one about x_b; C: F -> (x_a - x_b) x F). Built on first use.
   TwistMat<d> W;
   SmallCholesky<D> mass;
-  bool massReady = false;
+  bool massReady = false, massFactored = false;
   auto buildMass = [&]() {
     if (massReady) return true;
     W.setZero();
@@ -180,7 +188,19 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       W.template bottomLeftCorner<A, d>() += Ib * C;
       W.template bottomRightCorner<A, A>() += Ib;
     }
-    return massReady = mass.compute(W);
+    return massReady = true;
+  };
+  // The wrench W^{-1} change. Only A moving: W is block diagonal, W^{-1} = diag(m_a, I_a).
+  auto wrenchFor = [&](const Twist<d>& change, Twist<d>& wrench) {
+    if constexpr (movesA && !movesB) {
+      wrench.template head<d>() = change.template head<d>() / s.inverseMassA;
+      wrench.template tail<A>() = inertiaOfA() * change.template tail<A>();
+      return true;
+    }
+    if (!buildMass()) return false;
+    if (!massFactored && !(massFactored = mass.compute(W))) return false;
+    wrench = mass.solve(change);
+    return true;
   };
 
   // The velocities the impulses in `result` give, applied as the sweeps apply theirs, if the
@@ -203,7 +223,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
     // more kinetic energy than they had before the solve, or the sweeps go on instead.
     double before = 0, after = 0;
     if constexpr (movesA) {
-      const AngMat<d> inertia = s.inverseInertiaA.inverse();
+      const AngMat<d>& inertia = inertiaOfA();
       before += s.va.squaredNorm() / s.inverseMassA + s.wa.dot(inertia * s.wa);
       after += va1.squaredNorm() / s.inverseMassA + wa1.dot(inertia * wa1);
     }
@@ -348,8 +368,8 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
     // The wrench about x_a that changes the twist to `next`, and the impulses that give it:
     // the change of least norm from reference impulses (the current ones, a sliding point's
     // turned to its new direction, an unloaded point's zero).
-    if (!buildMass()) return false;
-    Twist<d> wrench = mass.solve(next - twist);
+    Twist<d> wrench;
+    if (!wrenchFor(next - twist, wrench)) return false;
     // The columns' Gram matrix M: the rows' N unless a point slides (its column is n + mu T dir
     // instead of the normal row n), so the factorisation of N serves where all points stick.
     bool anySliding = false;
