@@ -621,9 +621,13 @@ void ContactWorkspace<d>::startOrder(solvers::parallel::OrderedTasks& order, int
   const int members = static_cast<int>(islands.members[island].size());
   // Blocks of 4 updates: measured on 2 threads (docs/benchmarks.md) against 1, 2, 8 and 16, it
   // keeps pyramid_20's speed-up and stops the cheap sphere-pair checks of a pour from costing
-  // more to hand over than to run. One thread (or one body): no dependencies needed.
-  constexpr int kGrain = 4;
-  order.reset(members, kGrain, members > 1 && tbb::this_task_arena::max_concurrency() > 1);
+  // more to hand over than to run. With the exact finish most manifold solves end before their
+  // first sweep, so an update costs less and blocks of 2 hand over better: on 2 threads the
+  // short-schedule pyramid_20 step took 17 % less time with 2 than with 4 (16: 19 % more),
+  // while at the defaults and in the 250-sphere pour 2 cost 2-5 % more (docs/benchmarks.md,
+  // "Exact finish before the first sweep"). One thread (or one body): no dependencies needed.
+  const int grain = settings.exactManifoldFinish ? 2 : 4;
+  order.reset(members, grain, members > 1 && tbb::this_task_arena::max_concurrency() > 1);
 }
 
 template <int d>
