@@ -1,13 +1,14 @@
 #pragma once
-// Cholesky factorisation of a small symmetric positive definite matrix of fixed size, read from
-// its lower triangle, for the exact manifold finish (manifold_polish.h): its 6 x 6 normal
+// Cholesky (L D L^T) factorisation of a small symmetric positive definite matrix of fixed size,
+// read from its lower triangle, for the exact manifold finish (manifold_polish.h): its 6 x 6 normal
 // equations and effective inverse mass (3 x 3 in 2-D), a few of each per pair update.
 //
 // Why not Eigen::LLT: on these fixed 6 x 6 matrices Eigen runs its general unblocked loop with
 // run-time bounds; here the sizes are compile-time constants and the pivots' reciprocals are kept
-// so that the solves multiply. Eigen's LLT calls were 15 % of a short-schedule pyramid_20 step;
-// this one made the step about 2 % faster (docs/benchmarks.md, "Exact finish before the first
-// sweep"): most of that time is the pivots' dependent square roots, which both pay.
+// so that the solves multiply. Eigen's LLT calls were 15 % of a short-schedule pyramid_20 step.
+// An L L^T written so made the step about 2 % faster; this L D L^T, which keeps the square
+// roots off the pivots' dependent chain, another 6 % (docs/benchmarks.md, "Exact finish before
+// the first sweep").
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
@@ -20,29 +21,30 @@ class SmallCholesky {
   using Matrix = Eigen::Matrix<double, n, n>;
   using Vector = Eigen::Matrix<double, n, 1>;
 
-  // A = L L^T from A's lower triangle. False if a pivot is not positive (or NaN): A is not
-  // positive definite to rounding.
+  // A = L D L^T from A's lower triangle (unit L, no square roots on the pivots' dependent
+  // chain). False if a pivot is not positive (or NaN): A is not positive definite to rounding.
   bool compute(const Matrix& a) {
     for (int j = 0; j < n; ++j) {
       double pivot = a(j, j);
-      for (int k = 0; k < j; ++k) pivot -= l_[j][k] * l_[j][k];
+      for (int k = 0; k < j; ++k) pivot -= l_[j][k] * ld_[j][k];
       if (!(pivot > 0)) return false;
-      l_[j][j] = std::sqrt(pivot);
-      inverseRoot_[j] = 1 / l_[j][j];
+      pivot_[j] = pivot;
+      inversePivot_[j] = 1 / pivot;
       for (int i = j + 1; i < n; ++i) {
         double v = a(i, j);
-        for (int k = 0; k < j; ++k) v -= l_[i][k] * l_[j][k];
-        l_[i][j] = v * inverseRoot_[j];
+        for (int k = 0; k < j; ++k) v -= l_[i][k] * ld_[j][k];
+        ld_[i][j] = v;  // L(i, j) D(j)
+        l_[i][j] = v * inversePivot_[j];
       }
     }
     return true;
   }
-  // True if the smallest diagonal entry of L exceeds `ratio` times the largest: a test of rank
-  // (the square roots of the pivots scale like the singular values' roots).
+  // True if the smallest pivot exceeds `ratio`^2 times the largest: a test of rank (the
+  // pivots scale like the singular values; `ratio` is on their square roots, as for L L^T).
   bool wellConditioned(double ratio) const {
-    double lo = l_[0][0], hi = l_[0][0];
-    for (int j = 1; j < n; ++j) lo = std::min(lo, l_[j][j]), hi = std::max(hi, l_[j][j]);
-    return lo > ratio * hi;
+    double lo = pivot_[0], hi = pivot_[0];
+    for (int j = 1; j < n; ++j) lo = std::min(lo, pivot_[j]), hi = std::max(hi, pivot_[j]);
+    return lo > ratio * ratio * hi;
   }
   // A^{-1} b (after a successful compute).
   Vector solve(const Vector& b) const {
@@ -50,20 +52,20 @@ class SmallCholesky {
     for (int i = 0; i < n; ++i) {
       double v = b[i];
       for (int k = 0; k < i; ++k) v -= l_[i][k] * y[k];
-      y[i] = v * inverseRoot_[i];
+      y[i] = v;
     }
     Vector x;
     for (int i = n - 1; i >= 0; --i) {
-      double v = y[i];
+      double v = y[i] * inversePivot_[i];
       for (int k = i + 1; k < n; ++k) v -= l_[k][i] * x[k];
-      x[i] = v * inverseRoot_[i];
+      x[i] = v;
     }
     return x;
   }
 
  private:
-  double l_[n][n] = {};
-  double inverseRoot_[n] = {};
+  double l_[n][n] = {}, ld_[n][n] = {};
+  double pivot_[n] = {}, inversePivot_[n] = {};
 };
 
 }  // namespace monolith::solvers::contact
