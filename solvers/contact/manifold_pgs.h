@@ -163,8 +163,9 @@ struct PgsBodies {
   // The inverse inertias the points were prepared with (PgsPoint::prepare's Ia, Ib).
   AngMat<d> inverseInertiaA = AngMat<d>::Zero(), inverseInertiaB = AngMat<d>::Zero();
   bool movesA = false, movesB = false;  // bodies of infinite mass take no impulse
-  // Finish with the exact active-set step of manifold_polish.h once it applies (after sweeps
-  // 3, 6, 12, 24, ...); off: sweeps only, to the stop test or the sweep limit.
+  // Finish with the exact active-set step of manifold_polish.h once it applies (tried before
+  // the first sweep, then after sweeps 3, 6, 12, 24, ...); off: sweeps only, to the stop test
+  // or the sweep limit.
   bool exactFinish = false;
   // The points had only prepareRows (exact finish): pgsSweeps prepares the rest before sweeping.
   bool sweepsPrepared = true;

@@ -1,8 +1,8 @@
 #pragma once
 // The exact end of a manifold solve once projected Gauss-Seidel has found which points carry
 // load and which slide (issue 3; docs/architecture.md "One pair update", docs/benchmarks.md
-// "Manifold solves finished exactly" and "Exact finish before the first sweep"). Not in the thesis; scene switch
-// solvers.contact.exact_manifold_finish (off by default).
+// "Manifold solves finished exactly" and "Exact finish before the first sweep"). Not in the
+// thesis; scene switch solvers.contact.exact_manifold_finish (off by default).
 //
 // Why: the points of a face contact are redundant. Four corners of a box on a face, or the eight
 // of a pyramid box on the two below it, put 12 or 24 impulse components against the 6 degrees
@@ -173,7 +173,8 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
   SmallCholesky<D> mass;
   bool massReady = false, massFactored = false;
   auto buildMass = [&]() {
-    if (massReady) return true;
+    if (massReady) return;
+    massReady = true;
     W.setZero();
     if constexpr (movesA) {
       W.template topLeftCorner<d, d>().diagonal().array() += s.inverseMassA;
@@ -188,7 +189,6 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       W.template bottomLeftCorner<A, d>() += Ib * C;
       W.template bottomRightCorner<A, A>() += Ib;
     }
-    return massReady = true;
   };
   // The wrench W^{-1} change. Only A moving: W is block diagonal, W^{-1} = diag(m_a, I_a).
   auto wrenchFor = [&](const Twist<d>& change, Twist<d>& wrench) {
@@ -197,9 +197,18 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       wrench.template tail<A>() = inertiaOfA() * change.template tail<A>();
       return true;
     }
-    if (!buildMass()) return false;
+    buildMass();
     if (!massFactored && !(massFactored = mass.compute(W))) return false;
     wrench = mass.solve(change);
+    return true;
+  };
+
+  // An unloaded point that would end below its target at `next` carries load after all (the
+  // next pass). Returns whether it changed.
+  auto takesLoad = [&](std::size_t i, const Twist<d>& next) {
+    const Point& p = points[i];
+    if (p.offsetN + rowN(i).dot(next) >= p.target - tolerance) return false;
+    states[i] = p.mu > 0 ? loaded : frictionless;
     return true;
   };
 
@@ -241,76 +250,84 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
     return true;
   };
 
+  // Fewer active rows than the twist has dimensions (a box pivoting on one corner): they cannot
+  // fix the relative motion, the bodies' masses decide the rest. For loaded points that all
+  // stick (or have no friction) the impulse changes x on the rows' own columns solve
+  // (G^T W G) x = wanted - G^T twist, positive definite when the rows are independent.
+  enum class Outcome { Failed, Changed, Accepted };
+  auto solveFewRows = [&]() {
+    for (const State st : states)
+      if (st == State::Sliding) return Outcome::Failed;
+    buildMass();
+    // Reference impulses: the current ones, an unloaded point's removed.
+    Twist<d> base = twist;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Point& p = points[i];
+      result[i].normal = states[i] == State::Unloaded ? 0.0 : p.normalImpulse;
+      result[i].tangent = states[i] == State::Sticking ? p.tangentImpulse : Tangent::Zero();
+      const double dn = result[i].normal - p.normalImpulse;
+      const Tangent dt = result[i].tangent - p.tangentImpulse;
+      if (dn != 0 || dt.squaredNorm() != 0) base += W * impulseWrench(i, dn, dt);
+    }
+    Twist<d> g[D], Wg[D];
+    Twist<d> wanted = Twist<d>::Zero();
+    int k = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (states[i] == State::Unloaded) continue;
+      const Point& p = points[i];
+      g[k] = rowN(i);
+      wanted[k++] = p.target - p.offsetN;
+      if (states[i] == State::Sticking)
+        for (int t = 0; t < m; ++t) g[k] = tangentRow(i, t), wanted[k++] = -p.offsetT[t];
+    }
+    TwistMat<d> system = TwistMat<d>::Zero();
+    double scale = 0;
+    for (int c = 0; c < k; ++c) {
+      Wg[c] = W * g[c];
+      for (int r = c; r < k; ++r) system(r, c) = g[r].dot(Wg[c]);
+      scale += system(c, c);
+      wanted[c] -= g[c].dot(base);
+    }
+    if (k == 0) return Outcome::Failed;  // nothing loaded
+    // Padded to D x D with the mean pivot, so that the rank test compares like with like.
+    for (int c = k; c < D; ++c) system(c, c) = scale / k;
+    SmallCholesky<D> few;
+    if (!(few.compute(system) && few.wellConditioned(1e-6))) return Outcome::Failed;
+    const Twist<d> x = few.solve(wanted);
+    Twist<d> next = base;
+    for (int c = 0; c < k; ++c) next += x[c] * Wg[c];
+    bool changed = false;
+    k = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Point& p = points[i];
+      if (states[i] == State::Unloaded) {
+        changed = takesLoad(i, next) || changed;
+        continue;
+      }
+      result[i].normal += x[k++];
+      if (states[i] == State::Sticking)
+        for (int t = 0; t < m; ++t) result[i].tangent[t] += x[k++];
+      if (!(result[i].normal >= 0)) {
+        states[i] = State::Unloaded, changed = true;
+        continue;
+      }
+      const double limit = p.mu * result[i].normal;
+      if (states[i] == State::Sticking && !(result[i].tangent.squaredNorm() <= limit * limit))
+        return Outcome::Failed;
+    }
+    if (changed) return Outcome::Changed;
+    return accept() ? Outcome::Accepted : Outcome::Failed;
+  };
+
   // An active-set iteration: a sticking point that the twist would make slip, or whose impulse
   // leaves its disk, slides; a point whose impulse would turn negative is unloaded; then again.
   for (int pass = 0; pass < 4; ++pass) {
-    int rows = 0;
-    for (const State st : states) rows += st == State::Sticking ? d : st == State::Unloaded ? 0 : 1;
-    if (rows < D) {
-      // Too few rows to fix the relative motion (a box pivoting on one corner): the bodies'
-      // masses decide the rest. For loaded points that all stick (or have no friction) the
-      // impulse changes x on the rows' own columns solve (G^T W G) x = wanted - G^T twist,
-      // positive definite when the rows are independent.
-      for (const State st : states)
-        if (st == State::Sliding) return false;
-      if (!buildMass()) return false;
-      // Reference impulses: the current ones, an unloaded point's removed.
-      Twist<d> base = twist;
-      for (std::size_t i = 0; i < points.size(); ++i) {
-        const Point& p = points[i];
-        result[i].normal = states[i] == State::Unloaded ? 0.0 : p.normalImpulse;
-        result[i].tangent = states[i] == State::Sticking ? p.tangentImpulse : Tangent::Zero();
-        const double dn = result[i].normal - p.normalImpulse;
-        const Tangent dt = result[i].tangent - p.tangentImpulse;
-        if (dn != 0 || dt.squaredNorm() != 0) base += W * impulseWrench(i, dn, dt);
-      }
-      Twist<d> g[D], Wg[D];
-      Twist<d> wanted = Twist<d>::Zero();
-      int k = 0;
-      for (std::size_t i = 0; i < points.size(); ++i) {
-        if (states[i] == State::Unloaded) continue;
-        const Point& p = points[i];
-        g[k] = rowN(i);
-        wanted[k++] = p.target - p.offsetN;
-        if (states[i] == State::Sticking)
-          for (int t = 0; t < m; ++t) g[k] = tangentRow(i, t), wanted[k++] = -p.offsetT[t];
-      }
-      TwistMat<d> system = TwistMat<d>::Zero();
-      double scale = 0;
-      for (int c = 0; c < k; ++c) {
-        Wg[c] = W * g[c];
-        for (int r = c; r < k; ++r) system(r, c) = g[r].dot(Wg[c]);
-        scale += system(c, c);
-        wanted[c] -= g[c].dot(base);
-      }
-      // Padded to D x D with the mean pivot, so that the rank test compares like with like.
-      for (int c = k; c < D; ++c) system(c, c) = scale / k;
-      SmallCholesky<D> few;
-      if (!(few.compute(system) && few.wellConditioned(1e-6))) return false;
-      const Twist<d> x = few.solve(wanted);
-      Twist<d> next = base;
-      for (int c = 0; c < k; ++c) next += x[c] * Wg[c];
-      bool changed = false;
-      k = 0;
-      for (std::size_t i = 0; i < points.size(); ++i) {
-        const Point& p = points[i];
-        if (states[i] == State::Unloaded) {
-          const double vn = p.offsetN + rowN(i).dot(next);
-          if (!(vn >= p.target - tolerance)) states[i] = p.mu > 0 ? loaded : frictionless, changed = true;
-          continue;
-        }
-        result[i].normal += x[k++];
-        if (states[i] == State::Sticking)
-          for (int t = 0; t < m; ++t) result[i].tangent[t] += x[k++];
-        if (!(result[i].normal >= 0)) {
-          states[i] = State::Unloaded, changed = true;
-          continue;
-        }
-        const double limit = p.mu * result[i].normal;
-        if (states[i] == State::Sticking && !(result[i].tangent.squaredNorm() <= limit * limit)) return false;
-      }
-      if (changed) continue;
-      return accept();
+    int activeRows = 0;
+    for (const State st : states) activeRows += st == State::Sticking ? d : st == State::Unloaded ? 0 : 1;
+    if (activeRows < D) {
+      const Outcome outcome = solveFewRows();
+      if (outcome == Outcome::Changed) continue;
+      return outcome == Outcome::Accepted;
     }
 
     // The twist meeting every active row (normal velocity at its target; no slip where sticking),
@@ -344,12 +361,11 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
     bool changed = false;
     for (std::size_t i = 0; i < points.size(); ++i) {
       const Point& p = points[i];
-      const double vn = p.offsetN + rowN(i).dot(next);
       if (states[i] == State::Unloaded) {
-        // It would end below its target without load: it carries some.
-        if (!(vn >= p.target - tolerance)) states[i] = p.mu > 0 ? loaded : frictionless, changed = true;
+        changed = takesLoad(i, next) || changed;
         continue;
       }
+      const double vn = p.offsetN + rowN(i).dot(next);
       if (!(std::abs(vn - p.target) <= tolerance)) return false;
       if (states[i] == State::Frictionless) continue;
       Tangent slip;
