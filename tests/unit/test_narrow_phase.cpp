@@ -264,10 +264,11 @@ TEST(NarrowPhase3, SmallBoxRestingOnBoxGivesFourCorners) {
 
 TEST(NarrowPhase3, PyramidBoxesWithCoplanarSidesGiveOnlyTheFaceCorners) {
   // The pairs of pyramid_20 (unit boxes at the scene's positions, each layer sunk 0.0015 into
-  // the one below, turned by rounding-sized angles), their z sides coplanar. A corner lying on the other box's side plane must
-  // not come back as an extra contact with that side's normal (perpendicular to the contact, at
-  // depth 0 to rounding): only the four corners of the overlap, along the vertical, within a
-  // margin as the contact stages use it.
+  // the one below, turned by rounding-sized angles), their z sides coplanar. A corner lying on
+  // the other box's side plane must not come back as an extra contact with that side's normal
+  // (perpendicular to the contact, at depth 0 to rounding): only the four corners of the
+  // overlap, along the vertical, within a margin as the contact stages use it. With the old
+  // rule (normals merely not opposing the main one) this fails.
   int pairs = 0;
   for (int layer = 0; layer + 1 < 20; ++layer)
     for (int i = 0; i + layer + 1 < 20; ++i)
