@@ -345,8 +345,13 @@ int ContactWorkspace<d>::computeLevels() {
   // they end up at the bottom.
   std::vector<std::pair<int, int>>& edges = graphEdges;
   edges.clear();
-  const int added =
-      growPairs([&](const ContactBody<d>& b) { return std::array<col::Pose<d>, 2>{reAdvanced(b, 0.0), reAdvanced(b, 1.0)}; });
+  // Each body's two poses once (a quaternion turn each), read by every pair it is in.
+  std::vector<std::array<col::Pose<d>, 2>>& poses = reAdvancedPoses_;
+  poses.resize(bodies.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bodies.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) poses[i] = {reAdvanced(bodies[i], 0.0), reAdvanced(bodies[i], 1.0)};
+  });
+  const int added = growPairs([&](const ContactBody<d>& b) -> const std::array<col::Pose<d>, 2>& { return poses[&b - bodies.data()]; });
   // The same test also completes the processed list (notes 1.4, "contact pairs" gathered on the
   // last collision sweep): bodies resting on each other fall together in the candidate
   // positions, so only moving one of them with its new velocity shows that they touch. A
@@ -354,10 +359,10 @@ int ContactWorkspace<d>::computeLevels() {
   col::ContactQuery query;
   query.margin = settings.thickness;
   query.maxPoints = 1;
-  auto touches = [&](const ContactBody<d>& mover, const ContactBody<d>& other) {
+  auto touches = [&](int mover, int other) {
     thread_local std::vector<col::ContactPoint<d>> scratch;
     scratch.clear();
-    return col::findContacts(*mover.geometry, reAdvanced(mover, 1.0), *other.geometry, reAdvanced(other, 0.0), query,
+    return col::findContacts(*bodies[mover].geometry, poses[mover][1], *bodies[other].geometry, poses[other][0], query,
                              scratch) > 0;
   };
   // The tests only read the bodies: each pair's two answers in its own slot, in parallel, then
@@ -367,8 +372,8 @@ int ContactWorkspace<d>::computeLevels() {
     for (std::size_t k = r.begin(); k != r.end(); ++k) {
       const ContactBody<d>& A = bodies[pairs[k].a];
       const ContactBody<d>& B = bodies[pairs[k].b];
-      aOverB[k] = !(A.isStatic || A.kinematic) && touches(A, B);
-      bOverA[k] = !(B.isStatic || B.kinematic) && touches(B, A);
+      aOverB[k] = !(A.isStatic || A.kinematic) && touches(pairs[k].a, pairs[k].b);
+      bOverA[k] = !(B.isStatic || B.kinematic) && touches(pairs[k].b, pairs[k].a);
     }
   });
   for (std::size_t k = 0; k < pairs.size(); ++k) {

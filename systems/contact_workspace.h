@@ -7,6 +7,7 @@
 //
 // Conventions (notes 7.2): in a pair (a, b) the normal points out of b towards a, a receives
 // +j and b receives -j, the relative velocity is v_a - v_b at the point.
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -259,6 +260,8 @@ class ContactWorkspace {
   // growPairs' buffers: which boxes grew, and the merged pair list.
   std::vector<char> grew_;
   std::vector<std::pair<int, int>> mergedPairs_;
+  // computeLevels' poses of each body re-advanced with its old and its new velocity.
+  std::vector<std::array<solvers::collision::Pose<d>, 2>> reAdvancedPoses_;
 };
 
 }  // namespace monolith

@@ -158,6 +158,9 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
                 : !(p.mu > 0)           ? frictionless
                 : p.tangentImpulse.squaredNorm() < (1 - 1e-9) * limit * limit ? loaded
                                                                                 : State::Sliding;
+    // A sliding point's friction keeps the sweeps' direction unless the twist slips it.
+    if (states[i] == State::Sliding)
+      directions[i] = p.tangentImpulse.squaredNorm() > 0 ? Tangent(p.tangentImpulse.normalized()) : Tangent::UnitX();
   }
   // A's inertia (the inverse of the inverse inertia the points were prepared with), for the
   // energy test and, when only A moves, for W^{-1}.
@@ -372,12 +375,10 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       for (int k = 0; k < m; ++k) slip[k] = p.offsetT[k] + tangentRow(i, k).dot(next);
       const double size = slip.norm();
       if (states[i] == State::Sticking) {
-        if (size > tolerance) states[i] = State::Sliding, changed = true;
+        if (size > tolerance) states[i] = State::Sliding, directions[i] = -slip / size, changed = true;
         continue;
       }
       if (size > tolerance) directions[i] = -slip / size;
-      else if (p.tangentImpulse.squaredNorm() > 0) directions[i] = p.tangentImpulse.normalized();
-      else directions[i] = Tangent::UnitX();
     }
     if (changed) continue;
 
@@ -413,6 +414,8 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
     const Twist<d> multiplier = anySliding ? slidingColumns.solve(wrench) : normal.solve(wrench);
 
     // The impulses must stay in their cones.
+    std::size_t worst = points.size();
+    double worstRatio = 1;
     for (std::size_t i = 0; i < points.size(); ++i) {
       const Point& p = points[i];
       Impulse& r = result[i];
@@ -432,10 +435,15 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
         continue;
       }
       const double limit = p.mu * r.normal;
-      if (states[i] == State::Sticking && !(r.tangent.squaredNorm() <= limit * limit))
-        states[i] = State::Sliding, changed = true;
+      const double ratio = r.tangent.squaredNorm() / (limit * limit);
+      if (states[i] == State::Sticking && !(ratio <= worstRatio)) worst = i, worstRatio = ratio;
     }
     if (changed) continue;
+    if (worst < points.size()) {
+      states[worst] = State::Sliding;
+      directions[worst] = result[worst].tangent.normalized();
+      continue;
+    }
 
     return accept();
   }
