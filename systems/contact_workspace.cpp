@@ -93,6 +93,38 @@ int netImpulse(const std::vector<con::PgsPoint<d>>& points, Eigen::Matrix<double
   return active;
 }
 
+// The pair's manifold solve starts where its last one ended (ContactPairState::endStates), if
+// the narrow phase gave as many points; the point order of a manifold that barely moved is the
+// same. Only a start: the exact finish still checks every condition and changes what fails.
+template <int d>
+void recallEndStates(const ContactPairState& pair, std::vector<con::PgsPoint<d>>& points) {
+  if (pair.endPoints != static_cast<int>(points.size())) return;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    con::PgsPoint<d>& p = points[i];
+    p.startState = static_cast<con::PointState>((pair.endStates >> (2 * i)) & 3u);
+    if (p.startState != con::PointState::Sliding) continue;
+    const double angle = pair.endAngles[i];
+    if constexpr (d == 3) p.startDirection = Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    else p.startDirection[0] = angle == 0 ? 1.0 : -1.0;
+  }
+}
+
+template <int d>
+void rememberEndStates(ContactPairState& pair, const std::vector<con::PgsPoint<d>>& points) {
+  pair.endPoints = 0;
+  if (points.size() > static_cast<std::size_t>(ContactPairState::kRememberedPoints)) return;
+  pair.endStates = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const con::PgsPoint<d>& p = points[i];
+    const con::PointState state = con::stateFromImpulses(p);
+    pair.endStates |= static_cast<std::uint16_t>(static_cast<unsigned>(state) << (2 * i));
+    if (state != con::PointState::Sliding) continue;
+    if constexpr (d == 3) pair.endAngles[i] = static_cast<float>(std::atan2(p.tangentImpulse[1], p.tangentImpulse[0]));
+    else pair.endAngles[i] = p.tangentImpulse[0] >= 0 ? 0.0f : 3.14159265f;
+  }
+  pair.endPoints = static_cast<signed char>(points.size());
+}
+
 }  // namespace
 
 template <int d>
@@ -275,11 +307,21 @@ void ContactWorkspace<d>::findPairs() {
     broadPhase_ = std::make_unique<col::BroadPhase<d>>(n > 500 ? col::BroadPhaseMethod::FclDynamicTree
                                                                : col::BroadPhaseMethod::SweepAndPrune);
   const auto& found = broadPhase_->findPairs(boxes_, infinite_);
-  pairs.assign(found.size(), ContactPairState{});
+  // A fresh state per pair, except how its last manifold solve ended (both lists are sorted).
+  std::vector<ContactPairState>& fresh = freshPairs_;
+  fresh.assign(found.size(), ContactPairState{});
+  std::size_t old = 0;
   for (std::size_t k = 0; k < found.size(); ++k) {
-    pairs[k].a = found[k].first;
-    pairs[k].b = found[k].second;
+    ContactPairState& pair = fresh[k];
+    pair.a = found[k].first;
+    pair.b = found[k].second;
+    while (old < pairs.size() && std::make_pair(pairs[old].a, pairs[old].b) < found[k]) ++old;
+    if (old == pairs.size() || pairs[old].a != pair.a || pairs[old].b != pair.b) continue;
+    pair.endStates = pairs[old].endStates;
+    pair.endPoints = pairs[old].endPoints;
+    std::copy(std::begin(pairs[old].endAngles), std::end(pairs[old].endAngles), std::begin(pair.endAngles));
   }
+  pairs.swap(fresh);
   islands = con::computeIslands(n, found, infinite_);
   islandPairsByLevel = islands.pairs;
   memberIndex_.assign(n, -1);
@@ -499,7 +541,9 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
     // Gauss-Seidel on accumulated impulses (normal >= 0, friction inside the Coulomb disk), so
     // a box lying flat stops at all its corners at once instead of rocking between them as
     // one-point-at-a-time impulses do.
+    if (state.exactFinish) recallEndStates<d>(pair, points);
     con::pgsSolve<d>(points, state, iterations, tolerance);
+    if (state.exactFinish) rememberEndStates<d>(pair, points);
   }
   // Net impulse on A and its angular impulse about A's centre.
   VecD J;

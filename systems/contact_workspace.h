@@ -8,6 +8,7 @@
 // Conventions (notes 7.2): in a pair (a, b) the normal points out of b towards a, a receives
 // +j and b receives -j, the relative velocity is v_a - v_b at the point.
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -94,6 +95,14 @@ struct ContactPairState {
   bool swept = false;      // a collision update found it touching along the step's motion (swept_contact.h)
   long checkedStamp = -1;
   int level = 0;
+  // How the pair's last manifold solve ended, per point in the narrow phase's order: the exact
+  // finish starts the next solve of the pair from it (one pass instead of one per point that
+  // turns to sliding). 2 bits of solvers::contact::PointState per point, and a sliding point's
+  // friction direction as an angle in its tangent basis. endPoints 0: nothing remembered.
+  static constexpr int kRememberedPoints = 8;
+  std::uint16_t endStates = 0;
+  signed char endPoints = 0;
+  float endAngles[kRememberedPoints] = {};
 };
 
 // How one pair update treats the impulse (notes 1.4-1.6, Sec. 2.3.2).
@@ -260,6 +269,7 @@ class ContactWorkspace {
   // growPairs' buffers: which boxes grew, and the merged pair list.
   std::vector<char> grew_;
   std::vector<std::pair<int, int>> mergedPairs_;
+  std::vector<ContactPairState> freshPairs_;  // findPairs' new list
   // computeLevels' poses of each body re-advanced with its old and its new velocity.
   std::vector<std::array<solvers::collision::Pose<d>, 2>> reAdvancedPoses_;
 };

@@ -37,6 +37,10 @@ struct PgsPoint {
   // Accumulated impulses.
   double normalImpulse = 0;
   TangentVec tangentImpulse = TangentVec::Zero();
+  // Where the exact finish starts (manifold_polish.h): a state, and a sliding point's friction
+  // direction; Unknown: guessed from the velocities.
+  PointState startState = PointState::Unknown;
+  TangentVec startDirection = TangentVec::UnitX();
 
   // Prepared by prepare(): tangent basis, K's normal and tangent-plane blocks, Jacobian rows.
   TangentBasis T = TangentBasis::Zero();

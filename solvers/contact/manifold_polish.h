@@ -51,6 +51,20 @@
 
 namespace monolith::solvers::contact {
 
+// A manifold point's state in the active-set step below. `Unknown`: no start state is given.
+enum class PointState : char { Unloaded, Sticking, Sliding, Frictionless, Unknown };
+
+// A point's state as its accumulated impulses say: unloaded (normal impulse 0), sticking
+// (friction strictly inside its disk), sliding (on the rim), frictionless.
+template <class Point>
+PointState stateFromImpulses(const Point& p) {
+  const double limit = p.mu * p.normalImpulse;
+  return !(p.normalImpulse > 0) ? PointState::Unloaded
+         : !(p.mu > 0)          ? PointState::Frictionless
+         : p.tangentImpulse.squaredNorm() < (1 - 1e-9) * limit * limit ? PointState::Sticking
+                                                                         : PointState::Sliding;
+}
+
 template <int d>
 constexpr int kTwistDim = d + kAngularDim<d>;
 template <int d>
@@ -100,7 +114,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
   // The points' states, first as the sweeps left them; per point its rows (u, r_a x u) for
   // u = n, T_1, ..., built once per call (the loops below read them many times). One
   // thread-local block: each lookup of a thread_local costs a call.
-  enum class State : char { Unloaded, Sticking, Sliding, Frictionless };
+  using State = PointState;
   struct Impulse {
     double normal;
     Tangent tangent;
@@ -147,17 +161,19 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
   const State loaded = State::Sticking, frictionless = State::Frictionless;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Point& p = points[i];
+    if (guessLoaded && p.startState != State::Unknown) {
+      // Before any sweep, the state the pair's last solve ended in (the caller's memory).
+      states[i] = p.startState == loaded && !(p.mu > 0) ? frictionless : p.startState;
+      if (states[i] == State::Sliding) directions[i] = p.startDirection;
+      continue;
+    }
     if (guessLoaded) {
       // Before any sweep: a point carries load if it would otherwise end below its target.
       const bool carries = p.offsetN + rowN(i).dot(twist) < p.target + tolerance;
       states[i] = !carries ? State::Unloaded : p.mu > 0 ? loaded : frictionless;
       continue;
     }
-    const double limit = p.mu * p.normalImpulse;
-    states[i] = !(p.normalImpulse > 0)  ? State::Unloaded
-                : !(p.mu > 0)           ? frictionless
-                : p.tangentImpulse.squaredNorm() < (1 - 1e-9) * limit * limit ? loaded
-                                                                                : State::Sliding;
+    states[i] = stateFromImpulses(p);
     // A sliding point's friction keeps the sweeps' direction unless the twist slips it.
     if (states[i] == State::Sliding)
       directions[i] = p.tangentImpulse.squaredNorm() > 0 ? Tangent(p.tangentImpulse.normalized()) : Tangent::UnitX();
@@ -291,7 +307,11 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       scale += system(c, c);
       wanted[c] -= g[c].dot(base);
     }
-    if (k == 0) return Outcome::Failed;  // nothing loaded
+    if (k == 0) {  // nothing loaded: the points left approaching take load, if any
+      bool changed = false;
+      for (std::size_t i = 0; i < points.size(); ++i) changed = takesLoad(i, base) || changed;
+      return changed ? Outcome::Changed : Outcome::Failed;
+    }
     // Padded to D x D with the mean pivot, so that the rank test compares like with like.
     for (int c = k; c < D; ++c) system(c, c) = scale / k;
     SmallCholesky<D> few;
@@ -420,7 +440,8 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       const Point& p = points[i];
       Impulse& r = result[i];
       switch (states[i]) {
-        case State::Unloaded: continue;
+        case State::Unloaded:
+        case State::Unknown: continue;  // (never: states are set above)
         case State::Sliding:
           r.normal += slidingColumn(i, directions[i]).dot(multiplier);
           r.tangent = p.mu * r.normal * directions[i];

@@ -394,10 +394,52 @@ TEST(ExactManifoldFinish, RandomLandingsMeetTheConditionsAndNeverGainEnergy) {
     EXPECT_LT((exact.s.va - reference.s.va).norm() + (exact.s.wa - reference.s.wa).norm(), 1e-8) << trial;
   }
   std::printf("exact finish applied in %d of 400 random landings, %d compared\n", finished, compared);
-  // Measured: 160 applied (the rest slide on too many corners, or lose contact at some), all 160
+  // Measured: 170 applied (the rest slide on too many corners, or lose contact at some), all 170
   // compared.
   EXPECT_GT(finished, 120);
   EXPECT_GT(compared, 120);
+}
+
+TEST(ExactManifoldFinish, AStartFromTheStatesTheLastSolveEndedInFinishesBeforeAnySweep) {
+  // The contact stages start a pair's solve from the states its last solve ended in
+  // (ContactPairState::endStates). Here the same random landings are solved again with no sweep
+  // allowed, from the states and friction directions the exact result has and from the guess
+  // by velocities: the remembered start must reach the exact result (to rounding) in more cases
+  // than the guess, and a wrong start (all points remembered as unloaded) must still give the
+  // exact result or none.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1), unit(0, 1);
+  int exactCases = 0, byGuess = 0, byMemory = 0, byWrongMemory = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const V3 v(2 * u(rng), -0.2 - 2 * unit(rng), 2 * u(rng)), w(3 * u(rng), 3 * u(rng), 3 * u(rng));
+    const double mu = unit(rng);
+    const ExactCube exact(v, w, mu, 24, true);
+    if (exact.residual() > 1e-12) continue;
+    ++exactCases;
+    auto solvedBeforeAnySweep = [&](bool remembered, bool wrong) {
+      ExactCube again(v, w, mu, 0, false);  // (no sweep: nothing solved yet)
+      again.s = fallingCube(v, w);
+      again.s.inverseInertiaA = again.cube.inverseInertia;
+      again.s.exactFinish = true;
+      for (std::size_t i = 0; i < again.cube.points.size() && remembered; ++i) {
+        const PgsPoint<3>& end = exact.cube.points[i];
+        PgsPoint<3>& p = again.cube.points[i];
+        p.startState = wrong ? PointState::Unloaded : stateFromImpulses(end);
+        if (p.startState == PointState::Sliding) p.startDirection = end.tangentImpulse.normalized();
+      }
+      pgsSolve<3>(again.cube.points, again.s, 0, 1e-12);
+      const double error = (again.s.va - exact.s.va).norm() + (again.s.wa - exact.s.wa).norm();
+      const bool untouched = again.s.va == v && again.s.wa == w;
+      EXPECT_TRUE(error < 1e-12 || untouched) << trial << " remembered " << remembered << " wrong " << wrong;
+      return error < 1e-12;
+    };
+    byGuess += solvedBeforeAnySweep(false, false);
+    byMemory += solvedBeforeAnySweep(true, false);
+    byWrongMemory += solvedBeforeAnySweep(true, true);
+  }
+  std::printf("before any sweep: %d of %d exact results by the guess, %d from the end states, %d from all unloaded\n",
+              byGuess, exactCases, byMemory, byWrongMemory);
+  EXPECT_GT(byMemory, byGuess);
 }
 
 TEST(ExactManifoldFinish, BoxLandingFlatIn2DIsAtRestToRounding) {
