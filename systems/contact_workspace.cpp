@@ -398,14 +398,9 @@ int ContactWorkspace<d>::computeLevels() {
   // last collision sweep): bodies resting on each other fall together in the candidate
   // positions, so only moving one of them with its new velocity shows that they touch. A
   // separation within the contact thickness counts as touching.
-  col::ContactQuery query;
-  query.margin = settings.thickness;
-  query.maxPoints = 1;
   auto touches = [&](int mover, int other) {
-    thread_local std::vector<col::ContactPoint<d>> scratch;
-    scratch.clear();
-    return col::findContacts(*bodies[mover].geometry, poses[mover][1], *bodies[other].geometry, poses[other][0], query,
-                             scratch) > 0;
+    return col::touches(*bodies[mover].geometry, poses[mover][1], *bodies[other].geometry, poses[other][0],
+                        settings.thickness);
   };
   // The tests only read the bodies: each pair's two answers in its own slot, in parallel, then
   // the edges in pair order (the same list on any thread count).

@@ -172,6 +172,8 @@ int findContacts2(const PreparedGeometry<2>& a, const Pose<2>& poseA, const Prep
 int findContacts3(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b,
                   const Pose<3>& poseB, const ContactQuery& query, std::vector<ContactPoint<3>>& out);
 bool overlaps3(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b, const Pose<3>& poseB);
+bool touches3(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b, const Pose<3>& poseB,
+              double margin);
 // A shape (not a half-space or a mesh) against a mesh, appended to `out` unfinished (no merging).
 void meshContacts(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& mesh,
                   const Pose<3>& poseMesh, double margin, double scale, std::vector<ContactPoint<3>>& out);

@@ -14,6 +14,21 @@ int findContacts(const PreparedGeometry<d>& a, const Pose<d>& poseA, const Prepa
 }
 
 template <int d>
+bool touches(const PreparedGeometry<d>& a, const Pose<d>& poseA, const PreparedGeometry<d>& b, const Pose<d>& poseB,
+             double margin) {
+  if constexpr (d == 3) {
+    return touches3(a, poseA, b, poseB, margin);
+  } else {
+    thread_local std::vector<ContactPoint<2>> found;
+    found.clear();
+    ContactQuery query;
+    query.margin = margin;
+    query.maxPoints = 1;
+    return findContacts2(a, poseA, b, poseB, query, found) > 0;
+  }
+}
+
+template <int d>
 bool overlaps(const PreparedGeometry<d>& a, const Pose<d>& poseA, const PreparedGeometry<d>& b, const Pose<d>& poseB) {
   if constexpr (d == 3) {
     return overlaps3(a, poseA, b, poseB);
@@ -32,6 +47,8 @@ template int findContacts<2>(const PreparedGeometry<2>&, const Pose<2>&, const P
                              const ContactQuery&, std::vector<ContactPoint<2>>&);
 template int findContacts<3>(const PreparedGeometry<3>&, const Pose<3>&, const PreparedGeometry<3>&, const Pose<3>&,
                              const ContactQuery&, std::vector<ContactPoint<3>>&);
+template bool touches<2>(const PreparedGeometry<2>&, const Pose<2>&, const PreparedGeometry<2>&, const Pose<2>&, double);
+template bool touches<3>(const PreparedGeometry<3>&, const Pose<3>&, const PreparedGeometry<3>&, const Pose<3>&, double);
 template bool overlaps<2>(const PreparedGeometry<2>&, const Pose<2>&, const PreparedGeometry<2>&, const Pose<2>&);
 template bool overlaps<3>(const PreparedGeometry<3>&, const Pose<3>&, const PreparedGeometry<3>&, const Pose<3>&);
 

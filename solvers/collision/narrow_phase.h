@@ -24,6 +24,12 @@ template <int d>
 int findContacts(const PreparedGeometry<d>& a, const Pose<d>& poseA, const PreparedGeometry<d>& b,
                  const Pose<d>& poseB, const ContactQuery& query, std::vector<ContactPoint<d>>& out);
 
+// True when findContacts with this margin would report a point (any point, of any depth): the
+// same answer, without the manifold (box pairs: without the feature points and the merging).
+template <int d>
+bool touches(const PreparedGeometry<d>& a, const Pose<d>& poseA, const PreparedGeometry<d>& b, const Pose<d>& poseB,
+             double margin);
+
 // True when A and B overlap (depth > 0 anywhere). Cheaper than findContacts.
 template <int d>
 bool overlaps(const PreparedGeometry<d>& a, const Pose<d>& poseA, const PreparedGeometry<d>& b, const Pose<d>& poseB);

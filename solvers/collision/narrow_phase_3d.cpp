@@ -263,6 +263,31 @@ int findContacts3(const PG& a, const Pose<3>& poseA, const PG& b, const Pose<3>&
   return static_cast<int>(s.result.size());
 }
 
+bool touches3(const PG& a, const Pose<3>& poseA, const PG& b, const Pose<3>& poseB, double margin) {
+  margin = std::max(0.0, margin);
+  if (typeOf(a) == GeometryType::Box && typeOf(b) == GeometryType::Box) {
+    // generalPair's box-box route up to its first point: once the clipped faces or the nearest
+    // points give one, the feature points can only add more, and the merge keeps at least one.
+    const BoxBoxAxis sat = boxBoxAxis(a.geometry(), poseA, b.geometry(), poseB);
+    if (sat.separation > margin) return false;
+    Scratch& s = scratch();
+    s.main.clear();
+    boxBoxContacts(a.geometry(), poseA, b.geometry(), poseB, sat, s.main);
+    if (!s.main.empty()) return true;
+    if (!(margin > 0)) return false;
+    Vec3 onA, onB;
+    CP c;
+    return boxBoxNearestPoints(a.geometry(), poseA, b.geometry(), poseB, sat, margin, onA, onB) &&
+           contactOnAxis(a, poseA, -1, b, poseB, -1, 0.5 * (onA + onB), onA - onB, margin, c);
+  }
+  thread_local std::vector<CP> found;
+  found.clear();
+  ContactQuery query;
+  query.margin = margin;
+  query.maxPoints = 1;
+  return findContacts3(a, poseA, b, poseB, query, found) > 0;
+}
+
 bool overlaps3(const PG& a, const Pose<3>& poseA, const PG& b, const Pose<3>& poseB) {
   if (a.unbounded() && b.unbounded()) return false;
   if (typeOf(a) == GeometryType::Box && typeOf(b) == GeometryType::Box)

@@ -588,6 +588,46 @@ ShallowCase shallowCase(const PreparedGeometry<3>& A, const PreparedGeometry<3>&
   return c;
 }
 
+TEST(NarrowPhase3, TouchesAnswersAsFindContactsDoes) {
+  // touches() (the contact graph's test) must say "touching" exactly when findContacts with the
+  // same margin reports a point: random shallow placements on both sides of the margin, for box
+  // pairs (their own short route) and the other shapes (findContacts itself), and boxes stacked
+  // face on face with coplanar sides, as in a pyramid, just inside and just beyond the margin.
+  std::vector<Geometry<3>> shapes = {box3(0.5, 0.3, 0.4), box3(0.5, 0.5, 0.5), capsule3(0.2, 0.4), convexCube(0.4),
+                                     cylinder3(0.3, 0.4)};
+  std::vector<std::unique_ptr<PreparedGeometry<3>>> prepared;
+  for (const auto& g : shapes) prepared.push_back(std::make_unique<PreparedGeometry<3>>(g));
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> gap(-0.02, 0.01);
+  int touching = 0, apart = 0;
+  for (int it = 0; it < 1500; ++it) {
+    const int ia = it % 5, ib = (it / 5) % 5;
+    const ShallowCase sc = shallowCase(*prepared[ia], *prepared[ib], gap(rng), rng);
+    for (double margin : {0.0, 1e-4, 0.01}) {
+      std::vector<ContactPoint<3>> found;
+      ContactQuery query;
+      query.margin = margin;
+      const bool expected = findContacts<3>(*prepared[ia], sc.pa, *prepared[ib], sc.pb, query, found) > 0;
+      ASSERT_EQ(touches<3>(*prepared[ia], sc.pa, *prepared[ib], sc.pb, margin), expected)
+          << ia << "-" << ib << " case " << it << " margin " << margin;
+      (expected ? touching : apart) += 1;
+    }
+  }
+  EXPECT_GT(touching, 1000);
+  EXPECT_GT(apart, 1000);
+  const PreparedGeometry<3> cube(box3(0.5, 0.5, 0.5));
+  for (double lift : {0.0, 0.5e-4, 1.5e-4})
+    for (double shift : {0.0, 0.51, 1.0}) {
+      const Pose<3> below = at(Vec3::Zero()), above = at(Vec3(shift, 1 + lift, 0));
+      std::vector<ContactPoint<3>> found;
+      ContactQuery query;
+      query.margin = 1e-4;
+      const bool expected = findContacts<3>(cube, above, cube, below, query, found) > 0;
+      EXPECT_EQ(touches<3>(cube, above, cube, below, 1e-4), expected) << lift << " " << shift;
+      EXPECT_EQ(expected, lift < 1e-4) << lift << " " << shift;
+    }
+}
+
 TEST(NarrowPhase3, ShallowRandomContactsAreConsistent) {
   // A shape moved towards another along a random direction until they just touch (bisection on
   // overlaps), then 0.01 further: every contact must push A back against that direction, no
