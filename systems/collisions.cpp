@@ -45,6 +45,7 @@ void Collisions<d>::run(World<d>& world, StepContext& ctx) {
     swept += p.swept ? 1 : 0;
   }
   for (int n : impulses) impulseCount += n;
+  ws.lastCollisionImpulses = impulseCount;
   for (int n : clamps) clampCount += n;
   auto& out = ctx.diagnostics;
   out.set("contact_pairs_broad_phase", static_cast<double>(ws.pairs.size()));

@@ -426,11 +426,10 @@ int ContactWorkspace<d>::computeLevels() {
 }
 
 template <int d>
-int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, double epsilon, int iterations,
-                                   double margin, std::vector<col::ContactPoint<d>>& scratch,
-                                   double* clampEnergyChange, int* clampsApplied) {
-  ContactBody<d>& A = bodies[pair.a];
-  ContactBody<d>& B = bodies[pair.b];
+int ContactWorkspace<d>::updatePair(ContactPairState& pair, ContactBody<d>& A, ContactBody<d>& B, ImpulseMode mode,
+                                   double epsilon, int iterations, double margin,
+                                   std::vector<col::ContactPoint<d>>& scratch, double* clampEnergyChange,
+                                   int* clampsApplied, bool apply) {
   if (A.infinite() && B.infinite()) return 0;
   const bool collision = mode == ImpulseMode::Collision;
   con::ImpulseSettings impulse;
@@ -562,6 +561,7 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ImpulseMode mode, do
     scale = r.scale;
     if (scale == 0) return 0;
   }
+  if (!apply) return active;
   if (!A.infinite()) {
     A.v += scale * A.inverseMass() * J;
     A.L += scale * tau;
@@ -819,6 +819,8 @@ int ContactWorkspace<d>::collisionSweep(int island, int sweep, double* clampEner
     again.clampsOut = clampsApplied;
     return runSchedule(again);
   }
+  if (sweep == 0 && lastCollisionImpulses == 0 && list.size() >= 64 && tbb::this_task_arena::max_concurrency() > 1)
+    return speculativeCollisionSweep(island, clampEnergyChange, clampsApplied);
   IslandSchedule& s = startSchedule(island, ImpulseMode::Collision, clampEnergyChange, clampsApplied);
   for (std::size_t k = 0; k < list.size(); ++k) {
     SweepTask t;
@@ -830,6 +832,48 @@ int ContactWorkspace<d>::collisionSweep(int island, int sweep, double* clampEner
     addTask(s, t, touched, 2);
   }
   s.collisionSweepRecorded = s.order.tracking();
+  return runSchedule(s);
+}
+
+template <int d>
+int ContactWorkspace<d>::speculativeCollisionSweep(int island, double* clampEnergyChange, int* clampsApplied) {
+  const auto& list = islands.pairs[island];
+  const std::size_t n = list.size();
+  auto stamp = [](std::size_t k) { return 2 * (static_cast<long>(k) + 1); };  // collisionSweep's, sweep 0
+  // 1. Every update at once, applying nothing (the first sweep checks every pair: none skips).
+  probes_.assign(n, CollisionProbe{});
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+    thread_local std::vector<col::ContactPoint<d>> scratch;
+    for (std::size_t k = r.begin(); k != r.end(); ++k) {
+      CollisionProbe& probe = probes_[k];
+      probe.pair = pairs[list[k]];
+      probe.impulses = updatePair(probe.pair, bodies[probe.pair.a], bodies[probe.pair.b], ImpulseMode::Collision, 0.0,
+                                  settings.collisionPairIterations, 0.0, scratch, &probe.energyChange, &probe.clamps,
+                                  /*apply=*/false);
+    }
+  });
+  // 2. In order, up to the first update with impulses to apply (runTask's bookkeeping).
+  std::size_t k = 0;
+  for (; k < n && probes_[k].impulses == 0; ++k) {
+    const CollisionProbe& probe = probes_[k];
+    ContactPairState& pair = pairs[list[k]];
+    pair = probe.pair;
+    pair.checkedStamp = stamp(k) + 1;
+    if (clampsApplied) *clampsApplied += probe.clamps;
+    if (clampEnergyChange && (probe.clamps != 0 || probe.energyChange != 0)) *clampEnergyChange += probe.energyChange;
+  }
+  if (k == n) return 0;
+  // 3. The rest as the ordered sweep runs them (recorded afresh; later sweeps record their own).
+  IslandSchedule& s = startSchedule(island, ImpulseMode::Collision, clampEnergyChange, clampsApplied);
+  for (; k < n; ++k) {
+    SweepTask t;
+    t.kind = SweepTask::Kind::Collision;
+    t.index = list[k];
+    t.iterations = settings.collisionPairIterations;
+    t.stamp = stamp(k);
+    const int touched[2] = {pairs[t.index].a, pairs[t.index].b};
+    addTask(s, t, touched, 2);
+  }
   return runSchedule(s);
 }
 

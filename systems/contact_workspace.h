@@ -166,7 +166,15 @@ class ContactWorkspace {
   // Returns the number of impulses applied.
   int updatePair(ContactPairState& pair, ImpulseMode mode, double epsilon, int iterations, double margin,
                  std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
-                 int* clampsApplied);
+                 int* clampsApplied) {
+    return updatePair(pair, bodies[pair.a], bodies[pair.b], mode, epsilon, iterations, margin, scratch,
+                      clampEnergyChange, clampsApplied);
+  }
+  // The same on given bodies A and B; with `apply` false the impulses are found but not applied
+  // (the bodies are only read; the pair's state is updated as it would be).
+  int updatePair(ContactPairState& pair, ContactBody<d>& A, ContactBody<d>& B, ImpulseMode mode, double epsilon,
+                 int iterations, double margin, std::vector<solvers::collision::ContactPoint<d>>& scratch,
+                 double* clampEnergyChange, int* clampsApplied, bool apply = true);
 
   // One Gauss-Seidel collision sweep (Step II, notes 1.4) over one island's pairs; `sweep` counts
   // from 0. A pair is skipped when it was checked after both its bodies last moved. Returns the
@@ -252,6 +260,23 @@ class ContactWorkspace {
   // Runs the recorded tasks (if they did not run as they were recorded) and sums their results
   // in order. Returns the impulses applied.
   int runSchedule(IslandSchedule& s);
+  // The first collision sweep of an island when the last step's collision stage applied no
+  // impulse (a resting pile): every pair update runs at once without applying anything, on a
+  // copy of its pair state; in the sweep's order those that found nothing to apply are taken as
+  // they are, and from the first that did, the rest run as ordered tasks. Until then no body has
+  // changed, so each taken update saw what the sequential sweep gives it: the same result.
+  // Returns the impulses applied.
+  int speculativeCollisionSweep(int island, double* clampEnergyChange, int* clampsApplied);
+  struct CollisionProbe {  // what one update found, on a copy of its pair's state
+    ContactPairState pair;
+    int impulses = 0, clamps = 0;
+    double energyChange = 0;
+  };
+  std::vector<CollisionProbe> probes_;
+ public:
+  // Impulses the last collision stage applied (speculativeCollisionSweep runs only after none).
+  int lastCollisionImpulses = -1;
+ private:
   std::vector<IslandSchedule> schedules_;  // per island (islands are recorded and run at once)
   std::vector<int> memberIndex_;           // per body: its position in its island's members
 

@@ -15,8 +15,10 @@
 // Tried before the first sweep, then after sweeps 3, 6, 12, ...:
 //   1. states: before any sweep, a point whose normal velocity is at or below its target is
 //      taken as loaded and sticking, the others as unloaded (a resting manifold is then solved
-//      without sweeping at all); after sweeps, as their impulses say: unloaded (normal impulse
-//      0), sticking (friction strictly inside its disk), sliding (on the rim), frictionless;
+//      without sweeping at all), unless the caller gives start states (PgsPoint::startState:
+//      the contact stages pass those the pair's last solve ended in, which in a resting pile are
+//      this solve's own); after sweeps, as their impulses say: unloaded (normal impulse 0),
+//      sticking (friction strictly inside its disk), sliding (on the rim), frictionless;
 //   2. the relative twist meeting every active row -- normal velocity at its target for loaded
 //      points, zero slip for sticking ones -- by least squares on the 6 x 6 (3 x 3 in 2-D) normal
 //      equations N = G G^T. Rows that cannot all be met and rank-deficient rows fail; an
@@ -27,9 +29,12 @@
 //      impulse is lambda (n + mu T dir), one unknown;
 //   4. the wrench about x_a that gives the twist (W^{-1} times the change, W the effective
 //      inverse mass of the relative twist) and the impulse change of least norm giving it;
-//   5. a sticking point whose impulse leaves its disk, or slips at that twist, becomes sliding,
-//      and a point whose normal impulse would turn negative becomes unloaded: steps 2-5 again
-//      (at most 4 passes);
+//   5. a sticking point that slips at that twist becomes sliding, and a point whose normal
+//      impulse would turn negative becomes unloaded; else the sticking point whose impulse lies
+//      farthest outside its disk becomes sliding, its friction along that impulse (one such point
+//      per pass: turning all of them at once left pyramid boxes on one sticking and three
+//      sliding corners, rows that cannot fix the turn about the normal, and 41 % of the solves
+//      between two moving boxes failed): steps 2-5 again (at most 4 passes);
 //   6. accepted only if the bodies end with no more kinetic energy than before the solve.
 //      With sliding friction the complementarity problem can have spurious solutions with large
 //      impulses that feed energy in (Painleve's paradox): without this test pyramid_20 blew up
