@@ -274,10 +274,12 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
     return true;
   };
 
-  // Fewer active rows than the twist has dimensions (a box pivoting on one corner): they cannot
-  // fix the relative motion, the bodies' masses decide the rest. For loaded points that all
-  // stick (or have no friction) the impulse changes x on the rows' own columns solve
-  // (G^T W G) x = wanted - G^T twist, positive definite when the rows are independent.
+  // Fewer active rows than the twist has dimensions (a box pivoting on one corner), or as many
+  // but dependent (a box on one edge: its two sticking corners' slips along the edge are one
+  // row): they cannot fix the relative motion, the bodies' masses decide the rest. For loaded
+  // points that all stick (or have no friction) the impulse changes x on the rows' own columns
+  // solve (G^T W G) x = wanted - G^T twist; a row dependent on those before it is dropped (its
+  // impulse change stays 0), and must then be met by the others' solution, else this fails.
   enum class Outcome { Failed, Changed, Accepted };
   auto solveFewRows = [&]() {
     for (const State st : states)
@@ -294,7 +296,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       if (dn != 0 || dt.squaredNorm() != 0) base += W * impulseWrench(i, dn, dt);
     }
     Twist<d> g[D], Wg[D];
-    Twist<d> wanted = Twist<d>::Zero();
+    Twist<d> wanted = Twist<d>::Zero(), goal;
     int k = 0;
     for (std::size_t i = 0; i < points.size(); ++i) {
       if (states[i] == State::Unloaded) continue;
@@ -306,6 +308,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
     }
     TwistMat<d> system = TwistMat<d>::Zero();
     double scale = 0;
+    goal = wanted;  // each row's own condition: g . next = goal
     for (int c = 0; c < k; ++c) {
       Wg[c] = W * g[c];
       for (int r = c; r < k; ++r) system(r, c) = g[r].dot(Wg[c]);
@@ -320,10 +323,12 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
     // Padded to D x D with the mean pivot, so that the rank test compares like with like.
     for (int c = k; c < D; ++c) system(c, c) = scale / k;
     SmallCholesky<D> few;
-    if (!(few.compute(system) && few.wellConditioned(1e-6))) return Outcome::Failed;
+    const int dropped = few.computeDroppingDependent(system, 1e-6);
     const Twist<d> x = few.solve(wanted);
     Twist<d> next = base;
     for (int c = 0; c < k; ++c) next += x[c] * Wg[c];
+    for (int c = 0; c < k && dropped > 0; ++c)
+      if (!(std::abs(g[c].dot(next) - goal[c]) <= tolerance)) return Outcome::Failed;
     bool changed = false;
     k = 0;
     for (std::size_t i = 0; i < points.size(); ++i) {
@@ -380,8 +385,13 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       }
     }
     SmallCholesky<D> normal;
-    if (!normal.compute(N)) return false;
-    if (!normal.wellConditioned(1e-6)) return false;  // rank-deficient rows
+    if (!(normal.compute(N) && normal.wellConditioned(1e-6))) {
+      // Rank-deficient rows: as many as the twist has dimensions are solved as a few rows.
+      if (activeRows > D) return false;
+      const Outcome outcome = solveFewRows();
+      if (outcome == Outcome::Changed) continue;
+      return outcome == Outcome::Accepted;
+    }
     const Twist<d> next = twist + normal.solve(Gr);
 
     // Rows that cannot all be met fail; slip at a sticking point turns it to sliding; a sliding

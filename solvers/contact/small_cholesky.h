@@ -39,6 +39,32 @@ class SmallCholesky {
     }
     return true;
   }
+  // The same on a positive semi-definite A (a Gram matrix of rows), dropping every row whose
+  // pivot is at most `ratio`^2 times its diagonal entry: a row within an angle of about `ratio`
+  // of the span of the rows before it. solve() then leaves its unknown at 0, so the result
+  // solves the independent rows; whether it also meets the dropped ones is for the caller to
+  // check. Returns the number of rows dropped.
+  int computeDroppingDependent(const Matrix& a, double ratio) {
+    int dropped = 0;
+    for (int j = 0; j < n; ++j) {
+      double pivot = a(j, j);
+      for (int k = 0; k < j; ++k) pivot -= l_[j][k] * ld_[j][k];
+      const bool keep = pivot > ratio * ratio * a(j, j);
+      dropped += keep ? 0 : 1;
+      pivot_[j] = keep ? pivot : 0.0;
+      inversePivot_[j] = keep ? 1 / pivot : 0.0;
+      for (int i = j + 1; i < n; ++i) {
+        double v = 0;
+        if (keep) {
+          v = a(i, j);
+          for (int k = 0; k < j; ++k) v -= l_[i][k] * ld_[j][k];
+        }
+        ld_[i][j] = v;
+        l_[i][j] = v * inversePivot_[j];
+      }
+    }
+    return dropped;
+  }
   // True if the smallest pivot exceeds `ratio`^2 times the largest: a test of rank (the
   // pivots scale like the singular values; `ratio` is on their square roots, as for L L^T).
   bool wellConditioned(double ratio) const {
