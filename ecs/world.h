@@ -76,7 +76,7 @@ struct ContactSettings {
   int shockPairIterations = 40;      // measured: a 2-D pyramid's joint solves need them (docs/benchmarks.md)
   // Manifold and joint solves end with an exact active-set step once it applies
   // (solvers/contact/manifold_polish.h; not in the thesis, whose sweeps stop at their count).
-  // Off by default: at the thesis's schedule it costs 3-15 % more than it saves on three of
+  // Off by default: at the thesis's schedule it costs 3-30 % more than it saves on three of
   // five scenes; on a short schedule it makes the step 3x faster and leaves a standing pyramid
   // exactly at rest (docs/benchmarks.md, "States remembered, one slide per pass").
   bool exactManifoldFinish = false;

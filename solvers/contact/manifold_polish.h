@@ -21,10 +21,11 @@
 //      sticking (friction strictly inside its disk), sliding (on the rim), frictionless;
 //   2. the relative twist meeting every active row -- normal velocity at its target for loaded
 //      points, zero slip for sticking ones -- by least squares on the 6 x 6 (3 x 3 in 2-D) normal
-//      equations N = G G^T. Rows that cannot all be met and rank-deficient rows fail; an
-//      unloaded point left approaching takes load (next pass). Fewer rows than 6 (a box on one
-//      corner) cannot fix the twist: if no point slides, the impulse changes on the rows' own
-//      columns solve (G^T W G) x = wanted - G^T twist directly instead (steps 3-4 skipped);
+//      equations N = G G^T. Rows that cannot all be met fail, and so do more than 6 dependent
+//      ones; an unloaded point left approaching takes load (next pass). Fewer rows than 6 (a box
+//      on one corner), or 6 dependent ones (a box on one edge), cannot fix the twist: if no point
+//      slides, the impulse changes on the rows' own columns solve (G^T W G) x = wanted - G^T twist
+//      directly instead, a dependent row dropped and checked after (steps 3-4 skipped);
 //   3. a sliding point's friction is mu lambda against the slip that twist leaves there, so its
 //      impulse is lambda (n + mu T dir), one unknown;
 //   4. the wrench about x_a that gives the twist (W^{-1} times the change, W the effective
