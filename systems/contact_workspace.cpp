@@ -798,15 +798,32 @@ int ContactWorkspace<d>::runSchedule(IslandSchedule& s) {
   return impulses;
 }
 
+// Stamps that grow along the whole sequence of checks, sweep after sweep: "moved" gets the
+// even stamp of the check that moved the body, "checked" the odd one after it, both above the
+// initial values (moved 0, checked -1), so the skip test compares the order of events.
+inline long collisionStamp(int sweep, std::size_t pairCount, std::size_t k) {
+  return 2 * (static_cast<long>(sweep) * static_cast<long>(pairCount) + static_cast<long>(k) + 1);
+}
+
+template <int d>
+int ContactWorkspace<d>::addCollisionTasks(IslandSchedule& s, int island, int sweep, std::size_t from) {
+  const auto& list = islands.pairs[island];
+  for (std::size_t k = from; k < list.size(); ++k) {
+    SweepTask t;
+    t.kind = SweepTask::Kind::Collision;
+    t.index = list[k];
+    t.iterations = settings.collisionPairIterations;
+    t.stamp = collisionStamp(sweep, list.size(), k);
+    const int touched[2] = {pairs[t.index].a, pairs[t.index].b};
+    addTask(s, t, touched, 2);
+  }
+  return runSchedule(s);
+}
+
 template <int d>
 int ContactWorkspace<d>::collisionSweep(int island, int sweep, double* clampEnergyChange, int* clampsApplied) {
   const auto& list = islands.pairs[island];
-  // Stamps that grow along the whole sequence of checks, sweep after sweep: "moved" gets the
-  // even stamp of the check that moved the body, "checked" the odd one after it, both above
-  // the initial values (moved 0, checked -1), so the skip test compares the order of events.
-  auto stamp = [&](std::size_t k) {
-    return 2 * (static_cast<long>(sweep) * static_cast<long>(list.size()) + static_cast<long>(k) + 1);
-  };
+  auto stamp = [&](std::size_t k) { return collisionStamp(sweep, list.size(), k); };
   IslandSchedule& again = schedules_[island];
   if (sweep > 0 && again.collisionSweepRecorded && again.tasks.size() == list.size()) {
     // The previous sweep's tasks and dependencies, with this sweep's stamps (recording them
@@ -822,24 +839,15 @@ int ContactWorkspace<d>::collisionSweep(int island, int sweep, double* clampEner
   if (sweep == 0 && lastCollisionImpulses == 0 && list.size() >= 64 && tbb::this_task_arena::max_concurrency() > 1)
     return speculativeCollisionSweep(island, clampEnergyChange, clampsApplied);
   IslandSchedule& s = startSchedule(island, ImpulseMode::Collision, clampEnergyChange, clampsApplied);
-  for (std::size_t k = 0; k < list.size(); ++k) {
-    SweepTask t;
-    t.kind = SweepTask::Kind::Collision;
-    t.index = list[k];
-    t.iterations = settings.collisionPairIterations;
-    t.stamp = stamp(k);
-    const int touched[2] = {pairs[t.index].a, pairs[t.index].b};
-    addTask(s, t, touched, 2);
-  }
-  s.collisionSweepRecorded = s.order.tracking();
-  return runSchedule(s);
+  s.collisionSweepRecorded = s.order.tracking();  // later sweeps of the step reuse the tasks
+  return addCollisionTasks(s, island, sweep, 0);
 }
 
 template <int d>
 int ContactWorkspace<d>::speculativeCollisionSweep(int island, double* clampEnergyChange, int* clampsApplied) {
   const auto& list = islands.pairs[island];
   const std::size_t n = list.size();
-  auto stamp = [](std::size_t k) { return 2 * (static_cast<long>(k) + 1); };  // collisionSweep's, sweep 0
+  auto stamp = [n](std::size_t k) { return collisionStamp(0, n, k); };
   // 1. Every update at once, applying nothing (the first sweep checks every pair: none skips).
   probes_.assign(n, CollisionProbe{});
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -865,16 +873,7 @@ int ContactWorkspace<d>::speculativeCollisionSweep(int island, double* clampEner
   if (k == n) return 0;
   // 3. The rest as the ordered sweep runs them (recorded afresh; later sweeps record their own).
   IslandSchedule& s = startSchedule(island, ImpulseMode::Collision, clampEnergyChange, clampsApplied);
-  for (; k < n; ++k) {
-    SweepTask t;
-    t.kind = SweepTask::Kind::Collision;
-    t.index = list[k];
-    t.iterations = settings.collisionPairIterations;
-    t.stamp = stamp(k);
-    const int touched[2] = {pairs[t.index].a, pairs[t.index].b};
-    addTask(s, t, touched, 2);
-  }
-  return runSchedule(s);
+  return addCollisionTasks(s, island, 0, k);
 }
 
 template <int d>

@@ -267,6 +267,9 @@ class ContactWorkspace {
   // changed, so each taken update saw what the sequential sweep gives it: the same result.
   // Returns the impulses applied.
   int speculativeCollisionSweep(int island, double* clampEnergyChange, int* clampsApplied);
+  // Records the island's collision checks from position `from` on as tasks of sweep `sweep`
+  // and runs them (runSchedule). Returns the impulses applied.
+  int addCollisionTasks(IslandSchedule& s, int island, int sweep, std::size_t from);
   struct CollisionProbe {  // what one update found, on a copy of its pair's state
     ContactPairState pair;
     int impulses = 0, clamps = 0;
