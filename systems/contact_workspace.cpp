@@ -806,7 +806,7 @@ inline long collisionStamp(int sweep, std::size_t pairCount, std::size_t k) {
 }
 
 template <int d>
-int ContactWorkspace<d>::addCollisionTasks(IslandSchedule& s, int island, int sweep, std::size_t from) {
+int ContactWorkspace<d>::runCollisionTasks(IslandSchedule& s, int island, int sweep, std::size_t from) {
   const auto& list = islands.pairs[island];
   for (std::size_t k = from; k < list.size(); ++k) {
     SweepTask t;
@@ -840,7 +840,7 @@ int ContactWorkspace<d>::collisionSweep(int island, int sweep, double* clampEner
     return speculativeCollisionSweep(island, clampEnergyChange, clampsApplied);
   IslandSchedule& s = startSchedule(island, ImpulseMode::Collision, clampEnergyChange, clampsApplied);
   s.collisionSweepRecorded = s.order.tracking();  // later sweeps of the step reuse the tasks
-  return addCollisionTasks(s, island, sweep, 0);
+  return runCollisionTasks(s, island, sweep, 0);
 }
 
 template <int d>
@@ -873,7 +873,7 @@ int ContactWorkspace<d>::speculativeCollisionSweep(int island, double* clampEner
   if (k == n) return 0;
   // 3. The rest as the ordered sweep runs them (recorded afresh; later sweeps record their own).
   IslandSchedule& s = startSchedule(island, ImpulseMode::Collision, clampEnergyChange, clampsApplied);
-  return addCollisionTasks(s, island, 0, k);
+  return runCollisionTasks(s, island, 0, k);
 }
 
 template <int d>

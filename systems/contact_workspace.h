@@ -217,6 +217,9 @@ class ContactWorkspace {
   std::vector<std::vector<int>> islandPairsByLevel;
   double dt = 0;
   bool kick = false;
+  // Impulses the last collision stage applied; -1 before the first. A resting island's first
+  // collision sweep is speculative on several threads only after none (see below).
+  int lastCollisionImpulses = -1;
   ContactSettings settings;
   Vec<d> gravity = Vec<d>::Zero();
 
@@ -269,17 +272,13 @@ class ContactWorkspace {
   int speculativeCollisionSweep(int island, double* clampEnergyChange, int* clampsApplied);
   // Records the island's collision checks from position `from` on as tasks of sweep `sweep`
   // and runs them (runSchedule). Returns the impulses applied.
-  int addCollisionTasks(IslandSchedule& s, int island, int sweep, std::size_t from);
+  int runCollisionTasks(IslandSchedule& s, int island, int sweep, std::size_t from);
   struct CollisionProbe {  // what one update found, on a copy of its pair's state
     ContactPairState pair;
     int impulses = 0, clamps = 0;
     double energyChange = 0;
   };
   std::vector<CollisionProbe> probes_;
- public:
-  // Impulses the last collision stage applied (speculativeCollisionSweep runs only after none).
-  int lastCollisionImpulses = -1;
- private:
   std::vector<IslandSchedule> schedules_;  // per island (islands are recorded and run at once)
   std::vector<int> memberIndex_;           // per body: its position in its island's members
 
