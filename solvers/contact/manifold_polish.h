@@ -472,7 +472,8 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
         continue;
       }
       const double limit = p.mu * r.normal;
-      const double ratio = r.tangent.squaredNorm() / (limit * limit);
+      const double t2 = r.tangent.squaredNorm();
+      const double ratio = t2 == 0 ? 0.0 : t2 / (limit * limit);  // (no friction: inside any disk)
       if (states[i] == State::Sticking && !(ratio <= worstRatio)) worst = i, worstRatio = ratio;
     }
     if (changed) continue;
