@@ -93,17 +93,17 @@ int netImpulse(const std::vector<con::PgsPoint<d>>& points, Eigen::Matrix<double
   return active;
 }
 
-// The pair's manifold solve starts where its last one ended (ContactPairState::endStates), if
+// The pair's manifold solve starts where its last one ended (ContactPairState::end), if
 // the narrow phase gave as many points; the point order of a manifold that barely moved is the
 // same. Only a start: the exact finish still checks every condition and changes what fails.
 template <int d>
 void recallEndStates(const ContactPairState& pair, std::vector<con::PgsPoint<d>>& points) {
-  if (pair.endPoints != static_cast<int>(points.size())) return;
+  if (pair.end.points != static_cast<int>(points.size())) return;
   for (std::size_t i = 0; i < points.size(); ++i) {
     con::PgsPoint<d>& p = points[i];
-    p.startState = static_cast<con::PointState>((pair.endStates >> (2 * i)) & 3u);
+    p.startState = static_cast<con::PointState>((pair.end.states >> (2 * i)) & 3u);
     if (p.startState != con::PointState::Sliding) continue;
-    const double angle = pair.endAngles[i];
+    const double angle = pair.end.angles[i];
     if constexpr (d == 3) p.startDirection = Eigen::Vector2d(std::cos(angle), std::sin(angle));
     else p.startDirection[0] = angle == 0 ? 1.0 : -1.0;
   }
@@ -111,18 +111,18 @@ void recallEndStates(const ContactPairState& pair, std::vector<con::PgsPoint<d>>
 
 template <int d>
 void rememberEndStates(ContactPairState& pair, const std::vector<con::PgsPoint<d>>& points) {
-  pair.endPoints = 0;
-  if (points.size() > static_cast<std::size_t>(ContactPairState::kRememberedPoints)) return;
-  pair.endStates = 0;
+  pair.end.points = 0;
+  if (points.size() > static_cast<std::size_t>(ContactPairState::SolveEnd::kPoints)) return;
+  pair.end.states = 0;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const con::PgsPoint<d>& p = points[i];
     const con::PointState state = con::stateFromImpulses(p);
-    pair.endStates |= static_cast<std::uint16_t>(static_cast<unsigned>(state) << (2 * i));
+    pair.end.states |= static_cast<std::uint16_t>(static_cast<unsigned>(state) << (2 * i));
     if (state != con::PointState::Sliding) continue;
-    if constexpr (d == 3) pair.endAngles[i] = static_cast<float>(std::atan2(p.tangentImpulse[1], p.tangentImpulse[0]));
-    else pair.endAngles[i] = p.tangentImpulse[0] >= 0 ? 0.0f : 3.14159265f;
+    if constexpr (d == 3) pair.end.angles[i] = static_cast<float>(std::atan2(p.tangentImpulse[1], p.tangentImpulse[0]));
+    else pair.end.angles[i] = p.tangentImpulse[0] >= 0 ? 0.0f : 3.14159265f;
   }
-  pair.endPoints = static_cast<signed char>(points.size());
+  pair.end.points = static_cast<signed char>(points.size());
 }
 
 }  // namespace
@@ -317,9 +317,7 @@ void ContactWorkspace<d>::findPairs() {
     pair.b = found[k].second;
     while (old < pairs.size() && std::make_pair(pairs[old].a, pairs[old].b) < found[k]) ++old;
     if (old == pairs.size() || pairs[old].a != pair.a || pairs[old].b != pair.b) continue;
-    pair.endStates = pairs[old].endStates;
-    pair.endPoints = pairs[old].endPoints;
-    std::copy(std::begin(pairs[old].endAngles), std::end(pairs[old].endAngles), std::begin(pair.endAngles));
+    pair.end = pairs[old].end;
   }
   pairs.swap(fresh);
   islands = con::computeIslands(n, found, infinite_);

@@ -97,12 +97,13 @@ struct ContactPairState {
   int level = 0;
   // How the pair's last manifold solve ended, per point in the narrow phase's order: the exact
   // finish starts the next solve of the pair from it (one pass instead of one per point that
-  // turns to sliding). 2 bits of solvers::contact::PointState per point, and a sliding point's
-  // friction direction as an angle in its tangent basis. endPoints 0: nothing remembered.
-  static constexpr int kRememberedPoints = 8;
-  std::uint16_t endStates = 0;
-  signed char endPoints = 0;
-  float endAngles[kRememberedPoints] = {};
+  // turns to sliding). Kept across steps by findPairs.
+  struct SolveEnd {
+    static constexpr int kPoints = 8;
+    std::uint16_t states = 0;        // 2 bits of solvers::contact::PointState per point
+    signed char points = 0;          // 0: nothing remembered
+    float angles[kPoints] = {};      // a sliding point's friction direction in its tangent basis
+  } end;
 };
 
 // How one pair update treats the impulse (notes 1.4-1.6, Sec. 2.3.2).

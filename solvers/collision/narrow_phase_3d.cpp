@@ -100,6 +100,27 @@ void capsulePair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
   keepUnrepresented<3>(s.main, s.extra, kRedundantDepth * scale, s.result);
 }
 
+// How a box pair's main contacts were found (boxBoxMain).
+enum class BoxMain { None, Clipped, Nearest };
+
+// A box pair's main contacts, appended to `main`: our separating-axis test (`sat`) and face
+// clipping (box_box.cpp) instead of FCL's dBoxBox; apart but within the margin, one contact
+// between the exact nearest points instead of fcl::distance. None: farther apart than the margin
+// (then neither could the feature points find anything), or nothing within it.
+BoxMain boxBoxMain(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb, double margin, BoxBoxAxis& sat,
+                   std::vector<CP>& main) {
+  sat = boxBoxAxis(a.geometry(), pa, b.geometry(), pb);
+  if (sat.separation > margin) return BoxMain::None;
+  if (boxBoxContacts(a.geometry(), pa, b.geometry(), pb, sat, main) > 0) return BoxMain::Clipped;
+  if (!(margin > 0)) return BoxMain::None;
+  Vec3 onA, onB;
+  CP c;
+  if (!boxBoxNearestPoints(a.geometry(), pa, b.geometry(), pb, sat, margin, onA, onB)) return BoxMain::None;
+  if (!contactOnAxis(a, pa, -1, b, pb, -1, 0.5 * (onA + onB), onA - onB, margin, c)) return BoxMain::None;
+  main.push_back(c);
+  return BoxMain::Nearest;
+}
+
 void generalPair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb, double margin, double scale,
                  Scratch& s) {
   if (typeOf(b) == GeometryType::Mesh && typeOf(a) != GeometryType::Mesh) {
@@ -113,30 +134,22 @@ void generalPair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
   s.triangles.clear();
   bool fclWorked = true;
   BoxBoxAxis sat;  // box pairs: the separating-axis test
+  BoxMain boxMain = BoxMain::None;
   if (boxBox) {
-    // Our own separating-axis test and face clipping (box_box.cpp) instead of FCL's dBoxBox.
-    sat = boxBoxAxis(a.geometry(), pa, b.geometry(), pb);
-    // Apart by more than the margin along some axis: farther apart than that everywhere, so
-    // neither the distance query nor the feature points could find anything.
-    if (sat.separation > margin) return;
-    boxBoxContacts(a.geometry(), pa, b.geometry(), pb, sat, s.main);
+    boxMain = boxBoxMain(a, pa, b, pb, margin, sat, s.main);
+    if (boxMain == BoxMain::None) return;
     s.triangles.assign(s.main.size(), -1);
   } else {
     fclWorked = fclContacts(a, pa, b, pb, s.main, s.triangles);
   }
-  const bool clippedManifold = boxBox && !s.main.empty();  // the clipped box-box points: all kept
-  const bool fromFcl = !s.main.empty();                     // else from the distance query (exact axis)
-  if (fclWorked && s.main.empty()) {
+  const bool clippedManifold = boxMain == BoxMain::Clipped;  // the clipped box-box points: all kept
+  // Else from the distance query (exact axis).
+  const bool fromFcl = boxBox ? clippedManifold : !s.main.empty();
+  if (fclWorked && s.main.empty()) {  // (not box pairs: boxBoxMain did their distance query)
     if (!(margin > 0)) return;
     CP c;
     int triangle = -1;
-    if (boxBox) {  // exact nearest points instead of fcl::distance (box_box.cpp)
-      Vec3 onA, onB;
-      if (!boxBoxNearestPoints(a.geometry(), pa, b.geometry(), pb, sat, margin, onA, onB)) return;
-      if (!contactOnAxis(a, pa, -1, b, pb, -1, 0.5 * (onA + onB), onA - onB, margin, c)) return;
-    } else if (!fclMarginContact(a, pa, b, pb, margin, c, triangle)) {
-      return;
-    }
+    if (!fclMarginContact(a, pa, b, pb, margin, c, triangle)) return;
     s.main.push_back(c);
     s.triangles.push_back(triangle);
   }
@@ -266,19 +279,12 @@ int findContacts3(const PG& a, const Pose<3>& poseA, const PG& b, const Pose<3>&
 bool touches3(const PG& a, const Pose<3>& poseA, const PG& b, const Pose<3>& poseB, double margin) {
   margin = std::max(0.0, margin);
   if (typeOf(a) == GeometryType::Box && typeOf(b) == GeometryType::Box) {
-    // generalPair's box-box route up to its first point: once the clipped faces or the nearest
-    // points give one, the feature points can only add more, and the merge keeps at least one.
-    const BoxBoxAxis sat = boxBoxAxis(a.geometry(), poseA, b.geometry(), poseB);
-    if (sat.separation > margin) return false;
+    // generalPair's box-box route up to its main contacts: once they hold a point, the feature
+    // points can only add more, and the merge keeps at least one.
     Scratch& s = scratch();
     s.main.clear();
-    boxBoxContacts(a.geometry(), poseA, b.geometry(), poseB, sat, s.main);
-    if (!s.main.empty()) return true;
-    if (!(margin > 0)) return false;
-    Vec3 onA, onB;
-    CP c;
-    return boxBoxNearestPoints(a.geometry(), poseA, b.geometry(), poseB, sat, margin, onA, onB) &&
-           contactOnAxis(a, poseA, -1, b, poseB, -1, 0.5 * (onA + onB), onA - onB, margin, c);
+    BoxBoxAxis sat;
+    return boxBoxMain(a, poseA, b, poseB, margin, sat, s.main) != BoxMain::None;
   }
   thread_local std::vector<CP> found;
   found.clear();

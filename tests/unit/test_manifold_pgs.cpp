@@ -429,7 +429,7 @@ TEST(ExactManifoldFinish, RandomLandingsMeetTheConditionsAndNeverGainEnergy) {
 
 TEST(ExactManifoldFinish, AStartFromTheStatesTheLastSolveEndedInFinishesBeforeAnySweep) {
   // The contact stages start a pair's solve from the states its last solve ended in
-  // (ContactPairState::endStates). Here the same random landings are solved again with no sweep
+  // (ContactPairState::end). Here the same random landings are solved again with no sweep
   // allowed, from the states and friction directions the exact result has and from the guess
   // by velocities: the remembered start must reach the exact result (to rounding) in more cases
   // than the guess, and a wrong start (all points remembered as unloaded) must still give the
