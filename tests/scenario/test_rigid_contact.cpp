@@ -447,6 +447,36 @@ TEST(PushOutNewOverlaps, APushIntoAnUntouchedNeighbourIsUndoneInTheSameStep) {
   }
 }
 
+TEST(CollisionSkip, APairThatCannotApproachIsProcessedWithoutImpulseAndABarelyApproachingOneStillCollides) {
+  // No gravity. A unit box sunk 1 mm into a static one. The collision update skips the manifold
+  // when no point of the pair can approach faster than the tolerance (1e-9 m/s), yet must still
+  // mark the pair processed; and a corner approaching at 2e-9 m/s, by translation or by a spin
+  // that leaves the centre at rest, must still get its impulse.
+  const Registry registry = builtins();
+  auto run = [&](const std::string& velocity, const std::string& spin) {
+    const std::string text = R"({"dimension": 3, "time": {"dt": 0.03333333333333333, "end": 0.03333333333333333},
+      "gravity": [0, 0, 0], "entities": [
+      {"name": "A", "shape": {"type": "box", "half_extents": [0.5, 0.5, 0.5]},
+       "rigid_body": {"static": true}, "collider": {"restitution": 0, "friction": 0.5}},
+      {"name": "B", "shape": {"type": "box", "half_extents": [0.5, 0.5, 0.5]},
+       "rigid_body": {"mass": 1, "position": [0, 0.999, 0], "velocity": )" + velocity +
+                             R"(, "angular_velocity": )" + spin + R"(},
+       "collider": {"restitution": 0, "friction": 0.5}}]})";
+    Simulation<3> sim(parseScene(text, "two_boxes.json", {}), registry);
+    return sim.step();
+  };
+  const auto still = run("[0, 0, 0]", "[0, 0, 0]");
+  EXPECT_EQ(still.at("collision_pairs_processed"), 1);
+  EXPECT_EQ(still.at("collision_impulses"), 0);
+  EXPECT_EQ(still.at("contact_levels"), 2);  // B above A: the processed pair made the graph
+  // Within the tolerance: 4e-10 m/s down at the centre, nothing applied.
+  EXPECT_EQ(run("[0, -4e-10, 0]", "[0, 0, 0]").at("collision_impulses"), 0);
+  // Beyond it: 2e-9 m/s down, by translation, and at the corners x = +0.5 by a spin about z
+  // (w_z = -4e-9 rad/s: v_y = w_z x = -2e-9 m/s there).
+  EXPECT_GT(run("[0, -2e-9, 0]", "[0, 0, 0]").at("collision_impulses"), 0);
+  EXPECT_GT(run("[0, 0, 0]", "[0, 0, -4e-9]").at("collision_impulses"), 0);
+}
+
 TEST(PushOutRounds, APushPastTheBroadPhaseBoxIsUndoneInTheSameStep) {
   // As above, but D sits 2 cm above C's bounding box (a 1 m cube 1.97 m up), so the pair
   // (C, D) is not in the broad phase when push-out starts. Lifting C 5 cm out of A drives it 3 cm
