@@ -443,11 +443,11 @@ int ContactWorkspace<d>::computeLevels() {
 }
 
 template <int d>
-int ContactWorkspace<d>::updatePair(ContactPairState& pair, ContactBody<d>& A, ContactBody<d>& B, ImpulseMode mode,
-                                   double epsilon, int iterations, double margin,
-                                   std::vector<col::ContactPoint<d>>& scratch, double* clampEnergyChange,
-                                   int* clampsApplied, bool apply) {
-  if (A.infinite() && B.infinite()) return 0;
+typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
+    ContactPairState& pair, const ContactBody<d>& A, const ContactBody<d>& B, ImpulseMode mode, double epsilon,
+    int iterations, double margin, std::vector<col::ContactPoint<d>>& scratch, double* clampEnergyChange,
+    int* clampsApplied) const {
+  if (A.infinite() && B.infinite()) return {};
   const bool collision = mode == ImpulseMode::Collision;
   con::ImpulseSettings impulse;
   impulse.friction = std::min(A.friction, B.friction);
@@ -475,7 +475,7 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ContactBody<d>& A, C
       col::SweptQuery first;
       first.sampleTravel = 0.5 * size;
       const double s = col::firstContactFraction(*A.geometry, ma, *B.geometry, mb, first);
-      if (s < 0) return 0;
+      if (s < 0) return {};
       pair.swept = true;
       poseA = ma.at(s);
       poseB = mb.at(s);
@@ -485,14 +485,14 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ContactBody<d>& A, C
       query.margin = std::max(margin, 1e-3 * size);
     }
   }
-  if (!swept && !mayTouch<d>(A, B, margin)) return 0;
+  if (!swept && !mayTouch<d>(A, B, margin)) return {};
   if (collision && !swept && !mayApproach<d>(A, B, splitA, splitB, margin, settings.approachTolerance)) {
     // No point of the pair can approach: no impulse whatever the manifold. Only whether the
     // pair touches is kept (the processed list, notes 1.4): the same answer without the points.
     if (col::touches(*A.geometry, poseA, *B.geometry, poseB, query.margin)) pair.processed = true;
-    return 0;
+    return {};
   }
-  if (col::findContacts(*A.geometry, poseA, *B.geometry, poseB, query, scratch) == 0) return 0;
+  if (col::findContacts(*A.geometry, poseA, *B.geometry, poseB, query, scratch) == 0) return {};
   if (collision) pair.processed = true;
   // Manifold points within the margin, with split-state lever arms and normals (candidate
   // positions, as GBF 2003 and Sec. 2.3.2 compute them; mapping points back through the body's
@@ -528,20 +528,16 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ContactBody<d>& A, C
     p.mu = impulse.friction;
     speedScale = std::max(speedScale, std::abs(p.target) + std::abs(vn));
   }
-  if (!anyApproaching) return 0;
+  if (!anyApproaching) return {};
   // K and the Jacobian rows only when something approaches (a solve follows).
   const con::AngMat<d> Ia = finiteA ? splitA : con::AngMat<d>::Zero();
   const con::AngMat<d> Ib = finiteB ? splitB : con::AngMat<d>::Zero();
   state.inverseInertiaA = Ia;
   state.inverseInertiaB = Ib;
-  state.exactFinish = settings.exactManifoldFinish;
-  // With the exact finish, K's blocks wait until a sweep needs them (pgsSweeps).
-  state.sweepsPrepared = !state.exactFinish;
+  state.setExactFinish(settings.exactManifoldFinish);
   if (points.size() == 1) points[0].prepareOnePoint(A.inverseMass() + B.inverseMass(), Ia, Ib);
-  else if (state.exactFinish)
-    for (Point& p : points) p.prepareRows(A.inverseMass() + B.inverseMass(), Ia, Ib);
   else
-    for (Point& p : points) p.prepare(A.inverseMass() + B.inverseMass(), Ia, Ib);
+    for (Point& p : points) p.prepareForSolve(state.exactFinish, A.inverseMass() + B.inverseMass(), Ia, Ib);
 
   // Working copies (state): the impulse of the whole pair is found first, then (second contact
   // step, collisions) clamped as one against the state before it (Sec. 2.3.2) and applied.
@@ -566,7 +562,7 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ContactBody<d>& A, C
   VecD J;
   con::AngVec<d> tau;
   const int active = netImpulse<d>(points, J, tau);
-  if (active == 0) return 0;
+  if (active == 0) return {};
   double scale = 1;
   if (clamp) {
     // Energy of the non-split base state; a partner of infinite mass that moves (kinematic)
@@ -582,21 +578,25 @@ int ContactWorkspace<d>::updatePair(ContactPairState& pair, ContactBody<d>& A, C
     if (r.kind != con::ClampResult::Case::NoGain && clampsApplied) ++*clampsApplied;
     if (clampEnergyChange) *clampEnergyChange += r.energyChange;
     scale = r.scale;
-    if (scale == 0) return 0;
+    if (scale == 0) return {};
   }
-  if (!apply) return active;
+  return {active, J, tau, scale, VecD(poseA.x - poseB.x)};
+}
+
+template <int d>
+void ContactWorkspace<d>::applyPairImpulse(ContactPairState& pair, ContactBody<d>& A, ContactBody<d>& B,
+                                           const PairImpulse& r, ImpulseMode mode) const {
   if (!A.infinite()) {
-    A.v += scale * A.inverseMass() * J;
-    A.L += scale * tau;
+    A.v += r.scale * A.inverseMass() * r.J;
+    A.L += r.scale * r.tau;
     updateCandidate(A);
   }
   if (!B.infinite()) {
-    B.v -= scale * B.inverseMass() * J;
-    B.L -= scale * (tau + con::cross<d>(VecD(poseA.x - poseB.x), J));
+    B.v -= r.scale * B.inverseMass() * r.J;
+    B.L -= r.scale * (r.tau + con::cross<d>(r.fromB, r.J));
     updateCandidate(B);
   }
-  if (!collision) pair.contacted = true;
-  return active;
+  if (mode != ImpulseMode::Collision) pair.contacted = true;
 }
 
 template <int d>
@@ -651,11 +651,9 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
   if (!anyApproaching) return 0;
   const con::AngMat<d> none = con::AngMat<d>::Zero();
   double speedScale = 0;
-  state.exactFinish = settings.exactManifoldFinish;
-  state.sweepsPrepared = !state.exactFinish;  // as in updatePair
+  state.setExactFinish(settings.exactManifoldFinish);
   for (Point& p : points) {
-    if (state.exactFinish) p.prepareRows(C.inverseMass(), Iinv, none);
-    else p.prepare(C.inverseMass(), Iinv, none);
+    p.prepareForSolve(state.exactFinish, C.inverseMass(), Iinv, none);
     speedScale = std::max(speedScale, std::abs(p.target));
   }
   const double tolerance = 1e-7 * speedScale + 1e-12;
@@ -742,6 +740,26 @@ bool ContactWorkspace<d>::infiniteIn(const IslandSchedule& s, int body) const {
   return b.isStatic || b.kinematic || (memberIndex_[body] >= 0 && s.frozen[memberIndex_[body]]);
 }
 
+// What a collision check leaves for the skip test (notes 1.4): the bodies it moved carry its
+// stamp, the pair the one after it.
+template <int d>
+void markCollisionChecked(ContactPairState& pair, ContactBody<d>& A, ContactBody<d>& B, long stamp, bool moved) {
+  if (moved) {
+    if (!A.infinite()) A.movedStamp = stamp;
+    if (!B.infinite()) B.movedStamp = stamp;
+  }
+  pair.checkedStamp = stamp + 1;
+}
+
+// One update's counts added to a sweep's sums (an energy change only where a clamp acted or
+// the change is not zero, so that a sum of zeros stays exactly as it was).
+inline void addUpdateCounts(int impulses, int clamps, double energyChange, int* impulseSum, int* clampsOut,
+                            double* energyOut) {
+  *impulseSum += impulses;
+  if (clampsOut) *clampsOut += clamps;
+  if (energyOut && (clamps != 0 || energyChange != 0)) *energyOut += energyChange;
+}
+
 template <int d>
 void ContactWorkspace<d>::runTask(IslandSchedule& s, const SweepTask& t, int k,
                                   std::vector<col::ContactPoint<d>>& scratch) {
@@ -758,11 +776,7 @@ void ContactWorkspace<d>::runTask(IslandSchedule& s, const SweepTask& t, int k,
       if (pair.checkedStamp > std::max(A.movedStamp, B.movedStamp)) return;
       impulseCount = updatePair(pair, ImpulseMode::Collision, 0.0, t.iterations, 0.0, scratch, &energyChange,
                                 &clampCount);
-      if (impulseCount > 0) {
-        if (!A.infinite()) A.movedStamp = t.stamp;
-        if (!B.infinite()) B.movedStamp = t.stamp;
-      }
-      pair.checkedStamp = t.stamp + 1;
+      markCollisionChecked(pair, A, B, t.stamp, impulseCount > 0);
       break;
     }
     case SweepTask::Kind::Pair:
@@ -779,9 +793,7 @@ void ContactWorkspace<d>::runTask(IslandSchedule& s, const SweepTask& t, int k,
       return;
   }
   if (!s.order.tracking()) {  // run in order: the results go straight to the sums
-    s.impulseSum += impulseCount;
-    if (s.clampsOut) *s.clampsOut += clampCount;
-    if (s.energyOut && (clampCount != 0 || energyChange != 0)) *s.energyOut += energyChange;
+    addUpdateCounts(impulseCount, clampCount, energyChange, &s.impulseSum, s.clampsOut, s.energyOut);
     return;
   }
   if (energyChange != 0) s.energyChange[k] = energyChange;
@@ -878,20 +890,21 @@ int ContactWorkspace<d>::speculativeCollisionSweep(int island, double* clampEner
     for (std::size_t k = r.begin(); k != r.end(); ++k) {
       CollisionProbe& probe = probes_[k];
       probe.pair = pairs[list[k]];
-      probe.impulses = updatePair(probe.pair, bodies[probe.pair.a], bodies[probe.pair.b], ImpulseMode::Collision, 0.0,
-                                  settings.collisionPairIterations, 0.0, scratch, &probe.energyChange, &probe.clamps,
-                                  /*apply=*/false);
+      probe.impulses = findPairImpulse(probe.pair, bodies[probe.pair.a], bodies[probe.pair.b], ImpulseMode::Collision,
+                                       0.0, settings.collisionPairIterations, 0.0, scratch, &probe.energyChange,
+                                       &probe.clamps)
+                           .active;
     }
   });
   // 2. In order, up to the first update with impulses to apply (runTask's bookkeeping).
   std::size_t k = 0;
+  int none = 0;
   for (; k < n && probes_[k].impulses == 0; ++k) {
     const CollisionProbe& probe = probes_[k];
     ContactPairState& pair = pairs[list[k]];
     pair = probe.pair;
-    pair.checkedStamp = stamp(k) + 1;
-    if (clampsApplied) *clampsApplied += probe.clamps;
-    if (clampEnergyChange && (probe.clamps != 0 || probe.energyChange != 0)) *clampEnergyChange += probe.energyChange;
+    markCollisionChecked(pair, bodies[pair.a], bodies[pair.b], stamp(k), false);
+    addUpdateCounts(0, probe.clamps, probe.energyChange, &none, clampsApplied, clampEnergyChange);
   }
   if (k == n) return 0;
   // 3. The rest as the ordered sweep runs them (recorded afresh; later sweeps record their own).

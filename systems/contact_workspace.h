@@ -163,19 +163,39 @@ class ContactWorkspace {
   // The pose at x^n + dt (v + k dv): k = 1 re-advances with the Step I kick (notes 1.6).
   solvers::collision::Pose<d> reAdvanced(const ContactBody<d>& b, double k) const;
 
-  // One pair update: up to `iterations` impulses at the deepest approaching point.
-  // Returns the number of impulses applied.
+  // What one pair's manifold solve asks for: the net impulse J on A (-J on B), A's angular
+  // impulse tau about its centre, the energy clamp's scale, and how many points carry impulse
+  // (0: nothing to apply). fromB = x_a - x_b where the pair was tested.
+  struct PairImpulse {
+    int active = 0;
+    VecD J = VecD::Zero();
+    solvers::contact::AngVec<d> tau = solvers::contact::AngVec<d>::Zero();
+    double scale = 1;
+    VecD fromB = VecD::Zero();
+  };
+  // One pair update: the pair's manifold at the candidate poses, its impulses solved together
+  // (at most `iterations` sweeps) and applied. Returns how many points carry impulse.
   int updatePair(ContactPairState& pair, ImpulseMode mode, double epsilon, int iterations, double margin,
                  std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
                  int* clampsApplied) {
-    return updatePair(pair, bodies[pair.a], bodies[pair.b], mode, epsilon, iterations, margin, scratch,
-                      clampEnergyChange, clampsApplied);
+    ContactBody<d>& A = bodies[pair.a];
+    ContactBody<d>& B = bodies[pair.b];
+    const PairImpulse r = findPairImpulse(pair, A, B, mode, epsilon, iterations, margin, scratch, clampEnergyChange,
+                                          clampsApplied);
+    if (r.active > 0) applyPairImpulse(pair, A, B, r, mode);
+    return r.active;
   }
-  // The same on given bodies A and B; with `apply` false the impulses are found but not applied
-  // (the bodies are only read; the pair's state is updated as it would be).
-  int updatePair(ContactPairState& pair, ContactBody<d>& A, ContactBody<d>& B, ImpulseMode mode, double epsilon,
-                 int iterations, double margin, std::vector<solvers::collision::ContactPoint<d>>& scratch,
-                 double* clampEnergyChange, int* clampsApplied, bool apply = true);
+  // The update's first half: finds the impulse, only reading the bodies (the speculative sweep
+  // runs it on many pairs at once). The pair's own state (processed, swept, the solve's end)
+  // is updated as the update leaves it.
+  PairImpulse findPairImpulse(ContactPairState& pair, const ContactBody<d>& A, const ContactBody<d>& B,
+                              ImpulseMode mode, double epsilon, int iterations, double margin,
+                              std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
+                              int* clampsApplied) const;
+  // The second half: the impulse on both bodies (those of finite mass), their candidates
+  // re-advanced; a contact impulse marks the pair contacted (Step V's list).
+  void applyPairImpulse(ContactPairState& pair, ContactBody<d>& A, ContactBody<d>& B, const PairImpulse& r,
+                        ImpulseMode mode) const;
 
   // One Gauss-Seidel collision sweep (Step II, notes 1.4) over one island's pairs; `sweep` counts
   // from 0. A pair is skipped when it was checked after both its bodies last moved. Returns the

@@ -91,6 +91,12 @@ struct PgsPoint {
       biasT[k] = T.col(k).dot(partnerVelocity);
     }
   }
+  // What a solve needs before it starts: with the exact finish, which may end it before any
+  // sweep, only the rows (pgsSweeps prepares the rest if it sweeps: PgsBodies::sweepsPrepared).
+  void prepareForSolve(bool exactFinish, double inverseMasses, const AngMat<d>& Ia, const AngMat<d>& Ib) {
+    if (exactFinish) prepareRows(inverseMasses, Ia, Ib);
+    else prepare(inverseMasses, Ia, Ib);
+  }
   // K's normal and tangent-plane blocks, which only the sweeps use (after prepareRows). A solve
   // that the exact finish ends before its first sweep never needs them.
   void prepareSweeps() {
@@ -173,6 +179,11 @@ struct PgsBodies {
   bool exactFinish = false;
   // The points had only prepareRows (exact finish): pgsSweeps prepares the rest before sweeping.
   bool sweepsPrepared = true;
+  // The switch above and what it means for the points (PgsPoint::prepareForSolve).
+  void setExactFinish(bool on) {
+    exactFinish = on;
+    sweepsPrepared = !on;
+  }
 };
 
 // Part of the relative velocity at p that no impulse of this solve changes: the partner's
@@ -310,21 +321,7 @@ template <int d, bool movesA, bool movesB>
     }
     change2 = std::max(change2, df2 * p.inverseTangentMassNorm2);
   }
-  Vec<d> j = dl * p.n;
-  AngVec<d> ja = dl * p.IaRaN, jb = dl * p.IbRbN;
-  for (int k = 0; k < m; ++k) {
-    j += df[k] * p.T.col(k);
-    if constexpr (movesA) ja += df[k] * p.IaRaT.col(k);
-    if constexpr (movesB) jb += df[k] * p.IbRbT.col(k);
-  }
-  if constexpr (movesA) {
-    va += inverseMassA * j;
-    wa += ja;
-  }
-  if constexpr (movesB) {
-    vb -= inverseMassB * j;
-    wb -= jb;
-  }
+  applyImpulseChange<d, movesA, movesB>(p, dl, df, inverseMassA, inverseMassB, va, wa, vb, wb);
   return change2;
 }
 

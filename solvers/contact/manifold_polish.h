@@ -105,6 +105,30 @@ inline void addStickingBlock(TwistMat<d>& M, const Vec<d>& r) {
 
 // Point: PgsPoint<d> (prepared, offsets set); Bodies: PgsBodies<d>. va..wb: the sweeps' working
 // velocities, updated on success. Returns true if the solve is finished.
+// An impulse change at point p (dn along its normal, dt along its tangents) applied to the
+// working velocities: the sweeps' step (pgsStep) and the finish's result apply it alike, in the
+// same order of operations.
+template <int d, bool movesA, bool movesB, class Point>
+[[gnu::always_inline]] inline void applyImpulseChange(const Point& p, double dn, const double* dt, double inverseMassA,
+                                                      double inverseMassB, Vec<d>& va, AngVec<d>& wa, Vec<d>& vb,
+                                                      AngVec<d>& wb) {
+  Vec<d> j = dn * p.n;
+  AngVec<d> ja = dn * p.IaRaN, jb = dn * p.IbRbN;
+  for (int k = 0; k < d - 1; ++k) {
+    j += dt[k] * p.T.col(k);
+    if constexpr (movesA) ja += dt[k] * p.IaRaT.col(k);
+    if constexpr (movesB) jb += dt[k] * p.IbRbT.col(k);
+  }
+  if constexpr (movesA) {
+    va += inverseMassA * j;
+    wa += ja;
+  }
+  if constexpr (movesB) {
+    vb -= inverseMassB * j;
+    wb -= jb;
+  }
+}
+
 template <int d, bool movesA, bool movesB, class Point, class Bodies>
 bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, AngVec<d>& wa, Vec<d>& vb,
                     AngVec<d>& wb, double tolerance, bool guessLoaded = false) {
@@ -247,9 +271,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       const double dn = result[i].normal - p.normalImpulse;
       const Tangent dt = result[i].tangent - p.tangentImpulse;
       if (dn == 0 && dt.squaredNorm() == 0) continue;
-      const Vec<d> j = dn * p.n + p.T * dt;
-      if constexpr (movesA) va1 += s.inverseMassA * j, wa1 += dn * p.IaRaN + p.IaRaT * dt;
-      if constexpr (movesB) vb1 -= s.inverseMassB * j, wb1 -= dn * p.IbRbN + p.IbRbT * dt;
+      applyImpulseChange<d, movesA, movesB>(p, dn, dt.data(), s.inverseMassA, s.inverseMassB, va1, wa1, vb1, wb1);
     }
     // With sliding friction the complementarity problem can have spurious solutions of large
     // impulses that feed energy in (Painleve's paradox; seen in pyramid_20: a pair of boxes given

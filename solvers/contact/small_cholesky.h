@@ -90,6 +90,8 @@ class SmallCholesky {
   }
 
  private:
+  // L and L D both: the factorisation's inner products take L(i, k) L(j, k) D(k) as l_ times
+  // ld_, one multiply each, and the solves read l_ alone (144 more numbers on the stack).
   double l_[n][n] = {}, ld_[n][n] = {};
   double pivot_[n] = {}, inversePivot_[n] = {};
 };
