@@ -339,7 +339,7 @@ void ContactWorkspace<d>::findPairs() {
     pair.end = pairs[old].end;
   }
   pairs.swap(fresh);
-  islands = con::computeIslands(n, found, infinite_);
+  con::computeIslands(n, found, infinite_, islands);
   islandPairsByLevel = islands.pairs;
   memberIndex_.assign(n, -1);
   for (const auto& members : islands.members)
@@ -377,7 +377,7 @@ void ContactWorkspace<d>::rebuildPairsFrom(const std::vector<std::pair<int, int>
   if (old != pairs.size()) throw std::logic_error("ContactWorkspace: a grown broad phase lost a pair");
   pairs = std::move(merged);
   const int n = static_cast<int>(bodies.size());
-  islands = con::computeIslands(n, found, infinite_);
+  con::computeIslands(n, found, infinite_, islands);
   memberIndex_.assign(n, -1);
   for (const auto& members : islands.members)
     for (std::size_t k = 0; k < members.size(); ++k) memberIndex_[members[k]] = static_cast<int>(k);
@@ -436,7 +436,7 @@ int ContactWorkspace<d>::computeLevels() {
     if (bOverA[k]) edges.emplace_back(pair.a, pair.b);
     if (aOverB[k] || bOverA[k]) pair.processed = true;
   }
-  levels = con::computeLevels(static_cast<int>(bodies.size()), edges);
+  con::computeLevels(static_cast<int>(bodies.size()), edges, levels);
   for (ContactPairState& pair : pairs) pair.level = std::max(levels.levelOf[pair.a], levels.levelOf[pair.b]);
   sortIslandPairsByLevel();
   return added;

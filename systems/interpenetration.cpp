@@ -107,7 +107,7 @@ const solvers::contact::ContactLevels& ResolveInterpenetration<d>::pushLevels(co
     if (fb) edges_.emplace_back(a, b);
     if (fa) edges_.emplace_back(b, a);
   }
-  pushLevels_ = con::computeLevels(static_cast<int>(ws.bodies.size()), edges_);
+  con::computeLevels(static_cast<int>(ws.bodies.size()), edges_, pushLevels_);
   for (std::size_t k = 0; k < ws.pairs.size(); ++k)
     pairLevel_[k] = std::max(pushLevels_.levelOf[ws.pairs[k].a], pushLevels_.levelOf[ws.pairs[k].b]);
   return pushLevels_;
@@ -227,6 +227,7 @@ int ResolveInterpenetration<d>::pushApart(ContactWorkspace<d>& ws, const solvers
       thread_local std::vector<col::ContactPoint<d>> scratch;
       thread_local std::vector<con::PushOutOuter<d>> outers;
       thread_local std::vector<int> outerIndex;
+      thread_local con::PushOutResult<d> r;  // kept: its lists' storage carries over
       const col::ContactQuery query;
       const int c = task.central;
       ContactBody<d>& C = ws.bodies[c];
@@ -262,7 +263,7 @@ int ResolveInterpenetration<d>::pushApart(ContactWorkspace<d>& ws, const solvers
         central.mass = C.mass;
         central.inertia = C.inertia0;
         central.lengthScale = C.geometry->boundingRadius();
-        const con::PushOutResult<d> r = con::solvePushOut(central, outers);
+        con::solvePushOut(central, outers, r);
         setBasePose<d>(C, C.x0 + r.centralDisplacement, rotatedBy<d>(C.q0, r.centralRotation));
         for (std::size_t k = 0; k < outers.size(); ++k) {
           ContactBody<d>& O = ws.bodies[outerIndex[k]];

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <functional>
 #include <numeric>
-#include <queue>
 #include <stdexcept>
 #include <string>
 
@@ -25,30 +24,47 @@ struct Adjacency {
   std::vector<int> targets;
 };
 
-Adjacency buildAdjacency(int nodeCount, const std::vector<std::pair<int, int>>& edges) {
-  Adjacency adj;
+void buildAdjacency(int nodeCount, const std::vector<std::pair<int, int>>& edges, Adjacency& adj,
+                    std::vector<int>& fill) {
   adj.start.assign(static_cast<std::size_t>(nodeCount) + 1, 0);
   for (const auto& [from, to] : edges) ++adj.start[static_cast<std::size_t>(from) + 1];
   std::partial_sum(adj.start.begin(), adj.start.end(), adj.start.begin());
   adj.targets.resize(edges.size());
-  std::vector<int> fill(adj.start.begin(), adj.start.end() - 1);
+  fill.assign(adj.start.begin(), adj.start.end() - 1);
   for (const auto& [from, to] : edges) adj.targets[static_cast<std::size_t>(fill[from]++)] = to;
-  return adj;
+}
+
+// Everything the two computations need besides their results, kept per thread: the graph is
+// rebuilt every step (and by push-out), and once warm nothing here allocates.
+struct GraphScratch {
+  Adjacency adj, condensed;
+  std::vector<int> fill, index, low, component, stack, smallest, inDegree, levelOfComponent, parent, islandOfRoot;
+  std::vector<char> onStack;
+  std::vector<std::pair<int, int>> frames, componentEdges, ready;
+};
+GraphScratch& graphScratch() {
+  thread_local GraphScratch s;
+  return s;
 }
 
 // Tarjan's strongly connected components with an explicit call stack, so that a chain of 10^5
-// bodies cannot overflow the machine stack. Returns the component of every node.
-std::vector<int> stronglyConnectedComponents(int nodeCount, const Adjacency& adj,
-                                             int& componentCount) {
+// bodies cannot overflow the machine stack. Leaves the component of every node in s.component.
+int stronglyConnectedComponents(int nodeCount, const Adjacency& adj, GraphScratch& s) {
   constexpr int kUnvisited = -1;
-  std::vector<int> index(static_cast<std::size_t>(nodeCount), kUnvisited);
-  std::vector<int> low(static_cast<std::size_t>(nodeCount), 0);
-  std::vector<int> component(static_cast<std::size_t>(nodeCount), -1);
-  std::vector<char> onStack(static_cast<std::size_t>(nodeCount), 0);
-  std::vector<int> stack;
-  std::vector<std::pair<int, int>> frames;  // (node, next adjacency position)
+  std::vector<int>& index = s.index;
+  std::vector<int>& low = s.low;
+  std::vector<int>& component = s.component;
+  std::vector<char>& onStack = s.onStack;
+  std::vector<int>& stack = s.stack;
+  std::vector<std::pair<int, int>>& frames = s.frames;  // (node, next adjacency position)
+  index.assign(static_cast<std::size_t>(nodeCount), kUnvisited);
+  low.assign(static_cast<std::size_t>(nodeCount), 0);
+  component.assign(static_cast<std::size_t>(nodeCount), -1);
+  onStack.assign(static_cast<std::size_t>(nodeCount), 0);
+  stack.clear();
+  frames.clear();
   int counter = 0;
-  componentCount = 0;
+  int componentCount = 0;
 
   auto visit = [&](int v) {
     index[v] = low[v] = counter++;
@@ -90,27 +106,30 @@ std::vector<int> stronglyConnectedComponents(int nodeCount, const Adjacency& adj
       }
     }
   }
-  return component;
+  return componentCount;
 }
 
 }  // namespace
 
-ContactLevels computeLevels(int nodeCount, const std::vector<std::pair<int, int>>& belowAbove) {
+void computeLevels(int nodeCount, const std::vector<std::pair<int, int>>& belowAbove, ContactLevels& result) {
   for (const auto& [below, above] : belowAbove) {
     checkNode(below, nodeCount);
     checkNode(above, nodeCount);
   }
-  const Adjacency adj = buildAdjacency(nodeCount, belowAbove);
-  int componentCount = 0;
-  const std::vector<int> component = stronglyConnectedComponents(nodeCount, adj, componentCount);
+  GraphScratch& s = graphScratch();
+  buildAdjacency(nodeCount, belowAbove, s.adj, s.fill);
+  const int componentCount = stronglyConnectedComponents(nodeCount, s.adj, s);
+  const std::vector<int>& component = s.component;
 
   // Condensation: each cycle collapses to one node; name each by its smallest member so that
   // ties below are broken independently of Tarjan's visiting order.
-  std::vector<int> smallest(static_cast<std::size_t>(componentCount), nodeCount);
+  std::vector<int>& smallest = s.smallest;
+  smallest.assign(static_cast<std::size_t>(componentCount), nodeCount);
   for (int v = 0; v < nodeCount; ++v) smallest[component[v]] = std::min(smallest[component[v]], v);
-  std::vector<std::pair<int, int>> componentEdges;
-  componentEdges.reserve(belowAbove.size());
-  std::vector<int> inDegree(static_cast<std::size_t>(componentCount), 0);
+  std::vector<std::pair<int, int>>& componentEdges = s.componentEdges;
+  componentEdges.clear();
+  std::vector<int>& inDegree = s.inDegree;
+  inDegree.assign(static_cast<std::size_t>(componentCount), 0);
   for (const auto& [below, above] : belowAbove) {
     const int from = component[below];
     const int to = component[above];
@@ -118,45 +137,61 @@ ContactLevels computeLevels(int nodeCount, const std::vector<std::pair<int, int>
     componentEdges.emplace_back(from, to);
     ++inDegree[to];
   }
-  const Adjacency condensed = buildAdjacency(componentCount, componentEdges);
+  buildAdjacency(componentCount, componentEdges, s.condensed, s.fill);
 
   // Kahn's topological order from the bottom (nothing below), the ready component with the
   // smallest member first: each component is its own level (notes 1.6: levels are not merged).
-  using Entry = std::pair<int, int>;  // (smallest member, component)
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> ready;
+  // The heap lives in the scratch vector (a min-heap on (smallest member, component)).
+  using Entry = std::pair<int, int>;
+  std::vector<Entry>& ready = s.ready;
+  ready.clear();
+  const auto later = std::greater<Entry>();
+  auto push = [&](int c) {
+    ready.emplace_back(smallest[c], c);
+    std::push_heap(ready.begin(), ready.end(), later);
+  };
   for (int c = 0; c < componentCount; ++c) {
-    if (inDegree[c] == 0) ready.emplace(smallest[c], c);
+    if (inDegree[c] == 0) push(c);
   }
-  std::vector<int> levelOfComponent(static_cast<std::size_t>(componentCount), -1);
+  std::vector<int>& levelOfComponent = s.levelOfComponent;
+  levelOfComponent.assign(static_cast<std::size_t>(componentCount), -1);
   int level = 0;
   while (!ready.empty()) {
-    const int c = ready.top().second;
-    ready.pop();
+    std::pop_heap(ready.begin(), ready.end(), later);
+    const int c = ready.back().second;
+    ready.pop_back();
     levelOfComponent[c] = level++;
-    for (int p = condensed.start[c]; p < condensed.start[c + 1]; ++p) {
-      const int next = condensed.targets[static_cast<std::size_t>(p)];
-      if (--inDegree[next] == 0) ready.emplace(smallest[next], next);
+    for (int p = s.condensed.start[c]; p < s.condensed.start[c + 1]; ++p) {
+      const int next = s.condensed.targets[static_cast<std::size_t>(p)];
+      if (--inDegree[next] == 0) push(next);
     }
   }
 
-  ContactLevels result;
   result.levelOf.resize(static_cast<std::size_t>(nodeCount));
   result.nodes.resize(static_cast<std::size_t>(componentCount));
+  for (auto& list : result.nodes) list.clear();  // keeps each list's storage
   for (int v = 0; v < nodeCount; ++v) {  // ascending, so each level's list is sorted
     const int l = levelOfComponent[component[v]];
     result.levelOf[v] = l;
     result.nodes[l].push_back(v);
   }
+}
+
+ContactLevels computeLevels(int nodeCount, const std::vector<std::pair<int, int>>& belowAbove) {
+  ContactLevels result;
+  computeLevels(nodeCount, belowAbove, result);
   return result;
 }
 
-Islands computeIslands(int nodeCount, const std::vector<std::pair<int, int>>& pairs,
-                       const std::vector<char>& isInfinite) {
+void computeIslands(int nodeCount, const std::vector<std::pair<int, int>>& pairs, const std::vector<char>& isInfinite,
+                    Islands& islands) {
   if (static_cast<int>(isInfinite.size()) != nodeCount) {
     throw std::invalid_argument("contact graph: isInfinite needs one entry per node");
   }
+  GraphScratch& s = graphScratch();
   // Union-find over finite nodes; an infinite node (static ground) never joins two islands.
-  std::vector<int> parent(static_cast<std::size_t>(nodeCount));
+  std::vector<int>& parent = s.parent;
+  parent.resize(static_cast<std::size_t>(nodeCount));
   std::iota(parent.begin(), parent.end(), 0);
   auto find = [&parent](int v) {
     while (parent[v] != v) {
@@ -174,25 +209,36 @@ Islands computeIslands(int nodeCount, const std::vector<std::pair<int, int>>& pa
     if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
   }
 
-  Islands islands;
+  // The lists are cleared, not freed: their storage carries over to the next call.
   islands.islandOf.assign(static_cast<std::size_t>(nodeCount), -1);
-  std::vector<int> islandOfRoot(static_cast<std::size_t>(nodeCount), -1);
+  std::size_t count = 0;
+  std::vector<int>& islandOfRoot = s.islandOfRoot;
+  islandOfRoot.assign(static_cast<std::size_t>(nodeCount), -1);
   for (int v = 0; v < nodeCount; ++v) {  // ascending: islands come ordered by first member
     if (isInfinite[v]) continue;
     const int root = find(v);
     if (islandOfRoot[root] < 0) {
-      islandOfRoot[root] = static_cast<int>(islands.members.size());
-      islands.members.emplace_back();
+      islandOfRoot[root] = static_cast<int>(count++);
+      if (islands.members.size() < count) islands.members.emplace_back();
+      islands.members[count - 1].clear();
     }
     islands.islandOf[v] = islandOfRoot[root];
     islands.members[islandOfRoot[root]].push_back(v);
   }
-  islands.pairs.resize(islands.members.size());
+  islands.members.resize(count);
+  islands.pairs.resize(count);
+  for (auto& list : islands.pairs) list.clear();
   for (std::size_t p = 0; p < pairs.size(); ++p) {
     const auto& [a, b] = pairs[p];
     const int island = isInfinite[a] ? islands.islandOf[b] : islands.islandOf[a];
     if (island >= 0) islands.pairs[island].push_back(static_cast<int>(p));
   }
+}
+
+Islands computeIslands(int nodeCount, const std::vector<std::pair<int, int>>& pairs,
+                       const std::vector<char>& isInfinite) {
+  Islands islands;
+  computeIslands(nodeCount, pairs, isInfinite, islands);
   return islands;
 }
 

@@ -18,6 +18,9 @@ struct ContactLevels {
 // Edges (below, above). Deterministic: the result depends only on nodeCount and the edge set
 // (the order of `edges` does not matter). Isolated nodes get levels too.
 ContactLevels computeLevels(int nodeCount, const std::vector<std::pair<int, int>>& belowAbove);
+// The same into `out`, reusing its storage: the contact stages rebuild the graph every step,
+// and once warm this allocates nothing.
+void computeLevels(int nodeCount, const std::vector<std::pair<int, int>>& belowAbove, ContactLevels& out);
 
 // Every finite node is in exactly one island (one without pairs forms an island of its own).
 struct Islands {
@@ -31,5 +34,8 @@ struct Islands {
 // belongs to no island.
 Islands computeIslands(int nodeCount, const std::vector<std::pair<int, int>>& pairs,
                        const std::vector<char>& isInfinite);
+// The same into `out`, reusing its storage (as computeLevels above).
+void computeIslands(int nodeCount, const std::vector<std::pair<int, int>>& pairs, const std::vector<char>& isInfinite,
+                    Islands& out);
 
 }  // namespace monolith::solvers::contact

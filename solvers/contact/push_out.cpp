@@ -180,20 +180,25 @@ GenVec<d> solveWithStatics(const PushOutCentral<d>& central,
 }  // namespace
 
 template <int d>
-PushOutResult<d> solvePushOut(const PushOutCentral<d>& central,
-                              const std::vector<PushOutOuter<d>>& outers) {
+void solvePushOut(const PushOutCentral<d>& central, const std::vector<PushOutOuter<d>>& outers,
+                  PushOutResult<d>& result) {
   constexpr int k = kAngularDim<d>;
-  PushOutResult<d> result;
+  result.kind = PushOutCase::AllDynamic;
+  result.centralDisplacement.setZero();
+  result.centralRotation.setZero();
   const std::size_t count = outers.size();
   result.outerImpulses.assign(count, Vec<d>::Zero());
   result.outerDisplacements.assign(count, Vec<d>::Zero());
   result.outerRotations.assign(count, AngVec<d>::Zero());
-  if (count == 0) return result;
+  if (count == 0) return;
 
-  std::vector<Mat<d>> kInverse(count);
+  // Per thread and kept: push-out solves one such system per body and round.
+  thread_local std::vector<Mat<d>> kInverse;
+  thread_local std::vector<int> statics;
+  kInverse.resize(count);
+  statics.clear();
   NormalSystem<d> dyn;   // A_d (the central mass is added below), b_d
   NormalSystem<d> stat;  // A_s, b_s from K_hat_s
-  std::vector<int> statics;
   for (std::size_t i = 0; i < count; ++i) {
     kInverse[i] = outerFactor<d>(outers[i]).inverse();
     if (outers[i].isStatic) {
@@ -232,6 +237,12 @@ PushOutResult<d> solvePushOut(const PushOutCentral<d>& central,
   }
   result.centralDisplacement = x.template head<d>();
   result.centralRotation = x.template tail<k>();
+}
+
+template <int d>
+PushOutResult<d> solvePushOut(const PushOutCentral<d>& central, const std::vector<PushOutOuter<d>>& outers) {
+  PushOutResult<d> result;
+  solvePushOut<d>(central, outers, result);
   return result;
 }
 
@@ -239,5 +250,7 @@ template PushOutResult<2> solvePushOut<2>(const PushOutCentral<2>&,
                                           const std::vector<PushOutOuter<2>>&);
 template PushOutResult<3> solvePushOut<3>(const PushOutCentral<3>&,
                                           const std::vector<PushOutOuter<3>>&);
+template void solvePushOut<2>(const PushOutCentral<2>&, const std::vector<PushOutOuter<2>>&, PushOutResult<2>&);
+template void solvePushOut<3>(const PushOutCentral<3>&, const std::vector<PushOutOuter<3>>&, PushOutResult<3>&);
 
 }  // namespace monolith::solvers::contact

@@ -58,5 +58,10 @@ struct PushOutResult {
 template <int d>
 PushOutResult<d> solvePushOut(const PushOutCentral<d>& central,
                               const std::vector<PushOutOuter<d>>& outers);
+// The same into `result`, reusing its storage (push-out solves one such system per body and
+// round; once warm this allocates nothing).
+template <int d>
+void solvePushOut(const PushOutCentral<d>& central, const std::vector<PushOutOuter<d>>& outers,
+                  PushOutResult<d>& result);
 
 }  // namespace monolith::solvers::contact

@@ -137,4 +137,30 @@ TEST(ContactIslands, MergingThroughDynamicBodiesAndOrder) {
   EXPECT_THROW(computeIslands(8, pairs, std::vector<char>(7, 0)), std::invalid_argument);
 }
 
+TEST(ContactGraphReuse, ResultsWrittenOverEarlierOnesEqualFreshOnes) {
+  // The contact stages rebuild the graph into last step's results (their storage is kept);
+  // nothing of the earlier graph may show through, whether the new one is larger or smaller.
+  std::mt19937 rng(7);
+  ContactLevels levels;
+  Islands islands;
+  for (int graph = 0; graph < 40; ++graph) {
+    const int n = std::uniform_int_distribution<int>(1, 50)(rng);
+    std::uniform_int_distribution<int> node(0, n - 1);
+    Edges edges;
+    const int m = std::uniform_int_distribution<int>(0, 2 * n)(rng);
+    for (int e = 0; e < m; ++e) edges.emplace_back(node(rng), node(rng));
+    std::vector<char> infinite(n);
+    for (auto& f : infinite) f = std::uniform_int_distribution<int>(0, 5)(rng) == 0;
+    computeLevels(n, edges, levels);
+    const ContactLevels freshLevels = computeLevels(n, edges);
+    ASSERT_EQ(levels.levelOf, freshLevels.levelOf) << graph;
+    ASSERT_EQ(levels.nodes, freshLevels.nodes) << graph;
+    computeIslands(n, edges, infinite, islands);
+    const Islands freshIslands = computeIslands(n, edges, infinite);
+    ASSERT_EQ(islands.islandOf, freshIslands.islandOf) << graph;
+    ASSERT_EQ(islands.members, freshIslands.members) << graph;
+    ASSERT_EQ(islands.pairs, freshIslands.pairs) << graph;
+  }
+}
+
 }  // namespace

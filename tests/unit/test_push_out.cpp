@@ -379,4 +379,27 @@ TYPED_TEST(PushOut, PushesApartInTheRightDirection) {
   expectClose(push.outerImpulses[0], Vec<d>(0.3 * up), 1e-14, "ball impulse");
 }
 
+TYPED_TEST(PushOut, AResultWrittenOverAnEarlierOneEqualsAFreshOne) {
+  // Push-out solves into one kept result per thread: every case after every other, with more or
+  // fewer outers, must give exactly what a fresh result gets (nothing stale: the central motion
+  // of a static centre, the lists' lengths, an outer static now and dynamic before).
+  constexpr int d = TypeParam::value;
+  std::mt19937 rng(23);
+  PushOutResult<d> kept;
+  for (int trial = 0; trial < 60; ++trial) {
+    const PushOutCentral<d> c = randomCentral<d>(rng, trial % 5 == 0);
+    std::vector<PushOutOuter<d>> outers;
+    const int count = 1 + trial % 4;
+    for (int i = 0; i < count; ++i) outers.push_back(randomOuter<d>(rng, (trial + i) % 3 == 0));
+    solvePushOut<d>(c, outers, kept);
+    const PushOutResult<d> fresh = solvePushOut<d>(c, outers);
+    EXPECT_EQ(kept.kind, fresh.kind) << trial;
+    EXPECT_EQ(kept.centralDisplacement, fresh.centralDisplacement) << trial;
+    EXPECT_EQ(kept.centralRotation, fresh.centralRotation) << trial;
+    EXPECT_EQ(kept.outerImpulses, fresh.outerImpulses) << trial;
+    EXPECT_EQ(kept.outerDisplacements, fresh.outerDisplacements) << trial;
+    EXPECT_EQ(kept.outerRotations, fresh.outerRotations) << trial;
+  }
+}
+
 }  // namespace
