@@ -5,6 +5,7 @@
 // and result objects, GJK for the distance) cost several times the geometry itself.
 #include <array>
 #include <cmath>
+#include <type_traits>
 
 #include "solvers/collision/box_box_impl.h"
 #include "solvers/collision/contact_axis_impl.h"
@@ -268,21 +269,31 @@ BoxBoxAxis boxBoxAxis(const Geometry<3>& a, const Pose<3>& poseA, const Geometry
   }
   // Edge pairs in A's frame: b_j is column j of C and u = a_i x b_j, so a_k.u and b_k.u are
   // entries of C (their radii need no products), and |u| = sine of the angle between the edges.
+  // The indices are compile-time constants (the nine pairs spelled out below, in the order of a
+  // loop over i then j): no index arithmetic, and a_i x b_j read off C without products. The
+  // same numbers as Vec3::Unit(i).cross(C.col(j)) (its other terms are exact zeros).
   const Vec3 DA = poseA.R.transpose() * D;
-  for (int i = 0; i < 3; ++i) {
-    const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
-    for (int j = 0; j < 3; ++j) {
-      const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-      const Vec3 uA = Vec3::Unit(i).cross(C.col(j));
-      const double length = uA.norm();
-      if (length < kParallelSine) continue;
-      const double inverseLength = 1 / length;
-      const double along = DA.dot(uA) * inverseLength;
-      const double radii = hA[i1] * absC(i2, j) + hA[i2] * absC(i1, j) + hB[j1] * absC(i, j2) + hB[j2] * absC(i, j1);
-      consider(std::abs(along) - radii * inverseLength, along, 6 + 3 * i + j, false,
-               [&] { return Vec3(poseA.R * (uA * inverseLength)); });
-    }
-  }
+  auto edge = [&](auto iConstant, auto jConstant) {
+    constexpr int i = decltype(iConstant)::value, j = decltype(jConstant)::value;
+    constexpr int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+    Vec3 uA;
+    uA[i] = 0;
+    uA[i1] = -C(i2, j);
+    uA[i2] = C(i1, j);
+    const double length = uA.norm();
+    if (length < kParallelSine) return;
+    const double inverseLength = 1 / length;
+    const double along = DA.dot(uA) * inverseLength;
+    const double radii = hA[i1] * absC(i2, j) + hA[i2] * absC(i1, j) + hB[j1] * absC(i, j2) + hB[j2] * absC(i, j1);
+    consider(std::abs(along) - radii * inverseLength, along, 6 + 3 * i + j, false,
+             [&] { return Vec3(poseA.R * (uA * inverseLength)); });
+  };
+  using I0 = std::integral_constant<int, 0>;
+  using I1 = std::integral_constant<int, 1>;
+  using I2 = std::integral_constant<int, 2>;
+  edge(I0{}, I0{}), edge(I0{}, I1{}), edge(I0{}, I2{});
+  edge(I1{}, I0{}), edge(I1{}, I1{}), edge(I1{}, I2{});
+  edge(I2{}, I0{}), edge(I2{}, I1{}), edge(I2{}, I2{});
   best.leastOverlap = -separation;
   // Apart: report the largest gap (a lower bound on the distance); the axis is then irrelevant.
   if (separation > 0) best.separation = separation;
