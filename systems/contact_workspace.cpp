@@ -751,11 +751,11 @@ void markCollisionChecked(ContactPairState& pair, ContactBody<d>& A, ContactBody
   pair.checkedStamp = stamp + 1;
 }
 
-// One update's counts added to a sweep's sums (an energy change only where a clamp acted or
-// the change is not zero, so that a sum of zeros stays exactly as it was).
+// One update's counts added to a sweep's sums, each where it is wanted (an energy change only
+// where a clamp acted or the change is not zero, so that a sum of zeros stays exactly as it was).
 inline void addUpdateCounts(int impulses, int clamps, double energyChange, int* impulseSum, int* clampsOut,
                             double* energyOut) {
-  *impulseSum += impulses;
+  if (impulseSum) *impulseSum += impulses;
   if (clampsOut) *clampsOut += clamps;
   if (energyOut && (clamps != 0 || energyChange != 0)) *energyOut += energyChange;
 }
@@ -825,11 +825,8 @@ int ContactWorkspace<d>::runSchedule(IslandSchedule& s) {
   });
   // Diagnostics summed in the sequential order, so they too do not depend on the thread count.
   int impulses = 0;
-  for (std::size_t k = 0; k < s.tasks.size(); ++k) {
-    impulses += s.impulses[k];
-    if (s.clampsOut) *s.clampsOut += s.clamps[k];
-    if (s.energyOut && (s.clamps[k] != 0 || s.energyChange[k] != 0)) *s.energyOut += s.energyChange[k];
-  }
+  for (std::size_t k = 0; k < s.tasks.size(); ++k)
+    addUpdateCounts(s.impulses[k], s.clamps[k], s.energyChange[k], &impulses, s.clampsOut, s.energyOut);
   return impulses;
 }
 
@@ -898,13 +895,12 @@ int ContactWorkspace<d>::speculativeCollisionSweep(int island, double* clampEner
   });
   // 2. In order, up to the first update with impulses to apply (runTask's bookkeeping).
   std::size_t k = 0;
-  int none = 0;
   for (; k < n && probes_[k].impulses == 0; ++k) {
     const CollisionProbe& probe = probes_[k];
     ContactPairState& pair = pairs[list[k]];
     pair = probe.pair;
     markCollisionChecked(pair, bodies[pair.a], bodies[pair.b], stamp(k), false);
-    addUpdateCounts(0, probe.clamps, probe.energyChange, &none, clampsApplied, clampEnergyChange);
+    addUpdateCounts(0, probe.clamps, probe.energyChange, nullptr, clampsApplied, clampEnergyChange);
   }
   if (k == n) return 0;
   // 3. The rest as the ordered sweep runs them (recorded afresh; later sweeps record their own).
