@@ -8,8 +8,7 @@
 
 namespace monolith {
 
-namespace {
-solvers::BodyInertia bodyInertia(const RigidBody<3>& b) {
+solvers::BodyInertia rotationInertiaOf(const RigidBody<3>& b) {
   solvers::BodyInertia I;
   I.I0 = b.inertiaBody;
   I.I0inv = b.inertiaBodyInverse;
@@ -17,7 +16,6 @@ solvers::BodyInertia bodyInertia(const RigidBody<3>& b) {
   I.principalAxes = b.principalAxes;
   return I;
 }
-}  // namespace
 
 template <int d>
 void AdvanceRigidPositions<d>::run(World<d>& world, StepContext& ctx) {
@@ -34,7 +32,7 @@ void AdvanceRigidPositions<d>::run(World<d>& world, StepContext& ctx) {
     if constexpr (d == 2) {
       body->orientation += dt * body->omega()(0);
     } else {
-      const solvers::BodyInertia inertia = bodyInertia(*body);
+      const solvers::BodyInertia inertia = rotationInertiaOf(*body);
       const double energyBefore = solvers::rotationalKineticEnergy(inertia, body->orientation, body->L);
       body->orientation = solvers::advanceOrientation(static_cast<solvers::RotationOrder>(rule.order), dt, inertia,
                                                       body->orientation, body->L);

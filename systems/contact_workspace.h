@@ -141,6 +141,9 @@ class ContactWorkspace {
   // Candidate pose x0 + dt (v + kick*dv), rotated by dt * I^{-1}(L + kick*dL) (first order:
   // candidates only decide which pairs touch).
   void updateCandidate(ContactBody<d>& b) const;
+  // The velocity of the frame in which an impulse against `partner`, a body of infinite mass,
+  // is energy-clamped (r: the contact point from the partner's centre).
+  VecD clampFrameVelocity(const ContactBody<d>& partner, const VecD& r) const;
   // The motion from the base pose to the candidate pose (swept collisions).
   solvers::collision::StepMotion<d> stepMotion(const ContactBody<d>& b) const;
   void updateAllCandidates();
@@ -302,6 +305,7 @@ class ContactWorkspace {
   std::vector<CollisionProbe> probes_;
   std::vector<IslandSchedule> schedules_;  // per island (islands are recorded and run at once)
   std::vector<int> memberIndex_;           // per body: its position in its island's members
+  VecD frozenFrame_ = VecD::Zero();        // clampFrameVelocity's frame for frozen bodies (pack)
 
   void ensureGeometry(World<d>& world);
   std::vector<Entity> entities_;

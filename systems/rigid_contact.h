@@ -94,6 +94,16 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   };
 
  private:
+  // The rotational-energy clamp on the momentum Step V starts from (3-D; see the .cpp): what
+  // it needs from before push-out, then the clamp (returns the bodies it scaled).
+  void rememberRotationalEnergy(const ContactWorkspace<d>& ws);
+  int clampEnergyOfRestoredMomentum(ContactWorkspace<d>& ws);
+  struct AdvancedState {
+    solvers::contact::AngVec<d> L;
+    Orientation<d> q;
+  };
+  std::vector<double> energyAtTimeN_;     // per body: the restored momentum's energy at time n
+  std::vector<AdvancedState> advanced_;   // per body: Step IV's momentum and orientation
   std::vector<IslandPlan> plans_;
   // Per pair: its deepest overlap (m) and that over the smaller body's size, as last measured.
   // `which(k)` picks the pairs measured again; the others keep their values.

@@ -1,13 +1,14 @@
 #!/usr/bin/env python3
 """Writes the generated rigid-contact scenes of issue 3 (plain Python, no modules needed).
 
-    python3 scenarios/scenes/generate_contact_scenes.py [output_dir] [--pour N ...]
+    python3 scenarios/scenes/generate_contact_scenes.py [output_dir] [--pour N ...] [--random SEED ...]
 
 pyramid_10/20: boxes of edge 1 in layers of n, n-1, ..., 1 with horizontal spacing 1.02, mu 0.5,
 resting on a plane, one step per frame (dt = 1/30); pyramid_2d_10 the same in 2-D.
 sliver_shards: thin boxes dropped with spin at frame rate (the energy-clamp comparison of Sec. 2.3).
 box_stack_scatter: Fig. 2.2, boxes dropped into a stack, then a large box scatters it. pour_spheres_N: N spheres poured into a box.
 mixed_pile: boxes, spheres, capsules, cylinders and convex octahedra dropped into a walled box.
+random_drop_SEED: random bodies thrown over a plane (see random_drop); RANDOM_DROPS are kept.
 """
 import json
 import math
@@ -165,11 +166,88 @@ def mixed_pile(directory):
           "boxes, spheres, capsules, cylinders and octahedra dropped into a walled box", 1 / 60, 4.0, entities)
 
 
+def random_drop(directory, seed):
+    """random_drop_SEED: up to 30 bodies of random shape (boxes, spheres, capsules, cylinders,
+    convex hulls), size (half extents from 5 % to 100 % of a scale, so needles and slabs too),
+    mass (0.05-50), spin and speed (up to 15 m/s), thrown over a plane, often inside four walls, at
+    dt 1/30, 1/60 or 1/120 for 3 s. The energy rules must hold in every such scene."""
+    rng = random.Random(seed)
+
+    def quaternion():
+        u1, u2, u3 = rng.random(), rng.random(), rng.random()
+        return [math.sqrt(u1) * math.cos(2 * math.pi * u3), math.sqrt(1 - u1) * math.sin(2 * math.pi * u2),
+                math.sqrt(1 - u1) * math.cos(2 * math.pi * u2), math.sqrt(u1) * math.sin(2 * math.pi * u3)]
+
+    def shape(scale):
+        kind = rng.choice(["box", "box", "sphere", "capsule", "cylinder", "convex"])
+        size = lambda: scale * math.exp(rng.uniform(math.log(0.05), math.log(1.0)))
+        if kind == "box":
+            h = [size(), size(), size()]
+            return {"type": "box", "half_extents": h}, math.sqrt(sum(x * x for x in h)), None
+        if kind == "sphere":
+            r = size()
+            return {"type": "sphere", "radius": r}, r, None
+        if kind in ("capsule", "cylinder"):
+            r, hh = size(), size()
+            return {"type": kind, "radius": r, "half_height": hh}, math.hypot(r, hh) + (r if kind == "capsule" else 0), None
+        points = []
+        for _ in range(rng.randint(5, 12)):
+            v = [rng.gauss(0, 1) for _ in range(3)]
+            length = math.sqrt(sum(x * x for x in v))
+            r = size()
+            points.append([r * x / length for x in v])
+        bound = max(math.sqrt(sum(x * x for x in p)) for p in points)
+        return {"type": "convex", "vertices": points}, bound, bound
+
+    dt = rng.choice([1 / 30, 1 / 60, 1 / 120])
+    count = rng.randint(2, 30)
+    half = rng.uniform(1.0, 3.0)
+    scale = rng.choice([0.1, 0.3, 0.6])
+    mu, e = rng.uniform(0, 1), rng.choice([0, 0, 0.3, 0.7, 1.0])
+    entities = [ground(friction=mu, restitution=e)]
+    if rng.random() < 0.6:
+        for name, position, extents in [("wall_n", [0, 1, half], [half, 1, 0.1]), ("wall_s", [0, 1, -half], [half, 1, 0.1]),
+                                        ("wall_e", [half, 1, 0], [0.1, 1, half]), ("wall_w", [-half, 1, 0], [0.1, 1, half])]:
+            entities.append(body(name, {"type": "box", "half_extents": extents}, static=True, position=position,
+                                 friction=mu, restitution=e))
+    placed = []
+    for i in range(count):
+        s, bound, hull = shape(scale)
+        for _ in range(200):
+            inside = half - 0.1 - bound > -half + 0.1 + bound
+            p = [rng.uniform(-half + 0.1 + bound, half - 0.1 - bound) if inside else 0, rng.uniform(bound + 0.01, bound + 3.0),
+                 rng.uniform(-half + 0.1 + bound, half - 0.1 - bound) if inside else 0]
+            if all(math.dist(p, q) > bound + other + 1e-3 for q, other in placed):
+                break
+        else:
+            continue
+        placed.append((p, bound))
+        mass = math.exp(rng.uniform(math.log(0.05), math.log(50)))
+        extra = {"orientation": quaternion(),
+                 "velocity": [rng.uniform(-1, 1) * rng.choice([0, 1, 5, 15]) for _ in range(3)],
+                 "angular_velocity": [rng.uniform(-1, 1) * rng.choice([0, 1, 10]) for _ in range(3)]}
+        if hull:  # a hull has no built-in inertia: that of a solid ball of its bounding radius
+            extra["inertia"] = [0.4 * mass * hull * hull] * 3
+        restitution = rng.choice([e, rng.uniform(0, 1)])
+        friction = rng.choice([mu, rng.uniform(0, 1)])
+        entities.append(body("b%d" % i, s, mass=mass, position=p, friction=friction, restitution=restitution, **extra))
+    write(directory, "random_drop_%d" % seed, "random drop %d: bodies of random shape, size, mass and speed" % seed,
+          dt, 3.0, entities)
+
+
+# Random drops kept as scene files: each once broke an energy rule (test_rigid_contact, RandomDrops).
+RANDOM_DROPS = (39, 186, 204)
+
+
 def main(argv):
     directory = argv[1] if len(argv) > 1 and not argv[1].startswith("--") else os.path.dirname(os.path.abspath(__file__))
     if "--pour" in argv:
         for n in argv[argv.index("--pour") + 1:]:
             pour_spheres(directory, int(n))
+        return
+    if "--random" in argv:
+        for seed in argv[argv.index("--random") + 1:]:
+            random_drop(directory, int(seed))
         return
     pyramid(directory, 10)
     pyramid(directory, 20)
@@ -178,6 +256,8 @@ def main(argv):
     box_stack_scatter(directory)
     pour_spheres(directory, 250)
     mixed_pile(directory)
+    for seed in RANDOM_DROPS:
+        random_drop(directory, seed)
 
 
 if __name__ == "__main__":

@@ -406,6 +406,23 @@ TEST(MixedPile, ExactManifoldSolvesSettleItWithoutEnergyGain) {
   watch.expectNoGain(std::abs(watch.initialTotal));
 }
 
+TEST(RandomDrops, KeepTheEnergyRules) {
+  // Bodies of random shape, size (needles and slabs too), mass, spin and speed thrown over a
+  // plane (generate_contact_scenes.py --random SEED; 3 s each). Each of these seeds broke an
+  // energy rule until 2026-11-27:
+  //  - 39 gained 2.8 % of its total energy: contact (Step III) and push-out turned a spinning
+  //    needle, and the post-collision momentum Step V starts from had more energy in the new
+  //    orientation than in the old (now the energy fix runs again for it);
+  //  - 186 and 204 gained 46 % and 0.6 % of their kinetic energy in Step V: its shock
+  //    propagation clamped impulses against a frozen body in that body's frame, and the body
+  //    moved (now in the world or the scene's kinematic frame).
+  const Registry registry = builtins();
+  for (int seed : {39, 186, 204}) {
+    SCOPED_TRACE("random_drop_" + std::to_string(seed));
+    deepestOverlapWithoutEnergyGain(loadScene(kScenes + "random_drop_" + std::to_string(seed) + ".json"), registry);
+  }
+}
+
 TEST(PushOutNewOverlaps, APushIntoAnUntouchedNeighbourIsUndoneInTheSameStep) {
   // No gravity, no motion. Sphere C is sunk 5 cm into the static box A; box D sits 1.08 cm above
   // C's shoulder, inside C's bounding box (so the pair is in the broad phase) but not touching,
@@ -538,9 +555,8 @@ TEST(PushOutNewOverlaps, SliverShardsNoLongerSinkThroughEachOther) {
 
 // 24 shards 1 x 0.04 x 0.5 (mass 0.5, e = 0.5, mu = 0.6) dropped from 1 to 14.8 m with random
 // orientations and spins up to 8 rad/s onto a plane, dt = 1/30, 6 s: sliver_shards' layout
-// with another random stream per seed. Returns the deepest overlap over all steps.
-double randomSliverDrop(unsigned seed, bool newOverlaps, const Registry& registry,
-                        const std::string& roundOverlap = "0.02") {
+// with another random stream per seed.
+SceneSpec randomSliverScene(unsigned seed, bool newOverlaps, const std::string& roundOverlap = "0.02") {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(-1, 1), half(0, 1);
   std::ostringstream text;
@@ -560,11 +576,15 @@ double randomSliverDrop(unsigned seed, bool newOverlaps, const Registry& registr
          << 8 * unit(rng) << ", " << 8 * unit(rng) << R"(]}, "collider": {"restitution": 0.5, "friction": 0.6}})";
   }
   text << "]}";
-  return deepestOverlapWithoutEnergyGain(
-      parseScene(text.str(), "random_slivers.json",
-                 {{"solvers.contact.push_out_new_overlaps", newOverlaps ? "true" : "false"},
-                  {"solvers.contact.push_out_round_overlap", roundOverlap}}),
-      registry);
+  return parseScene(text.str(), "random_slivers.json",
+                    {{"solvers.contact.push_out_new_overlaps", newOverlaps ? "true" : "false"},
+                     {"solvers.contact.push_out_round_overlap", roundOverlap}});
+}
+
+// The deepest overlap over all steps of a random sliver drop, which must keep the energy rules.
+double randomSliverDrop(unsigned seed, bool newOverlaps, const Registry& registry,
+                        const std::string& roundOverlap = "0.02") {
+  return deepestOverlapWithoutEnergyGain(randomSliverScene(seed, newOverlaps, roundOverlap), registry);
 }
 
 TEST(RandomSliverDrops, MostKeepTheirOverlapsShallow) {
@@ -615,26 +635,44 @@ TEST(PushOutRounds, APushPastTheBroadPhaseBoxIsUndoneInTheSameStepIn2D) {
   EXPECT_GT(fourD, 1.97 + 0.02);
 }
 
-TEST(PushOutRounds, JamsTheLevelPassesLeaveAreReducedByFurtherRounds) {
-  // The drops of the generator above whose deepest overlap exceeds 5 % of a shard's thickness
-  // when only missed pairs start another round (seeds 1-60, push_out_round_overlap = 1e9): shards
-  // jammed across each other, which the six level passes of one round do not undo. Rounds on
-  // the pairs still over 2 % (the default) reduce them; a round that would leave anything it
-  // touched deeper is undone, so none gets worse. Measured: 5.7/5.7, 21.2/16.9, 63.7/23.8,
-  // 7.4/2.1, 6.2/6.2, 10.1/8.0 % (docs/benchmarks.md, "Push-out in rounds").
+TEST(PushOutRounds, TheFirstStepThatNeedsFurtherRoundsEndsShallowerWithThem) {
+  // Random sliver drops with and without rounds for residual overlaps (push_out_round_overlap
+  // 0.02, the default, against 1e9). Until a step needs a second round the two runs are the
+  // same bitwise; at that step the rounds, kept or undone, must leave the deepest overlap no
+  // deeper than one round does, and over the drops they must cut it. (Whole runs cannot be
+  // compared: from that step on the piles differ, and any difference moves a chaotic pile's
+  // later overlaps by factors either way -- docs/benchmarks.md, "Push-out in rounds".)
+  // Seeds: the first ten of 1-240 whose runs without rounds exceed 5 % (measured 2026-11-27).
   const Registry registry = builtins();
-  double sumOff = 0, sumOn = 0, worstOff = 0, worstOn = 0;
-  for (unsigned seed : {13u, 20u, 28u, 32u, 53u, 60u}) {
-    const double off = randomSliverDrop(seed, true, registry, "1e9"), on = randomSliverDrop(seed, true, registry);
-    EXPECT_LE(on, off + 1e-3) << "seed " << seed;
-    sumOff += off;
-    sumOn += on;
-    worstOff = std::max(worstOff, off);
-    worstOn = std::max(worstOn, on);
+  int compared = 0, shallower = 0;
+  double sumOn = 0, sumOff = 0;
+  for (unsigned seed : {7u, 13u, 60u, 83u, 88u, 90u, 111u, 113u, 118u, 126u}) {
+    Simulation<3> on(randomSliverScene(seed, true), registry), off(randomSliverScene(seed, true, "1e9"), registry);
+    while (!on.finished()) {
+      const auto& a = on.step();
+      const auto& b = off.step();
+      // The first step where the runs part: the one where a residual overlap took a round.
+      const bool same = a.at("total_energy") == b.at("total_energy") &&
+                        a.at("max_penetration_ratio") == b.at("max_penetration_ratio") &&
+                        a.at("push_out_rounds") == b.at("push_out_rounds") &&
+                        a.at("push_out_rounds_undone") == b.at("push_out_rounds_undone");
+      if (same) continue;
+      EXPECT_GT(a.at("push_out_rounds") + a.at("push_out_rounds_undone"), 1) << "seed " << seed;
+      EXPECT_LE(a.at("max_penetration_ratio"), b.at("max_penetration_ratio") + 1e-12) << "seed " << seed;
+      ++compared;
+      shallower += a.at("max_penetration_ratio") < b.at("max_penetration_ratio") ? 1 : 0;
+      sumOn += a.at("max_penetration_ratio");
+      sumOff += b.at("max_penetration_ratio");
+      std::printf("seed %u, step %ld: deepest overlap %.2f %% with rounds, %.2f %% without\n", seed, on.stepsDone(),
+                  100 * a.at("max_penetration_ratio"), 100 * b.at("max_penetration_ratio"));
+      break;
+    }
   }
-  EXPECT_GT(worstOff, 0.3);
-  EXPECT_LT(worstOn, 0.5 * worstOff);
-  EXPECT_LT(sumOn, 0.7 * sumOff);
+  // Measured: 10 compared, 9 shallower, the sum of the ten 0.72 of that without rounds (two
+  // jams cut from 12.3 % and 9.4 % to 3.4 % and 0.6 %; most residual rounds shave a little).
+  EXPECT_GE(compared, 8);
+  EXPECT_GE(shallower, compared / 2);
+  EXPECT_LT(sumOn, 0.85 * sumOff);
 }
 
 TEST(BroadPhaseGrowth, ABallThatBouncesIntoABallItWasNeverPairedWithDoesNotSinkIntoIt) {

@@ -1,0 +1,81 @@
+#!/usr/bin/env python3
+"""Runs random drops (generate_contact_scenes.py --random SEED) and flags the ones that break a
+rule of issue 3: the total energy rising more than 0.1 % above its value after the first step,
+collision impulses or the second contact step adding kinetic energy (1e-12 relative), a
+deepest overlap over 5 % of the smaller body's size, a non-zero exit, a NaN.
+
+    /usr/bin/python3 tests/support/random_drop_campaign.py FIRST LAST [--monolith build/monolith]
+        [--threads 2] [--work /tmp/random_drops]
+
+One line per seed: its wall time and OK, or what it broke. Plain Python, no modules needed.
+"""
+import argparse
+import csv
+import math
+import os
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "scenarios", "scenes"))
+import generate_contact_scenes  # noqa: E402
+
+
+def check(seed, monolith, threads, work):
+    generate_contact_scenes.random_drop(work, seed)
+    scene = os.path.join(work, "random_drop_%d.json" % seed)
+    out = os.path.join(work, "out_%d" % seed)
+    start = time.time()
+    try:
+        run = subprocess.run([monolith, "run", scene, "--threads", str(threads), "--no-frames", "--out", out, "--quiet"],
+                             capture_output=True, text=True, timeout=600)
+    except subprocess.TimeoutExpired:
+        return ["no result in 600 s"], time.time() - start
+    seconds = time.time() - start
+    flags = []
+    if run.returncode != 0:
+        flags.append("exit %d: %s" % (run.returncode, (run.stderr or run.stdout).strip()[-300:]))
+    try:
+        with open(os.path.join(out, "metrics.csv")) as f:
+            rows = list(csv.DictReader(f))
+    except OSError:
+        return flags + ["no metrics.csv"], seconds
+    if not rows:
+        return flags + ["no steps"], seconds
+    if any(not math.isfinite(float(v)) for row in rows for k, v in row.items() if k != "step"):
+        flags.append("NaN or inf in metrics.csv")
+        return flags, seconds
+    first = float(rows[0]["total_energy"])
+    rise = max(float(r["total_energy"]) for r in rows) - first
+    if rise > 1e-3 * abs(first):
+        flags.append("total energy rose %.3g %%" % (100 * rise / abs(first)))
+    for name in ("collision_energy_change", "velocity_contact_energy_change"):
+        gain = max(float(r[name]) for r in rows)
+        if gain > 1e-12:
+            flags.append("%s %.3g" % (name, gain))
+    overlap = max(float(r["max_penetration_ratio"]) for r in rows)
+    if overlap > 0.05:
+        flags.append("deepest overlap %.1f %%" % (100 * overlap))
+    return flags, seconds
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("first", type=int)
+    parser.add_argument("last", type=int)
+    parser.add_argument("--monolith", default=os.path.join(HERE, "..", "..", "build", "monolith"))
+    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--work", default="/tmp/random_drops")
+    args = parser.parse_args()
+    os.makedirs(args.work, exist_ok=True)
+    broken = 0
+    for seed in range(args.first, args.last + 1):
+        flags, seconds = check(seed, args.monolith, args.threads, args.work)
+        broken += 1 if flags else 0
+        print("%d %.1fs %s" % (seed, seconds, "OK" if not flags else " | ".join(flags)), flush=True)
+    print("%d of %d seeds flagged" % (broken, args.last - args.first + 1))
+
+
+if __name__ == "__main__":
+    main()
