@@ -8,7 +8,8 @@
 
 namespace monolith {
 
-solvers::BodyInertia rotationInertiaOf(const RigidBody<3>& b) {
+namespace {
+solvers::BodyInertia bodyInertia(const RigidBody<3>& b) {
   solvers::BodyInertia I;
   I.I0 = b.inertiaBody;
   I.I0inv = b.inertiaBodyInverse;
@@ -16,6 +17,7 @@ solvers::BodyInertia rotationInertiaOf(const RigidBody<3>& b) {
   I.principalAxes = b.principalAxes;
   return I;
 }
+}  // namespace
 
 template <int d>
 void AdvanceRigidPositions<d>::run(World<d>& world, StepContext& ctx) {
@@ -32,7 +34,7 @@ void AdvanceRigidPositions<d>::run(World<d>& world, StepContext& ctx) {
     if constexpr (d == 2) {
       body->orientation += dt * body->omega()(0);
     } else {
-      const solvers::BodyInertia inertia = rotationInertiaOf(*body);
+      const solvers::BodyInertia inertia = bodyInertia(*body);
       const double energyBefore = solvers::rotationalKineticEnergy(inertia, body->orientation, body->L);
       body->orientation = solvers::advanceOrientation(static_cast<solvers::RotationOrder>(rule.order), dt, inertia,
                                                       body->orientation, body->L);

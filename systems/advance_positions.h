@@ -10,12 +10,8 @@
 #include "components/forces.h"
 #include "components/rigid_body.h"
 #include "ecs/system.h"
-#include "solvers/rigid_rotation.h"
 
 namespace monolith {
-
-// A 3-D body's inertia as the rotation solvers take it (body frame, principal axes).
-solvers::BodyInertia rotationInertiaOf(const RigidBody<3>& b);
 
 template <int d>
 class AdvanceRigidPositions final : public System<d> {
