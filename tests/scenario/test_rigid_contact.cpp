@@ -357,6 +357,13 @@ TEST(ContactDeterminism, ABoxDroppedOnARestingPyramidGivesTheSameStateOnOneAndTw
   expectSameStateOnOneAndTwoThreads(parseScene(scene, "pyramid_10_dropped.json", overrides));
 }
 
+TEST(ContactDeterminism, RandomDropsGiveTheSameStateOnOneAndTwoThreads) {
+  // Needles, slabs, hulls and fast throws: swept collisions, push-out rounds and the
+  // rotational-energy clamp on the way.
+  expectSameStateOnOneAndTwoThreads("random_drop_186.json", "3", {});
+  expectSameStateOnOneAndTwoThreads("random_drop_39.json", "3", {});
+}
+
 TEST(ContactDeterminism, ExactManifoldSolvesGiveTheSameStateOnOneAndTwoThreads) {
   expectSameStateOnOneAndTwoThreads("mixed_pile.json", "1.5", {{"solvers.contact.exact_manifold_finish", "true"}});
 }
