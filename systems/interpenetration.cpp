@@ -23,6 +23,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <array>
 #include <utility>
 
@@ -252,7 +253,12 @@ int ResolveInterpenetration<d>::pushApart(ContactWorkspace<d>& ws, const solvers
           out.isStatic = O.infinite();
           out.r = deepest->point - C.x0;
           out.q = deepest->point - O.x0;
-          out.mass = O.mass;
+          // A body of infinite mass here (static, kinematic or frozen below) weighs as the unit
+          // K_hat_s the original code gives every static contact (notes 1.7), whatever its
+          // real mass: weighted by its real mass, a heavy frozen neighbour that the central body
+          // barely touched outweighed the ground and a wall it was sunk into, and the statics'
+          // fit (B.3.2) left it there (26-103 % of a body's size in random drops).
+          out.mass = O.infinite() ? std::numeric_limits<double>::infinity() : O.mass;
           out.inertia = O.inertia0;
           // d_o: from the point on c's surface to the point on o's surface (App. B.1).
           out.displacement = -task.fraction * deepest->depth * deepest->normal;

@@ -423,10 +423,17 @@ TEST(RandomDrops, KeepTheEnergyRules) {
   //  - 186 and 204 gained 46 % and 0.6 % of their kinetic energy in Step V: its shock
   //    propagation clamped impulses against a frozen body in that body's frame, and the body
   //    moved (now in the world or the scene's kinematic frame).
+  //  - 108 gained 1.1 % in Step V the same way.
+  // 108 and 186 also sank 41 % of a body's size into the ground and a wall: a light body wedged
+  // there also touched a heavy frozen one, which push-out weighted by its real mass, so the
+  // statics' fit kept the light body where it was (now every body of infinite mass in push-out
+  // weighs as the original code's unit static; measured 0.9 % and 1.8 %, single chaotic runs).
   const Registry registry = builtins();
-  for (int seed : {39, 186, 204}) {
+  for (int seed : {39, 108, 186, 204}) {
     SCOPED_TRACE("random_drop_" + std::to_string(seed));
-    deepestOverlapWithoutEnergyGain(loadScene(kScenes + "random_drop_" + std::to_string(seed) + ".json"), registry);
+    const double deepest =
+        deepestOverlapWithoutEnergyGain(loadScene(kScenes + "random_drop_" + std::to_string(seed) + ".json"), registry);
+    if (seed == 108 || seed == 186) EXPECT_LT(deepest, 0.05);
   }
 }
 
