@@ -1,5 +1,6 @@
 #include "scenarios/contact_components.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -102,6 +103,25 @@ void centrePolygon(const Config& c, Shape<2>& shape) {
     for (int i = n - 1; i >= 0; --i) v.insert(v.end(), {shape.vertices[2 * i], shape.vertices[2 * i + 1]});
     shape.vertices = v;
   }
+  // Convex, in order around it: every turn to the left (collinear points allowed) and one turn
+  // around in all. The narrow phase works on the points' convex hull and the inertia on the
+  // polygon as listed, so a concave or crossed list would give a body whose inertia is not its
+  // shape's (a crossed one even a negative inertia, which made collisions add energy).
+  double turning = 0, size = 0;
+  for (int i = 0; i < n; ++i) size = std::max(size, shape.vertex(i).norm());
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector2d e0 = shape.vertex(i) - shape.vertex((i + n - 1) % n);
+    const Eigen::Vector2d e1 = shape.vertex((i + 1) % n) - shape.vertex(i);
+    const double cross = e0.x() * e1.y() - e0.y() * e1.x();
+    // The input's index of this vertex (the list was reversed if clockwise).
+    const int given = area < 0 ? n - 1 - i : i;
+    if (cross < -1e-12 * size * size)
+      c.failAt("vertices", "a convex polygon's vertices in order around it",
+               "an inward turn at vertices[" + std::to_string(given) + "]");
+    turning += std::atan2(cross, e0.dot(e1));
+  }
+  if (turning > 2 * M_PI + 1e-6)
+    c.failAt("vertices", "a convex polygon's vertices in order around it", "a list that winds around more than once");
 }
 
 }  // namespace

@@ -289,6 +289,12 @@ std::vector<Case> cases() {
       {"level_set_missing_file",
        scene2(R"({ "name": "o", "level_set": { "file": "no_such_level_set.json" } })"),
        "entities[0].level_set.file", {"a readable level-set JSON file", "no_such_level_set.json", "cannot be opened"}},
+      {"polygon_concave",  // an arrowhead: the collision shape would be its hull, the inertia not
+       scene2(R"({ "name": "p", "shape": { "type": "polygon", "vertices": [[0, 0], [2, -1], [1, 0], [2, 1]] } })"),
+       "entities[0].shape.vertices", {"a convex polygon's vertices in order around it", "inward turn at vertices[2]"}},
+      {"polygon_crossed",  // a pentagram: every turn to the left, twice around
+       scene2(R"({ "name": "p", "shape": { "type": "polygon", "vertices": [[1, 0], [-0.809, 0.588], [0.309, -0.951], [0.309, 0.951], [-0.809, -0.588]] } })"),
+       "entities[0].shape.vertices", {"a convex polygon's vertices in order around it", "winds around more than once"}},
       {"level_set_degenerate_polygon",
        scene2(R"({ "name": "o", "level_set": { "polygon": [[0, 0], [1, 1], [2, 2]], "spacing": 0.1 } })"),
        "entities[0].level_set.polygon", {"a closed outline of non-zero area"}},
