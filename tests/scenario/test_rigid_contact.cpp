@@ -433,7 +433,9 @@ TEST(RandomDrops, KeepTheEnergyRules) {
     SCOPED_TRACE("random_drop_" + std::to_string(seed));
     const double deepest =
         deepestOverlapWithoutEnergyGain(loadScene(kScenes + "random_drop_" + std::to_string(seed) + ".json"), registry);
-    if (seed == 108 || seed == 186) EXPECT_LT(deepest, 0.05);
+    if (seed == 108 || seed == 186) {
+      EXPECT_LT(deepest, 0.05);
+    }
   }
 }
 
