@@ -209,12 +209,17 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       directions[i] = p.tangentImpulse.squaredNorm() > 0 ? Tangent(p.tangentImpulse.normalized()) : Tangent::UnitX();
   }
   // A's inertia (the inverse of the inverse inertia the points were prepared with), for the
-  // energy test and, when only A moves, for W^{-1}.
-  AngMat<d> inertiaA;
-  bool inertiaReady = false;
+  // energy test and, when only A moves, for W^{-1}; B's for the energy test. Each inverted once
+  // per finish, on first use.
+  AngMat<d> inertiaA, inertiaB;
+  bool inertiaReady = false, inertiaBReady = false;
   auto inertiaOfA = [&]() -> const AngMat<d>& {
     if (!inertiaReady) inertiaA = s.inverseInertiaA.inverse(), inertiaReady = true;
     return inertiaA;
+  };
+  auto inertiaOfB = [&]() -> const AngMat<d>& {
+    if (!inertiaBReady) inertiaB = s.inverseInertiaB.inverse(), inertiaBReady = true;
+    return inertiaB;
   };
   // W = W_A + S^T W_B S: the effective inverse mass of the relative twist for a wrench about x_a
   // (S: a wrench about x_a to one about x_b; C: F -> (x_a - x_b) x F). Built on first use.
@@ -284,7 +289,7 @@ bool polishManifold(std::vector<Point>& points, const Bodies& s, Vec<d>& va, Ang
       after += va1.squaredNorm() / s.inverseMassA + wa1.dot(inertia * wa1);
     }
     if constexpr (movesB) {
-      const AngMat<d> inertia = s.inverseInertiaB.inverse();
+      const AngMat<d>& inertia = inertiaOfB();
       before += s.vb.squaredNorm() / s.inverseMassB + s.wb.dot(inertia * s.wb);
       after += vb1.squaredNorm() / s.inverseMassB + wb1.dot(inertia * wb1);
     }
