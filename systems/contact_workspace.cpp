@@ -72,15 +72,15 @@ bool mayTouch(const ContactBody<d>& a, const ContactBody<d>& b, double margin) {
 // at most the smaller body's width, so l_a <= r_a + min(r_a, r_b) + margin. A settled pile's
 // time-n velocities are ~1e-13 m/s: its collision sweep then needs no manifolds.
 template <int d>
-bool mayApproach(const ContactBody<d>& a, const ContactBody<d>& b, const con::AngVec<d>& wa,
-                 const con::AngVec<d>& wb, double margin, double tolerance) {
+bool mayApproach(const ContactBody<d>& a, const ContactBody<d>& b, const con::AngMat<d>& splitA,
+                 const con::AngMat<d>& splitB, double margin, double tolerance) {
   const double ra = a.geometry->boundingRadius(), rb = b.geometry->boundingRadius();
   const double shorter = std::min(ra, rb);
-  auto spin = [&](const con::AngVec<d>& omega, double r) {
-    const double w = omega.norm();
+  auto spin = [&](const con::AngMat<d>& split, const con::AngVec<d>& L, double r) {
+    const double w = (split * L).norm();
     return w == 0 ? 0.0 : w * (r + shorter + margin);  // an unturning plane adds nothing (0 * inf)
   };
-  const double bound = (a.v - b.v).norm() + spin(wa, ra) + spin(wb, rb);
+  const double bound = (a.v - b.v).norm() + spin(splitA, a.L, ra) + spin(splitB, b.L, rb);
   // Half the tolerance: the bound and the points' v_n round differently.
   return !(bound <= 0.5 * tolerance);
 }
@@ -509,9 +509,7 @@ typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
     }
   }
   if (!swept && !mayTouch<d>(A, B, margin)) return {};
-  // The split-state angular velocities, for the approach bound and the points below.
-  const con::AngVec<d> wa = splitA * A.L, wb = splitB * B.L;
-  if (collision && !swept && !mayApproach<d>(A, B, wa, wb, margin, settings.approachTolerance)) {
+  if (collision && !swept && !mayApproach<d>(A, B, splitA, splitB, margin, settings.approachTolerance)) {
     // No point of the pair can approach: no impulse whatever the manifold. Only whether the
     // pair touches is kept (the processed list, notes 1.4): the same answer without the points.
     if (col::touches(*A.geometry, poseA, *B.geometry, poseB, query.margin)) pair.processed = true;
@@ -531,8 +529,8 @@ typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
   con::PgsBodies<d> state;
   state.va = A.v;
   state.vb = B.v;
-  state.wa = wa;
-  state.wb = wb;
+  state.wa = splitA * A.L;
+  state.wb = splitB * B.L;
   state.inverseMassA = A.inverseMass();
   state.inverseMassB = B.inverseMass();
   state.movesA = finiteA;  // bodies of infinite mass take no impulse

@@ -307,6 +307,15 @@ int ResolveInterpenetration<d>::pushApart(ContactWorkspace<d>& ws, const solvers
 //   large turns where the momentum is tiny (a body at rest in a pile), which made new overlaps
 //   in `mixed_pile` (1.9 % of a body); the scaling moves nothing.
 // Bodies that neither contact nor push-out turned differently are already fixed and skipped.
+// Whether the body's rotational energy depends on its orientation: not for a round inertia
+// (a cube's, a sphere's), which the clamp can skip.
+template <int d>
+bool turningChangesEnergy(const ContactBody<d>& b) {
+  if (b.isStatic || b.kinematic || b.turnFree) return false;
+  const auto& I = b.body->inertiaBodyInverse;
+  return !(I.isDiagonal(0) && I(0, 0) == I(1, 1) && I(1, 1) == I(2, 2));
+}
+
 template <int d>
 void ResolveInterpenetration<d>::rememberRotationalEnergy(const ContactWorkspace<d>& ws) {
   // Before push-out re-bases the bodies: inverseInertia0 is still the time-n one (Step II's
@@ -315,7 +324,7 @@ void ResolveInterpenetration<d>::rememberRotationalEnergy(const ContactWorkspace
   advanced_.resize(ws.bodies.size());
   for (std::size_t i = 0; i < ws.bodies.size(); ++i) {
     const ContactBody<d>& b = ws.bodies[i];
-    if (b.isStatic || b.kinematic || b.turnFree) continue;
+    if (!turningChangesEnergy(b)) continue;
     const auto kept = b.LCollided + b.dL;
     energyAtTimeN_[i] = 0.5 * kept.dot(b.inverseInertia0 * kept);
     advanced_[i] = {b.body->L, b.body->orientation};
@@ -331,7 +340,7 @@ int ResolveInterpenetration<d>::clampEnergyOfRestoredMomentum(ContactWorkspace<d
     int clamped = 0;
     for (std::size_t i = 0; i < ws.bodies.size(); ++i) {
       ContactBody<d>& b = ws.bodies[i];
-      if (b.isStatic || b.kinematic || b.turnFree) continue;
+      if (!turningChangesEnergy(b)) continue;
       if (b.L == advanced_[i].L && b.q0.coeffs() == advanced_[i].q.coeffs()) continue;
       // inverseInertia0 is push-out's last base pose: the final orientation.
       const double energy = 0.5 * b.L.dot(b.inverseInertia0 * b.L);
