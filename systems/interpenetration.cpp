@@ -22,9 +22,9 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
-#include <array>
 #include <utility>
 
 #include "solvers/contact/push_out.h"
@@ -289,6 +289,20 @@ int ResolveInterpenetration<d>::pushApart(ContactWorkspace<d>& ws, const solvers
   return total;
 }
 
+// Whether a body's rotational energy depends on its orientation: only in 3-D, and not for a
+// round inertia (a cube's, a sphere's).
+template <int d>
+bool turningChangesEnergy(const ContactBody<d>& b) {
+  if constexpr (d == 3) {
+    if (b.isStatic || b.kinematic || b.turnFree) return false;
+    const auto& I = b.body->inertiaBodyInverse;
+    return !(I.isDiagonal(0) && I(0, 0) == I(1, 1) && I(1, 1) == I(2, 2));
+  } else {
+    (void)b;
+    return false;
+  }
+}
+
 // A clamp on the rotational energy of the momentum a body keeps (3-D; not in the thesis).
 // Step IV turns each body with the momentum contact left it (Step III), and its energy fix
 // (Sec. 2.2) keeps that momentum's energy; push-out then turns bodies further. The step ends by
@@ -306,16 +320,8 @@ int ResolveInterpenetration<d>::pushApart(ContactWorkspace<d>& ws, const solvers
 // - Turning the body instead, as the energy fix of Sec. 2.2 does, keeps the momentum but needs
 //   large turns where the momentum is tiny (a body at rest in a pile), which made new overlaps
 //   in `mixed_pile` (1.9 % of a body); the scaling moves nothing.
-// Bodies that neither contact nor push-out turned differently are already fixed and skipped.
-// Whether the body's rotational energy depends on its orientation: not for a round inertia
-// (a cube's, a sphere's), which the clamp can skip.
-template <int d>
-bool turningChangesEnergy(const ContactBody<d>& b) {
-  if (b.isStatic || b.kinematic || b.turnFree) return false;
-  const auto& I = b.body->inertiaBodyInverse;
-  return !(I.isDiagonal(0) && I(0, 0) == I(1, 1) && I(1, 1) == I(2, 2));
-}
-
+// Bodies that neither contact nor push-out turned differently are already fixed and skipped,
+// and so are bodies whose rotational energy does not depend on their orientation.
 template <int d>
 void ResolveInterpenetration<d>::rememberRotationalEnergy(const ContactWorkspace<d>& ws) {
   // Before push-out re-bases the bodies: inverseInertia0 is still the time-n one (Step II's
