@@ -214,14 +214,13 @@ bool ContactWorkspace<d>::pack(World<d>& world, double stepDt, bool subtractKick
     }
   };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, entities_.size(), 256), packRange);
-  // The frame for clamps against frozen bodies: that of the scene's one translating kinematic
-  // body (the frame readEnergy reports), else the world.
-  frozenFrame_.setZero();
-  const ContactBody<d>* kinematic = nullptr;
+  // The scene's kinematic frame (readEnergy, clampFrameVelocity): only a translating kinematic
+  // body gives a frame without rotation (a scripted spin is in its L), and only one is a frame.
+  kinematicFrameBody_ = -1;
   int kinematicCount = 0;
-  for (const ContactBody<d>& b : bodies)
-    if (b.kinematic) kinematic = &b, ++kinematicCount;
-  if (kinematicCount == 1 && kinematic->omega().squaredNorm() == 0) frozenFrame_ = kinematic->v;
+  for (std::size_t i = 0; i < bodies.size(); ++i)
+    if (bodies[i].kinematic) kinematicFrameBody_ = static_cast<int>(i), ++kinematicCount;
+  if (kinematicCount != 1 || bodies[kinematicFrameBody_].omega().squaredNorm() != 0) kinematicFrameBody_ = -1;
   return !bodies.empty();
 }
 
@@ -236,8 +235,8 @@ typename ContactWorkspace<d>::VecD ContactWorkspace<d>::clampFrameVelocity(const
   // kinetic energy in Step V that way), so it is measured in the world, or the kinematic
   // frame of the scene, as the stage's energy is checked.
   if (partner.kinematic) return partner.pointVelocity(r);
-  if (partner.isStatic) return VecD::Zero();
-  return frozenFrame_;
+  if (partner.isStatic || kinematicFrameBody_ < 0) return VecD::Zero();
+  return bodies[kinematicFrameBody_].v;
 }
 
 template <int d>
@@ -256,18 +255,13 @@ void ContactWorkspace<d>::unpack(bool positions) {
 template <int d>
 typename ContactWorkspace<d>::EnergyReading ContactWorkspace<d>::readEnergy() const {
   EnergyReading r;
-  const ContactBody<d>* kinematic = nullptr;
-  int kinematicCount = 0;
-  for (const auto& b : bodies) {
-    r.world += b.kineticEnergy();
-    if (b.kinematic) kinematic = &b, ++kinematicCount;
-  }
-  // Only a translating kinematic body gives a frame without rotation (a scripted spin is in its L).
-  r.hasKinematicFrame = kinematicCount == 1 && kinematic->omega().squaredNorm() == 0;
-  if (r.hasKinematicFrame)
+  for (const auto& b : bodies) r.world += b.kineticEnergy();
+  r.hasKinematicFrame = kinematicFrameBody_ >= 0;
+  if (r.hasKinematicFrame) {
+    const VecD frame = bodies[kinematicFrameBody_].v;
     for (const auto& b : bodies)
-      if (!b.infinite())
-        r.kinematicFrame += 0.5 * b.mass * (b.v - kinematic->v).squaredNorm() + 0.5 * b.L.dot(b.omega());
+      if (!b.infinite()) r.kinematicFrame += 0.5 * b.mass * (b.v - frame).squaredNorm() + 0.5 * b.L.dot(b.omega());
+  }
   return r;
 }
 

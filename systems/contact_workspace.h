@@ -305,7 +305,7 @@ class ContactWorkspace {
   std::vector<CollisionProbe> probes_;
   std::vector<IslandSchedule> schedules_;  // per island (islands are recorded and run at once)
   std::vector<int> memberIndex_;           // per body: its position in its island's members
-  VecD frozenFrame_ = VecD::Zero();        // clampFrameVelocity's frame for frozen bodies (pack)
+  int kinematicFrameBody_ = -1;            // the scene's one translating kinematic body, or -1 (pack)
 
   void ensureGeometry(World<d>& world);
   std::vector<Entity> entities_;
