@@ -114,7 +114,8 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   // many do.
   int markNewOverlaps(const ContactWorkspace<d>& ws);
   // The levels push-out runs by (pairLevel_ per pair): the contact graph's, or with new overlaps
-  // those of its copy with an edge both ways per new overlap.
+  // those of its copy with an edge both ways per new overlap (newOverlap_, which a later round
+  // also sets for the pairs it ties, tie_).
   const solvers::contact::ContactLevels& pushLevels(const ContactWorkspace<d>& ws, int newOverlaps);
   // One round of push-out over the islands marked in active_; returns the central-body solves.
   // focused: only the pairs with a body in focus_ (the rounds after the first).
@@ -127,11 +128,12 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   std::vector<SavedPose> savedPoses_;  // a later round's bodies before it, to undo it
   std::vector<char> active_;      // per island: pushed apart in this round
   std::vector<char> focus_;       // per body: worked on in the next round
+  std::vector<char> tie_;         // per pair of two dynamic bodies: one level in the next round
   std::vector<std::pair<int, int>> knownPairs_;  // the pairs before a round's growth
   std::vector<double> knownDepth_, knownRatio_;  // and their measurements
   std::vector<int> knownIndex_;                  // per pair after the growth: its index before, or -1
   std::vector<char> moved_;       // per body: in an island push-out worked on
-  std::vector<char> newOverlap_;  // per pair: not processed in Step II, yet overlapping now
+  std::vector<char> newOverlap_;  // per pair: not processed in Step II, yet overlapping now (or tied)
   std::vector<int> pairLevel_;    // per pair: its level in push-out
   std::vector<std::pair<int, int>> edges_;
   solvers::contact::ContactLevels pushLevels_;

@@ -362,6 +362,7 @@ TEST(ContactDeterminism, RandomDropsGiveTheSameStateOnOneAndTwoThreads) {
   // rotational-energy clamp on the way.
   expectSameStateOnOneAndTwoThreads("random_drop_186.json", "3", {});
   expectSameStateOnOneAndTwoThreads("random_drop_39.json", "3", {});
+  expectSameStateOnOneAndTwoThreads("random_drop_142.json", "3", {});  // push-out's tied levels
 }
 
 TEST(ContactDeterminism, ExactManifoldSolvesGiveTheSameStateOnOneAndTwoThreads) {
@@ -419,23 +420,30 @@ TEST(RandomDrops, KeepTheEnergyRules) {
   // energy rule until 2026-11-27:
   //  - 39 gained 2.8 % of its total energy: contact (Step III) and push-out turned a spinning
   //    needle, and the post-collision momentum Step V starts from had more energy in the new
-  //    orientation than in the old (now the energy fix runs again for it);
+  //    orientation than in the old (now that momentum is scaled back to its time-n energy where
+  //    it gained more than 5 %);
   //  - 186 and 204 gained 46 % and 0.6 % of their kinetic energy in Step V: its shock
   //    propagation clamped impulses against a frozen body in that body's frame, and the body
   //    moved (now in the world or the scene's kinematic frame).
   //  - 108 gained 1.1 % in Step V the same way.
-  // 108 and 186 also sank 41 % of a body's size into the ground and a wall: a light body wedged
-  // there also touched a heavy frozen one, which push-out weighted by its real mass, so the
-  // statics' fit kept the light body where it was (now every body of infinite mass in push-out
-  // weighs as the original code's unit static; measured 0.9 % and 1.8 %, single chaotic runs).
+  // The others sank deep, in push-out:
+  //  - 108 and 186 41 % of a body's size into the ground and a wall: a light body wedged there
+  //    also touched a heavy frozen one, which push-out weighted by its real mass, so the statics'
+  //    fit kept the light body where it was (now every body of infinite mass in push-out weighs
+  //    as the original code's unit static);
+  //  - 37, 142 and 204 35 %, 44 % and 23 %: a slab sunk at both ends into the ground (or the
+  //    ground and a wall) was turned out at its deepest point and in at the other end, solve
+  //    after solve; in 142 a light box was also wedged between a wall and a heavy ball frozen
+  //    on a level below. Now the rounds after the first take every overlapping point of a
+  //    static and put the two bodies of each pair they work on on one level.
+  // Deepest overlaps now (single chaotic runs): 37 0.6 %, 39 0.07 %, 108 0.3 %, 142 1.0 %,
+  // 186 2.0 %, 204 1.8 %.
   const Registry registry = builtins();
-  for (int seed : {39, 108, 186, 204}) {
+  for (int seed : {37, 39, 108, 142, 186, 204}) {
     SCOPED_TRACE("random_drop_" + std::to_string(seed));
     const double deepest =
         deepestOverlapWithoutEnergyGain(loadScene(kScenes + "random_drop_" + std::to_string(seed) + ".json"), registry);
-    if (seed == 108 || seed == 186) {
-      EXPECT_LT(deepest, 0.05);
-    }
+    EXPECT_LT(deepest, 0.05);
   }
 }
 
