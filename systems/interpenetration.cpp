@@ -61,10 +61,13 @@ void setBasePose(ContactBody<d>& b, const Eigen::Matrix<double, d, 1>& x, const 
 // a small body lying at the wall's foot that pokes further into the wall sideways than it sticks
 // up out of the ground is pushed down by the wall and up by the ground, and no push satisfies
 // both (random drops 40, 222, 412: a needle and small hulls 50-67 % of their size deep). Where
-// two such directions oppose (cosine below -1/2), the box among them that the body leaves most
-// cheaply through a face that pushes against no other static direction
-// (escapeThroughBoxFace) contributes that push instead of its points, until no two oppose or no
-// box can give way. The outers of each body of infinite mass are consecutive in `outers`.
+// the directions of two static bodies oppose (cosine below -1/2), the static box among them
+// that the body leaves most cheaply through a face within 120 degrees of every direction
+// opposing it (escapeThroughBoxFace) contributes that push instead of its points; until no two
+// oppose or no box can give way. Frozen bodies are left out (they are statics only for now):
+// counting them, and avoiding every other static's direction rather than the opposing ones',
+// sent bodies through a wall's far face, over a metre. The outers of each body of infinite mass
+// are consecutive in `outers`.
 template <int d>
 void escapeOpposedStatics(const std::vector<ContactBody<d>>& bodies, const ContactBody<d>& central, double fraction,
                           double tolerance, std::vector<con::PushOutOuter<d>>& outers, std::vector<int>& outerIndex) {
@@ -95,7 +98,7 @@ void escapeOpposedStatics(const std::vector<ContactBody<d>>& bodies, const Conta
         if (avoid.empty()) continue;
         col::ContactPoint<3> escape;
         if (!col::escapeThroughBoxFace(*O.geometry, O.candidate, *central.geometry, central.candidate, avoid, escape)) continue;
-        if (escape.depth <= tolerance || escape.depth > 2 * central.geometry->boundingRadius()) continue;
+        if (escape.depth <= tolerance) continue;
         if (chosen < 0 || escape.depth < best.depth) chosen = static_cast<int>(i), best = escape;
       }
       if (chosen < 0) return;
