@@ -2,6 +2,7 @@
 """Writes the generated rigid-contact scenes of issue 3 (plain Python, no modules needed).
 
     python3 scenarios/scenes/generate_contact_scenes.py [output_dir] [--pour N ...] [--random SEED ...]
+        [--random-2d SEED ...]
 
 pyramid_10/20: boxes of edge 1 in layers of n, n-1, ..., 1 with horizontal spacing 1.02, mu 0.5,
 resting on a plane, one step per frame (dt = 1/30); pyramid_2d_10 the same in 2-D.
@@ -9,6 +10,7 @@ sliver_shards: thin boxes dropped with spin at frame rate (the energy-clamp comp
 box_stack_scatter: Fig. 2.2, boxes dropped into a stack, then a large box scatters it. pour_spheres_N: N spheres poured into a box.
 mixed_pile: boxes, spheres, capsules, cylinders and convex octahedra dropped into a walled box.
 random_drop_SEED: random bodies thrown over a plane (see random_drop); RANDOM_DROPS are kept.
+random_drop_2d_SEED: the same in 2-D (--random-2d SEED ...; see random_drop_2d); RANDOM_DROPS_2D are kept.
 """
 import json
 import math
@@ -235,8 +237,87 @@ def random_drop(directory, seed):
           dt, 3.0, entities)
 
 
+def convex_hull_2d(points):
+    """The convex hull of 2-D points, counter-clockwise, without collinear points (monotone chain)."""
+    points = sorted(set(map(tuple, points)))
+    if len(points) < 3:
+        return points
+
+    def half(sequence):
+        chain = []
+        for p in sequence:
+            while len(chain) >= 2 and ((chain[-1][0] - chain[-2][0]) * (p[1] - chain[-2][1]) -
+                                       (chain[-1][1] - chain[-2][1]) * (p[0] - chain[-2][0])) <= 0:
+                chain.pop()
+            chain.append(p)
+        return chain
+
+    lower, upper = half(points), half(reversed(points))
+    return [list(p) for p in lower[:-1] + upper[:-1]]
+
+
+def random_drop_2d(directory, seed):
+    """random_drop_2d_SEED: the 2-D kind of random_drop: up to 30 boxes, disks and convex polygons
+    (sizes from 5 % to 100 % of a scale), masses 0.05-50, thrown over a line, often between two
+    walls standing on it, at dt 1/30, 1/60 or 1/120 for 3 s."""
+    rng = random.Random(seed)
+
+    def shape(scale):
+        kind = rng.choice(["box", "box", "disk", "polygon"])
+        size = lambda: scale * math.exp(rng.uniform(math.log(0.05), math.log(1.0)))
+        if kind == "box":
+            h = [size(), size()]
+            return {"type": "box", "half_extents": h}, math.hypot(*h)
+        if kind == "disk":
+            r = size()
+            return {"type": "disk", "radius": r}, r
+        while True:
+            points = []
+            for _ in range(rng.randint(3, 9)):
+                angle, r = rng.uniform(0, 2 * math.pi), size()
+                points.append([r * math.cos(angle), r * math.sin(angle)])
+            hull = convex_hull_2d(points)
+            area = 0.5 * sum(hull[i][0] * hull[i - 1][1] - hull[i - 1][0] * hull[i][1] for i in range(len(hull)))
+            if len(hull) >= 3 and abs(area) > (0.05 * scale) ** 2:
+                break
+        return {"type": "polygon", "vertices": hull}, max(math.hypot(*p) for p in hull)
+
+    dt = rng.choice([1 / 30, 1 / 60, 1 / 120])
+    count = rng.randint(2, 30)
+    half = rng.uniform(1.0, 3.0)
+    scale = rng.choice([0.1, 0.3, 0.6])
+    mu, e = rng.uniform(0, 1), rng.choice([0, 0, 0.3, 0.7, 1.0])
+    entities = [body("ground", {"type": "plane", "normal": [0, 1]}, static=True, position=(0, 0), friction=mu,
+                     restitution=e)]
+    if rng.random() < 0.6:
+        for name, x in (("wall_e", half), ("wall_w", -half)):
+            entities.append(body(name, {"type": "box", "half_extents": [0.1, 1]}, static=True, position=[x, 1],
+                                 friction=mu, restitution=e))
+    placed = []
+    for i in range(count):
+        s, bound = shape(scale)
+        for _ in range(200):
+            inside = half - 0.1 - bound > -half + 0.1 + bound
+            p = [rng.uniform(-half + 0.1 + bound, half - 0.1 - bound) if inside else 0, rng.uniform(bound + 0.01, bound + 3.0)]
+            if all(math.dist(p, q) > bound + other + 1e-3 for q, other in placed):
+                break
+        else:
+            continue
+        placed.append((p, bound))
+        mass = math.exp(rng.uniform(math.log(0.05), math.log(50)))
+        extra = {"angle": rng.uniform(0, 2 * math.pi),
+                 "velocity": [rng.uniform(-1, 1) * rng.choice([0, 1, 5, 15]) for _ in range(2)],
+                 "angular_velocity": rng.uniform(-1, 1) * rng.choice([0, 1, 10])}
+        restitution = rng.choice([e, rng.uniform(0, 1)])
+        friction = rng.choice([mu, rng.uniform(0, 1)])
+        entities.append(body("b%d" % i, s, mass=mass, position=p, friction=friction, restitution=restitution, **extra))
+    write(directory, "random_drop_2d_%d" % seed, "2-D random drop %d: bodies of random shape, size, mass and speed" % seed,
+          dt, 3.0, entities, dimension=2)
+
+
 # Random drops kept as scene files: each once broke an energy rule or sank deep (test_rigid_contact, RandomDrops).
 RANDOM_DROPS = (37, 39, 40, 108, 142, 186, 204, 412, 1316)
+RANDOM_DROPS_2D = (45, 216)
 
 
 def main(argv):
@@ -249,6 +330,10 @@ def main(argv):
         for seed in argv[argv.index("--random") + 1:]:
             random_drop(directory, int(seed))
         return
+    if "--random-2d" in argv:
+        for seed in argv[argv.index("--random-2d") + 1:]:
+            random_drop_2d(directory, int(seed))
+        return
     pyramid(directory, 10)
     pyramid(directory, 20)
     pyramid_2d(directory, 10)
@@ -258,6 +343,8 @@ def main(argv):
     mixed_pile(directory)
     for seed in RANDOM_DROPS:
         random_drop(directory, seed)
+    for seed in RANDOM_DROPS_2D:
+        random_drop_2d(directory, seed)
 
 
 if __name__ == "__main__":

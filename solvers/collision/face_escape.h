@@ -10,14 +10,17 @@
 
 namespace monolith::solvers::collision {
 
-// Among the six faces of `box` (a box geometry, posed) whose outward normal n has n.u >= -1/2
-// for every u in `avoid` (unit directions the body must not be pushed against), the one through
-// which `body` (posed, bounded) leaves with the least push along n: the push is how far the
-// body must move along n to lie wholly on the outer side of the face's plane. Reports it as
-// findContacts(box, body) would (normal out of the body towards the box: -n; depth: the push;
-// the point midway between the body's deepest point past the face and the face's plane).
-// False when no face qualifies or the body already lies outside one that does (depth <= 0).
-bool escapeThroughBoxFace(const PreparedGeometry<3>& box, const Pose<3>& boxPose, const PreparedGeometry<3>& body,
-                          const Pose<3>& bodyPose, const std::vector<Eigen::Vector3d>& avoid, ContactPoint<3>& out);
+// Among the faces of `box` (a box geometry, posed; 6 in 3-D, 4 in 2-D) whose outward normal n
+// has n.u >= -1/2 for every u in `avoid` (unit directions the body must not be pushed against),
+// the one through which `body` (posed, bounded) leaves with the least push along n: the push is
+// how far the body must move along n to lie wholly on the outer side of the face's plane.
+// Reports it as findContacts(box, body) would (normal out of the body towards the box: -n;
+// depth: the push; the point midway between the body's deepest point past the face and the
+// face's plane). False when no face qualifies or the body already lies outside one that does
+// (depth <= 0). Throws std::invalid_argument if `box` is not a box.
+template <int d>
+bool escapeThroughBoxFace(const PreparedGeometry<d>& box, const Pose<d>& boxPose, const PreparedGeometry<d>& body,
+                          const Pose<d>& bodyPose, const std::vector<Eigen::Matrix<double, d, 1>>& avoid,
+                          ContactPoint<d>& out);
 
 }  // namespace monolith::solvers::collision

@@ -61,7 +61,8 @@ struct EnergyWatch {
 
 // Runs a scene to its end under the energy watch; returns the deepest overlap of a contact pair
 // after push-out over the smaller body's size, over all steps.
-double runToEndWatching(Simulation<3>& sim, EnergyWatch& watch) {
+template <int d>
+double runToEndWatching(Simulation<d>& sim, EnergyWatch& watch) {
   double worst = 0;
   while (!sim.finished()) {
     const auto& diag = sim.step();
@@ -72,8 +73,9 @@ double runToEndWatching(Simulation<3>& sim, EnergyWatch& watch) {
 }
 
 // Runs a scene to its end, expecting no energy gain; returns its deepest overlap (as above).
+template <int d = 3>
 double deepestOverlapWithoutEnergyGain(const SceneSpec& scene, const Registry& registry) {
-  Simulation<3> sim(scene, registry);
+  Simulation<d> sim(scene, registry);
   EnergyWatch watch;
   const double worst = runToEndWatching(sim, watch);
   watch.expectNoGain(std::abs(watch.initialTotal));
@@ -447,6 +449,22 @@ TEST(RandomDrops, KeepTheEnergyRules) {
     SCOPED_TRACE("random_drop_" + std::to_string(seed));
     const double deepest =
         deepestOverlapWithoutEnergyGain(loadScene(kScenes + "random_drop_" + std::to_string(seed) + ".json"), registry);
+    EXPECT_LT(deepest, 0.05);
+  }
+}
+
+TEST(RandomDrops, KeepTheEnergyRulesIn2D) {
+  // The 2-D kind (generate_contact_scenes.py --random-2d SEED: boxes, disks and convex polygons
+  // between two walls standing on a line). On be12a88 these sank 116 % and 107 % of a body's
+  // size: 45 a thin body jammed under others, 216 a 93 g body at a wall's foot, pushed down by
+  // the wall's bottom face and up by the ground (57.6 % still with the later rounds' ties and
+  // static points alone; the face escape, escapeThroughBoxFace, takes it out). Measured now:
+  // 2.1 % and 1.5 % (single chaotic runs).
+  const Registry registry = builtins();
+  for (int seed : {45, 216}) {
+    SCOPED_TRACE("random_drop_2d_" + std::to_string(seed));
+    const double deepest = deepestOverlapWithoutEnergyGain<2>(
+        loadScene(kScenes + "random_drop_2d_" + std::to_string(seed) + ".json"), registry);
     EXPECT_LT(deepest, 0.05);
   }
 }

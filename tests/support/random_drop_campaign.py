@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
-"""Runs random drops (generate_contact_scenes.py --random SEED) and flags the ones that break a
-rule of issue 3: the total energy rising more than 0.1 % above its value after the first step,
-collision impulses or the second contact step adding kinetic energy (1e-12 relative), a
-deepest overlap over 5 % of the smaller body's size, a non-zero exit, a NaN.
+"""Runs random drops (generate_contact_scenes.py --random SEED, or --random-2d SEED with
+--dimension 2) and flags the ones that break a rule of issue 3: the total energy rising more
+than 0.1 % above its value after the first step, collision impulses or the second contact step
+adding kinetic energy (1e-12 relative), a deepest overlap over 5 % of the smaller body's size,
+a non-zero exit, a NaN.
 
     /usr/bin/python3 tests/support/random_drop_campaign.py FIRST LAST [--monolith build/monolith]
-        [--threads 2] [--work /tmp/random_drops]
+        [--threads 2] [--work /tmp/random_drops] [--dimension 2]
 
 One line per seed: its wall time and OK, or what it broke. Plain Python, no modules needed.
 """
@@ -22,9 +23,13 @@ sys.path.insert(0, os.path.join(HERE, "..", "..", "scenarios", "scenes"))
 import generate_contact_scenes  # noqa: E402
 
 
-def check(seed, monolith, threads, work):
-    generate_contact_scenes.random_drop(work, seed)
-    scene = os.path.join(work, "random_drop_%d.json" % seed)
+def check(seed, monolith, threads, work, dimension=3):
+    if dimension == 2:
+        generate_contact_scenes.random_drop_2d(work, seed)
+        scene = os.path.join(work, "random_drop_2d_%d.json" % seed)
+    else:
+        generate_contact_scenes.random_drop(work, seed)
+        scene = os.path.join(work, "random_drop_%d.json" % seed)
     out = os.path.join(work, "out_%d" % seed)
     start = time.time()
     try:
@@ -67,11 +72,13 @@ def main():
     parser.add_argument("--monolith", default=os.path.join(HERE, "..", "..", "build", "monolith"))
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--work", default="/tmp/random_drops")
+    parser.add_argument("--dimension", type=int, choices=(2, 3), default=3,
+                        help="2: the 2-D drops of generate_contact_scenes.py --random-2d")
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
     broken = 0
     for seed in range(args.first, args.last + 1):
-        flags, seconds = check(seed, args.monolith, args.threads, args.work)
+        flags, seconds = check(seed, args.monolith, args.threads, args.work, args.dimension)
         broken += 1 if flags else 0
         print("%d %.1fs %s" % (seed, seconds, "OK" if not flags else " | ".join(flags)), flush=True)
     print("%d of %d seeds flagged" % (broken, args.last - args.first + 1))
