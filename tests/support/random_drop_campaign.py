@@ -3,15 +3,17 @@
 --dimension 2) and flags the ones that break a rule of issue 3: the total energy rising more
 than 0.1 % above its value after the first step, collision impulses or the second contact step
 adding kinetic energy (1e-12 relative), a deepest overlap over 5 % of the smaller body's size,
-a non-zero exit, a NaN.
+a non-zero exit, a NaN; with --compare-threads N also a final state (summary.json's state_hash)
+that differs on N threads.
 
     /usr/bin/python3 tests/support/random_drop_campaign.py FIRST LAST [--monolith build/monolith]
-        [--threads 2] [--work /tmp/random_drops] [--dimension 2]
+        [--threads 2] [--work /tmp/random_drops] [--dimension 2] [--compare-threads 1]
 
 One line per seed: its wall time and OK, or what it broke. Plain Python, no modules needed.
 """
 import argparse
 import csv
+import json
 import math
 import os
 import subprocess
@@ -23,7 +25,15 @@ sys.path.insert(0, os.path.join(HERE, "..", "..", "scenarios", "scenes"))
 import generate_contact_scenes  # noqa: E402
 
 
-def check(seed, monolith, threads, work, dimension=3):
+def state_hash(out):
+    try:
+        with open(os.path.join(out, "summary.json")) as f:
+            return json.load(f).get("state_hash")
+    except (OSError, ValueError):
+        return None
+
+
+def check(seed, monolith, threads, work, dimension=3, compare_threads=0):
     if dimension == 2:
         generate_contact_scenes.random_drop_2d(work, seed)
         scene = os.path.join(work, "random_drop_2d_%d.json" % seed)
@@ -62,6 +72,14 @@ def check(seed, monolith, threads, work, dimension=3):
     overlap = max(float(r["max_penetration_ratio"]) for r in rows)
     if overlap > 0.05:
         flags.append("deepest overlap %.1f %%" % (100 * overlap))
+    if compare_threads and compare_threads != threads:
+        # The same scene on another thread count must end in bitwise the same state.
+        other = out + "_threads_%d" % compare_threads
+        subprocess.run([monolith, "run", scene, "--threads", str(compare_threads), "--no-frames", "--out", other,
+                        "--quiet"], capture_output=True, text=True, timeout=600)
+        mine, theirs = state_hash(out), state_hash(other)
+        if mine is None or mine != theirs:
+            flags.append("state on %d threads %s, on %d threads %s" % (threads, mine, compare_threads, theirs))
     return flags, seconds
 
 
@@ -74,11 +92,13 @@ def main():
     parser.add_argument("--work", default="/tmp/random_drops")
     parser.add_argument("--dimension", type=int, choices=(2, 3), default=3,
                         help="2: the 2-D drops of generate_contact_scenes.py --random-2d")
+    parser.add_argument("--compare-threads", type=int, default=0, metavar="N",
+                        help="also run each seed on N threads and flag a final state that differs")
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
     broken = 0
     for seed in range(args.first, args.last + 1):
-        flags, seconds = check(seed, args.monolith, args.threads, args.work, args.dimension)
+        flags, seconds = check(seed, args.monolith, args.threads, args.work, args.dimension, args.compare_threads)
         broken += 1 if flags else 0
         print("%d %.1fs %s" % (seed, seconds, "OK" if not flags else " | ".join(flags)), flush=True)
     print("%d of %d seeds flagged" % (broken, args.last - args.first + 1))
