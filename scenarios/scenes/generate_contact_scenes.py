@@ -168,6 +168,21 @@ def mixed_pile(directory):
           "boxes, spheres, capsules, cylinders and octahedra dropped into a walled box", 1 / 60, 4.0, entities)
 
 
+def free_spot(rng, placed, half, bound, dimension):
+    """A random drop's starting point for a body of bounding radius `bound`: inside the walls at
+    +-half (at x = 0, and z = 0 in 3-D, if the body is too wide), 0.01-3 m above its lowest
+    position, clear of the bounding balls already `placed` ((point, radius) pairs); None after
+    200 tries."""
+    for _ in range(200):
+        inside = half - 0.1 - bound > -half + 0.1 + bound
+        p = [rng.uniform(-half + 0.1 + bound, half - 0.1 - bound) if inside else 0, rng.uniform(bound + 0.01, bound + 3.0)]
+        if dimension == 3:
+            p.append(rng.uniform(-half + 0.1 + bound, half - 0.1 - bound) if inside else 0)
+        if all(math.dist(p, q) > bound + other + 1e-3 for q, other in placed):
+            return p
+    return None
+
+
 def random_drop(directory, seed):
     """random_drop_SEED: up to 30 bodies of random shape (boxes, spheres, capsules, cylinders,
     convex hulls), size (half extents from 5 % to 100 % of a scale, so needles and slabs too),
@@ -215,13 +230,8 @@ def random_drop(directory, seed):
     placed = []
     for i in range(count):
         s, bound, hull = shape(scale)
-        for _ in range(200):
-            inside = half - 0.1 - bound > -half + 0.1 + bound
-            p = [rng.uniform(-half + 0.1 + bound, half - 0.1 - bound) if inside else 0, rng.uniform(bound + 0.01, bound + 3.0),
-                 rng.uniform(-half + 0.1 + bound, half - 0.1 - bound) if inside else 0]
-            if all(math.dist(p, q) > bound + other + 1e-3 for q, other in placed):
-                break
-        else:
+        p = free_spot(rng, placed, half, bound, 3)
+        if p is None:
             continue
         placed.append((p, bound))
         mass = math.exp(rng.uniform(math.log(0.05), math.log(50)))
@@ -296,12 +306,8 @@ def random_drop_2d(directory, seed):
     placed = []
     for i in range(count):
         s, bound = shape(scale)
-        for _ in range(200):
-            inside = half - 0.1 - bound > -half + 0.1 + bound
-            p = [rng.uniform(-half + 0.1 + bound, half - 0.1 - bound) if inside else 0, rng.uniform(bound + 0.01, bound + 3.0)]
-            if all(math.dist(p, q) > bound + other + 1e-3 for q, other in placed):
-                break
-        else:
+        p = free_spot(rng, placed, half, bound, 2)
+        if p is None:
             continue
         placed.append((p, bound))
         mass = math.exp(rng.uniform(math.log(0.05), math.log(50)))
