@@ -214,9 +214,16 @@ int ResolveInterpenetration<d>::pushApart(ContactWorkspace<d>& ws, const solvers
     // neighbour that touched nothing before (a pair that does not overlap costs one query).
     auto& list = plan.pairsByLevel;
     list.clear();
+    // A focused round also takes the pairs of a focus body's neighbours with static and kinematic
+    // bodies: a neighbour is pushed as an outer body, and without its own pair with the ground
+    // it was pushed into it (random drop 82: a light body pushed out of a heavy hull drove a disc
+    // under it 27 % of its thickness into the ground, and the round was undone).
+    const auto taken = [&](const ContactPairState& q) {
+      if (!focused || focus_[q.a] || focus_[q.b]) return true;
+      return (partner_[q.a] && ws.bodies[q.b].infinite()) || (partner_[q.b] && ws.bodies[q.a].infinite());
+    };
     for (int p : ws.islands.pairs[island])
-      if ((ws.pairs[p].processed || s.pushOutNewOverlaps) && (!focused || focus_[ws.pairs[p].a] || focus_[ws.pairs[p].b]))
-        list.push_back(p);
+      if ((ws.pairs[p].processed || s.pushOutNewOverlaps) && taken(ws.pairs[p])) list.push_back(p);
     std::stable_sort(list.begin(), list.end(), [&](int x, int y) { return pairLevel_[x] < pairLevel_[y]; });
     // A focused round works on the bodies of the listed pairs only: (level, body), ascending.
     auto& focusByLevel = plan.focusByLevel;
@@ -582,6 +589,12 @@ void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
         tie_[k] = !ws.bodies[p.a].infinite() && !ws.bodies[p.b].infinite();
         const int island = ws.islands.islandOf[ws.bodies[p.a].infinite() ? p.b : p.a];
         if (island >= 0) active_[island] = 1;
+      }
+      // The dynamic neighbours of the focus bodies (pushApart takes their pairs with statics).
+      partner_.assign(ws.bodies.size(), 0);
+      for (const ContactPairState& p : ws.pairs) {
+        if (focus_[p.a] && !ws.bodies[p.a].infinite() && !ws.bodies[p.b].infinite()) partner_[p.b] = 1;
+        if (focus_[p.b] && !ws.bodies[p.b].infinite() && !ws.bodies[p.a].infinite()) partner_[p.a] = 1;
       }
     }
     if (missed + deeper + residual == 0 || !s.pushOut || !s.pushOutNewOverlaps || rounds >= s.pushOutRounds) break;

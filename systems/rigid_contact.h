@@ -128,6 +128,7 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   std::vector<SavedPose> savedPoses_;  // a later round's bodies before it, to undo it
   std::vector<char> active_;      // per island: pushed apart in this round
   std::vector<char> focus_;       // per body: worked on in the next round
+  std::vector<char> partner_;     // per body: a dynamic neighbour of a focus body
   std::vector<char> tie_;         // per pair of two dynamic bodies: one level in the next round
   std::vector<std::pair<int, int>> knownPairs_;  // the pairs before a round's growth
   std::vector<double> knownDepth_, knownRatio_;  // and their measurements
