@@ -72,6 +72,12 @@ template <int d>
 void escapeOpposedStatics(const std::vector<ContactBody<d>>& bodies, const ContactBody<d>& central, double fraction,
                           double tolerance, std::vector<con::PushOutOuter<d>>& outers, std::vector<int>& outerIndex) {
   using VecD = Eigen::Matrix<double, d, 1>;
+  // Nothing to do unless two static bodies touch c (the common case: every solve of a later
+  // round comes here), so that is found first, without allocating.
+  int staticBodies = 0;
+  for (std::size_t k = 0; k < outers.size(); ++k)
+    if (bodies[outerIndex[k]].isStatic && (k == 0 || outerIndex[k - 1] != outerIndex[k])) ++staticBodies;
+  if (staticBodies < 2) return;
   const auto direction = [&](std::size_t k) { return VecD(outers[k].displacement.normalized()); };
   const auto opposed = [&](int a, int b) {
     for (std::size_t i = 0; i < outers.size(); ++i)
