@@ -29,8 +29,8 @@
 #include <limits>
 #include <utility>
 
-#include "solvers/collision/face_escape.h"
 #include "solvers/contact/push_out.h"
+#include "systems/opposed_statics.h"
 #include "systems/rigid_contact.h"
 
 namespace monolith {
@@ -52,77 +52,6 @@ void setBasePose(ContactBody<d>& b, const Eigen::Matrix<double, d, 1>& x, const 
   }
   b.candidate.x = b.x0;
   b.candidate.R = b.R0;
-}
-
-// A later round's guard against two bodies of infinite mass pushing the central body c in
-// opposite directions (not in the thesis). The narrow phase reports each pair's direction
-// of least penetration. For a box standing on another static body -- the usual wall on the
-// ground plane, its bottom face on the plane -- that direction can be the box's bottom face:
-// a small body lying at the wall's foot that pokes further into the wall sideways than it sticks
-// up out of the ground is pushed down by the wall and up by the ground, and no push satisfies
-// both (random drops 40, 222, 412: a needle and small hulls 50-67 % of their size deep). Where
-// the directions of two static bodies oppose (cosine below -1/2), the static box among them
-// that the body leaves most cheaply through a face within 120 degrees of every direction
-// opposing it (escapeThroughBoxFace) contributes that push instead of its points; until no two
-// oppose or no box can give way. Frozen bodies are left out (they are statics only for now):
-// counting them, and avoiding every other static's direction rather than the opposing ones',
-// sent bodies through a wall's far face, over a metre. The outers of each body of infinite mass
-// are consecutive in `outers`.
-template <int d>
-void escapeOpposedStatics(const std::vector<ContactBody<d>>& bodies, const ContactBody<d>& central, double fraction,
-                          double tolerance, std::vector<con::PushOutOuter<d>>& outers, std::vector<int>& outerIndex) {
-  using VecD = Eigen::Matrix<double, d, 1>;
-  // Nothing to do unless two static bodies touch c (the common case: every solve of a later
-  // round comes here), so that is found first, without allocating.
-  int staticBodies = 0;
-  for (std::size_t k = 0; k < outers.size(); ++k)
-    if (bodies[outerIndex[k]].isStatic && (k == 0 || outerIndex[k - 1] != outerIndex[k])) ++staticBodies;
-  if (staticBodies < 2) return;
-  const auto direction = [&](std::size_t k) { return VecD(outers[k].displacement.normalized()); };
-  const auto opposed = [&](int a, int b) {
-    for (std::size_t i = 0; i < outers.size(); ++i)
-      for (std::size_t j = 0; j < outers.size(); ++j)
-        if (outerIndex[i] == a && outerIndex[j] == b && direction(i).dot(direction(j)) < -0.5) return true;
-    return false;
-  };
-  std::vector<int> statics;
-  for (std::size_t k = 0; k < outers.size(); ++k)
-    if (outers[k].isStatic && (statics.empty() || statics.back() != outerIndex[k])) statics.push_back(outerIndex[k]);
-  std::vector<char> replaced(statics.size(), 0);
-  std::vector<VecD> avoid;
-  for (std::size_t pass = 0; pass < statics.size(); ++pass) {
-    int chosen = -1;
-    col::ContactPoint<d> best;
-    for (std::size_t i = 0; i < statics.size(); ++i) {
-      const ContactBody<d>& O = bodies[statics[i]];
-      if (replaced[i] || !O.isStatic || O.geometry->geometry().type != col::GeometryType::Box) continue;
-      avoid.clear();
-      for (std::size_t j = 0; j < statics.size(); ++j) {
-        if (j == i || !bodies[statics[j]].isStatic || !opposed(statics[i], statics[j])) continue;
-        for (std::size_t k = 0; k < outers.size(); ++k)
-          if (outerIndex[k] == statics[j]) avoid.push_back(direction(k));
-      }
-      if (avoid.empty()) continue;
-      col::ContactPoint<d> escape;
-      if (!col::escapeThroughBoxFace<d>(*O.geometry, O.candidate, *central.geometry, central.candidate, avoid, escape)) continue;
-      if (escape.depth <= tolerance) continue;
-      if (chosen < 0 || escape.depth < best.depth) chosen = static_cast<int>(i), best = escape;
-    }
-    if (chosen < 0) return;
-    replaced[chosen] = 1;
-    const int o = statics[chosen];
-    std::size_t first = 0;
-    while (outerIndex[first] != o) ++first;
-    std::size_t last = first;
-    while (last < outers.size() && outerIndex[last] == o) ++last;
-    con::PushOutOuter<d> out = outers[first];
-    out.r = best.point - central.x0;
-    out.q = best.point - bodies[o].x0;
-    out.displacement = -fraction * best.depth * best.normal;
-    outers.erase(outers.begin() + first + 1, outers.begin() + last);
-    outerIndex.erase(outerIndex.begin() + first + 1, outerIndex.begin() + last);
-    outers[first] = out;
-  }
 }
 
 }  // namespace
@@ -385,78 +314,6 @@ int ResolveInterpenetration<d>::pushApart(ContactWorkspace<d>& ws, const solvers
   int total = 0;
   for (int n : pushes) total += n;
   return total;
-}
-
-// Whether a body's rotational energy depends on its orientation: only in 3-D, and not for a
-// round inertia (a cube's, a sphere's).
-template <int d>
-bool turningChangesEnergy(const ContactBody<d>& b) {
-  if constexpr (d == 3) {
-    if (b.isStatic || b.kinematic || b.turnFree) return false;
-    const auto& I = b.body->inertiaBodyInverse;
-    return !(I.isDiagonal(0) && I(0, 0) == I(1, 1) && I(1, 1) == I(2, 2));
-  } else {
-    (void)b;
-    return false;
-  }
-}
-
-// A clamp on the rotational energy of the momentum a body keeps (3-D; not in the thesis).
-// Step IV turns each body with the momentum contact left it (Step III), and its energy fix
-// (Sec. 2.2) keeps that momentum's energy; push-out then turns bodies further. The step ends by
-// restoring the post-collision momentum (notes 1.3, item 9), whose energy in the new
-// orientation can be far above its energy in the old one when the inertia is far from round:
-// in random scenes a spinning needle came out of one step with 3.9 times its rotational
-// energy after a contact impulse, and push-out's turns added energy the same way (2.8 % of
-// the scene's total energy in all). Where the restored momentum has more than 5 % more energy
-// in the new orientation than in the time-n one, it is scaled down to the time-n energy
-// (Sec. 2.3.2's rule: an energy gain is clamped, a loss left).
-// - Below 5 % nothing is done: resting and tumbling bodies gain and lose a little this way
-//   all the time (in `mixed_pile` at most 1.2 %, in sliver drops 99 % of the cases under
-//   1.6 %), and clamping each of those too changed the chaotic piles' overlaps for the worse
-//   in the sliver-drop tests while the energy stayed within the 0.1 % without it.
-// - Turning the body instead, as the energy fix of Sec. 2.2 does, keeps the momentum but needs
-//   large turns where the momentum is tiny (a body at rest in a pile), which made new overlaps
-//   in `mixed_pile` (1.9 % of a body); the scaling moves nothing.
-// Bodies that neither contact nor push-out turned differently are already fixed and skipped,
-// and so are bodies whose rotational energy does not depend on their orientation.
-template <int d>
-void ResolveInterpenetration<d>::rememberRotationalEnergy(const ContactWorkspace<d>& ws) {
-  // Before push-out re-bases the bodies: inverseInertia0 is still the time-n one (Step II's
-  // pack), body->L the momentum Step IV turned the body with, body->orientation where it did.
-  energyAtTimeN_.assign(ws.bodies.size(), 0.0);
-  advanced_.resize(ws.bodies.size());
-  for (std::size_t i = 0; i < ws.bodies.size(); ++i) {
-    const ContactBody<d>& b = ws.bodies[i];
-    if (!turningChangesEnergy(b)) continue;
-    const auto kept = b.LCollided + b.dL;
-    energyAtTimeN_[i] = 0.5 * kept.dot(b.inverseInertia0 * kept);
-    advanced_[i] = {b.body->L, b.body->orientation};
-  }
-}
-
-// The restored momentum's energy gain (relative) that is left alone (see above).
-constexpr double kRotationGainAllowed = 0.05;
-
-template <int d>
-int ResolveInterpenetration<d>::clampEnergyOfRestoredMomentum(ContactWorkspace<d>& ws) {
-  if constexpr (d == 3) {
-    int clamped = 0;
-    for (std::size_t i = 0; i < ws.bodies.size(); ++i) {
-      ContactBody<d>& b = ws.bodies[i];
-      if (!turningChangesEnergy(b)) continue;
-      if (b.L == advanced_[i].L && b.q0.coeffs() == advanced_[i].q.coeffs()) continue;
-      // inverseInertia0 is push-out's last base pose: the final orientation.
-      const double energy = 0.5 * b.L.dot(b.inverseInertia0 * b.L);
-      if (!(energy > energyAtTimeN_[i] * (1 + kRotationGainAllowed))) continue;
-      b.L *= std::sqrt(energyAtTimeN_[i] / energy);
-      ++clamped;
-    }
-    return clamped;
-  } else {
-    (void)ws;
-    return 0;
-  }
 }
 
 template <int d>

@@ -94,7 +94,8 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   };
 
  private:
-  // The rotational-energy clamp on the momentum Step V starts from (3-D; see the .cpp): what
+  // The rotational-energy clamp on the momentum Step V starts from (3-D;
+  // systems/rotational_energy_clamp.cpp): what
   // it needs from before push-out, then the clamp (returns the bodies it scaled).
   void rememberRotationalEnergy(const ContactWorkspace<d>& ws);
   int clampEnergyOfRestoredMomentum(ContactWorkspace<d>& ws);
