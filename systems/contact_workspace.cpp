@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "solvers/collision/grounded_box.h"
 #include "solvers/contact/energy_clamp.h"
 #include "solvers/contact/impulse.h"
 #include "solvers/contact/manifold_pgs.h"
@@ -154,8 +155,28 @@ void ContactWorkspace<d>::ensureGeometry(World<d>& world) {
   if (current == entities_ && !geometries_.empty()) return;
   entities_ = current;
   geometries_.clear();
-  for (Entity e : entities_)
-    geometries_.push_back(std::make_unique<col::PreparedGeometry<d>>(collisionGeometryOf(*world.template get<Shape<d>>(e))));
+  centreShift_.assign(entities_.size(), VecD::Zero());
+  // Static boxes standing on a static half-space reach down through it (grounded_box.h): the
+  // bodies' poses are those of the scene, as statics never move.
+  std::vector<col::HalfSpaceInWorld<d>> grounds;
+  for (Entity e : entities_) {
+    const RigidBody<d>& rb = *world.template get<RigidBody<d>>(e);
+    const Shape<d>& shape = *world.template get<Shape<d>>(e);
+    if (rb.isStatic && shape.type == ShapeType::Plane)
+      grounds.push_back({rotationOf<d>(rb.orientation) * shape.normal, rb.x});
+  }
+  for (std::size_t i = 0; i < entities_.size(); ++i) {
+    const RigidBody<d>& rb = *world.template get<RigidBody<d>>(entities_[i]);
+    col::Geometry<d> g = collisionGeometryOf(*world.template get<Shape<d>>(entities_[i]));
+    if (rb.isStatic && g.type == col::GeometryType::Box && !grounds.empty()) {
+      col::Pose<d> pose;
+      pose.x = rb.x;
+      pose.R = rotationOf<d>(rb.orientation);
+      // A face within the push-out tolerance of the plane stands on it.
+      centreShift_[i] = col::extendBoxThroughGround<d>(g, pose, grounds, world.settings().contact.pushOutTolerance);
+    }
+    geometries_.push_back(std::make_unique<col::PreparedGeometry<d>>(g));
+  }
 }
 
 template <int d>
@@ -189,6 +210,7 @@ bool ContactWorkspace<d>::pack(World<d>& world, double stepDt, bool subtractKick
       b.x0 = rb->x;
       b.q0 = rb->orientation;
       b.R0 = rotationOf<d>(rb->orientation);
+      if (b.isStatic) b.x0 += b.R0 * centreShift_[i];  // the centre of its collision box
       b.inverseInertia0 = rb->worldInverseInertia();
       b.inertia0 = rb->worldInertia();
       b.v = rb->v;

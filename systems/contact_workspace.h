@@ -310,6 +310,9 @@ class ContactWorkspace {
   void ensureGeometry(World<d>& world);
   std::vector<Entity> entities_;
   std::vector<std::unique_ptr<solvers::collision::PreparedGeometry<d>>> geometries_;
+  // Per body: where its collision geometry's centre lies in its body frame (non-zero only for a
+  // static box reaching down through the ground, solvers/collision/grounded_box.h).
+  std::vector<VecD> centreShift_;
   std::unique_ptr<solvers::collision::BroadPhase<d>> broadPhase_;
   std::vector<Eigen::AlignedBox<double, d>> boxes_;
   // Takes `found` (sorted, a superset of `pairs`) as the pair list, keeping the known pairs'

@@ -322,7 +322,10 @@ void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
   if (ws.bodies.empty()) return;
   const bool clampRotation = d == 3 && ws.settings.energyClamp;
   if (clampRotation) rememberRotationalEnergy(ws);
-  for (auto& b : ws.bodies) setBasePose<d>(b, b.body->x, b.body->orientation);
+  // Where Step IV put the moving bodies (a static one keeps pack's pose: its collision
+  // geometry's centre, which for a grounded box is not the body's, grounded_box.h).
+  for (auto& b : ws.bodies)
+    if (!b.isStatic) setBasePose<d>(b, b.body->x, b.body->orientation);
   const ContactSettings& s = ws.settings;
   const auto candidatePoses = [](const ContactBody<d>& b) { return std::array<col::Pose<d>, 1>{b.candidate}; };
 

@@ -12,7 +12,10 @@
 // oppose or no box can give way. Frozen bodies are left out (they are statics only for now):
 // counting them, and avoiding every other static's direction rather than the opposing ones',
 // sent bodies through a wall's far face, over a metre. The outers of each body of infinite mass
-// are consecutive in `outers`.
+// are consecutive in `outers`. A wall standing on a static half-space no longer shows its bottom
+// face (its collision box reaches down through the ground, solvers/collision/grounded_box.h), so
+// this is left for statics that stand on no half-space: a wall hovering over the ground, a box
+// on another static box.
 #include <vector>
 
 #include "solvers/contact/push_out.h"

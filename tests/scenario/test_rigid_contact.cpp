@@ -682,19 +682,23 @@ TEST(PushOutRounds, APushPastTheBroadPhaseBoxIsUndoneInTheSameStepIn2D) {
 }
 
 TEST(PushOutRounds, ANeedleAtAWallsFootLeavesThroughTheWallsInnerFace) {
-  // No gravity, no motion. A wall box stands on the ground plane (its bottom face on it); a
-  // needle 1 cm thick lies at its foot, 1 mm into the ground and 5 cm into the wall. The wall's
-  // least-penetration direction is its bottom face (9 mm down, into the ground), the ground's is
-  // up: the first round, the thesis's, cannot satisfy both and leaves the needle deep. A later
-  // round takes the wall's inner face instead (escapeThroughBoxFace): 5 cm out along +z.
+  // No gravity, no motion. A wall box 2 m tall, 20 cm thick; a needle 1 cm thick lies at its
+  // foot, 1 mm into the ground and 5 cm into the wall.
+  // - Wall hovering 1 mm above the ground: its least-penetration direction is its bottom face
+  //   (8 mm down, into the ground), the ground's is up. The first round, the thesis's, cannot
+  //   satisfy both and leaves the needle deep; a later round takes the wall's inner face instead
+  //   (escapeThroughBoxFace): 5 cm out along +z.
+  // - Wall standing on the ground: its box reaches down through the plane (grounded_box.h), so
+  //   its bottom face is no way out, and already the first round pushes the needle out of the
+  //   inner face.
   const Registry registry = builtins();
-  auto run = [&](int rounds) {
+  auto run = [&](double wallBottom, int rounds) {
     const std::string text = R"({"dimension": 3, "time": {"dt": 0.016666666666666666, "end": 0.016666666666666666},
       "gravity": [0, 0, 0], "entities": [
       {"name": "ground", "shape": {"type": "plane", "normal": [0, 1, 0]}, "rigid_body": {"static": true},
        "collider": {"restitution": 0, "friction": 0.5}},
       {"name": "wall", "shape": {"type": "box", "half_extents": [1, 1, 0.1]},
-       "rigid_body": {"static": true, "position": [0, 1, -0.1]}, "collider": {"restitution": 0, "friction": 0.5}},
+       "rigid_body": {"static": true, "position": [0, )" + std::to_string(1 + wallBottom) + R"(, -0.1]}, "collider": {"restitution": 0, "friction": 0.5}},
       {"name": "needle", "shape": {"type": "box", "half_extents": [0.005, 0.005, 0.1]},
        "rigid_body": {"mass": 1, "position": [0, 0.004, 0.05]}, "collider": {"restitution": 0, "friction": 0.5}}]})";
     Simulation<3> sim(parseScene(text, "wall_foot.json", {{"solvers.contact.push_out_rounds", std::to_string(rounds)}}),
@@ -702,12 +706,18 @@ TEST(PushOutRounds, ANeedleAtAWallsFootLeavesThroughTheWallsInnerFace) {
     const auto diag = sim.step();
     return std::make_pair(diag.at("max_penetration_ratio"), positionOf(sim, "needle"));
   };
-  const auto [oneRatio, oneX] = run(1);
-  const auto [fourRatio, fourX] = run(4);
-  EXPECT_GT(oneRatio, 0.5);  // measured 0.83 with one round (and with four, before the escape)
-  EXPECT_LT(fourRatio, 0.01);
-  EXPECT_NEAR(fourX.z(), 0.05 + 0.05, 2e-3);  // out of the wall's inner face, z = 0
-  EXPECT_NEAR(fourX.y(), 0.005, 2e-3);        // resting on the ground, not pushed into it
+  const auto [hoverOne, hoverOneX] = run(0.001, 1);
+  const auto [hoverFour, hoverFourX] = run(0.001, 4);
+  EXPECT_GT(hoverOne, 0.5);  // measured 0.82 (0.83 on the ground before grounded_box.h)
+  EXPECT_LT(hoverFour, 0.01);
+  EXPECT_NEAR(hoverFourX.z(), 0.05 + 0.05, 2e-3);  // out of the wall's inner face, z = 0
+  EXPECT_NEAR(hoverFourX.y(), 0.005, 2e-3);        // resting on the ground, not pushed into it
+  for (int rounds : {1, 4}) {
+    const auto [ratio, x] = run(0, rounds);
+    EXPECT_LT(ratio, 0.01) << rounds << " rounds";
+    EXPECT_NEAR(x.z(), 0.05 + 0.05, 2e-3) << rounds << " rounds";
+    EXPECT_NEAR(x.y(), 0.005, 2e-3) << rounds << " rounds";
+  }
 }
 
 TEST(PushOutRounds, TheFirstStepThatNeedsFurtherRoundsEndsShallowerWithThem) {
