@@ -1,7 +1,7 @@
 #pragma once
 // Collision geometries of the narrow-phase and swept-contact unit tests, by their sizes: boxes by
 // half extents, spheres and disks by radius, capsules and cylinders by radius and half height
-// (axis z), half-spaces by normal and offset.
+// (axis z), half-spaces by normal and offset; and 3-D poses.
 #include <Eigen/Core>
 
 #include "solvers/collision/geometry.h"
@@ -50,5 +50,13 @@ inline solvers::collision::Geometry<2> box2(double hx, double hy) {
   return g;
 }
 inline solvers::collision::Geometry<2> disk(double r) { return ball<2>(r); }
+
+// A 3-D pose: the body frame's origin at x, turned by R.
+inline solvers::collision::Pose<3> at(const Eigen::Vector3d& x, const Eigen::Matrix3d& R = Eigen::Matrix3d::Identity()) {
+  solvers::collision::Pose<3> p;
+  p.x = x;
+  p.R = R;
+  return p;
+}
 
 }  // namespace monolith::test

@@ -21,13 +21,6 @@ using Vec3 = Eigen::Vector3d;
 
 constexpr double kTight = 1e-12;
 
-Pose<3> at(const Vec3& x, const Eigen::Matrix3d& R = Eigen::Matrix3d::Identity()) {
-  Pose<3> p;
-  p.x = x;
-  p.R = R;
-  return p;
-}
-
 // A wall 2 m high and 0.2 m thick standing on the ground plane y = 0 (its inner face at z = 0),
 // and a needle 1 cm thick lying along z at its foot, 1 mm into the ground and 5 cm into the wall.
 struct WallFoot {

@@ -21,13 +21,6 @@ using Vec2 = Eigen::Vector2d;
 
 constexpr double kTight = 1e-12;
 
-Pose<3> at(const Vec3& x, const Eigen::Matrix3d& R = Eigen::Matrix3d::Identity()) {
-  Pose<3> p;
-  p.x = x;
-  p.R = R;
-  return p;
-}
-
 // The box's extent [low, high] along a world direction n, centred at pose.x + pose.R * shift.
 std::pair<double, double> extentAlong(const Geometry<3>& box, const Pose<3>& pose, const Vec3& shift, const Vec3& n) {
   const double c = n.dot(pose.x + pose.R * shift);

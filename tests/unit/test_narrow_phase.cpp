@@ -27,7 +27,7 @@
 namespace {
 
 using namespace monolith::solvers::collision;
-using namespace monolith::test;  // box3, sphere3, capsule3, cylinder3, halfSpace, box2, disk
+using namespace monolith::test;  // box3, sphere3, capsule3, cylinder3, halfSpace, box2, disk, at
 using Vec3 = Eigen::Vector3d;
 using Vec2 = Eigen::Vector2d;
 using Mat3 = Eigen::Matrix3d;
@@ -53,12 +53,6 @@ Geometry<3> groundMesh() {
   g.vertices = {Vec3(-5, 0, -5), Vec3(5, 0, -5), Vec3(5, 0, 5), Vec3(-5, 0, 5)};
   g.triangles = {{0, 2, 1}, {0, 3, 2}};
   return g;
-}
-Pose<3> at(const Vec3& x, const Mat3& R = Mat3::Identity()) {
-  Pose<3> p;
-  p.x = x;
-  p.R = R;
-  return p;
 }
 Pose<2> at2(const Vec2& x, double angle = 0) {
   Pose<2> p;
