@@ -726,7 +726,7 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
 }
 
 template <int d>
-void ContactWorkspace<d>::startOrder(solvers::parallel::OrderedTasks& order, int island) const {
+void ContactWorkspace<d>::startOrder(solvers::parallel::OrderedTasks& order, int island, std::size_t taskBound) const {
   const int members = static_cast<int>(islands.members[island].size());
   // Blocks of 4 updates: measured on 2 threads (docs/benchmarks.md) against 1, 2, 8 and 16, it
   // keeps pyramid_20's speed-up and stops the cheap sphere-pair checks of a pour from costing
@@ -735,8 +735,14 @@ void ContactWorkspace<d>::startOrder(solvers::parallel::OrderedTasks& order, int
   // short-schedule pyramid_20 step took 17 % less time with 2 than with 4 (16: 19 % more),
   // while at the defaults and in the 250-sphere pour 2 cost 2-5 % more (docs/benchmarks.md,
   // "Exact finish before the first sweep"). One thread (or one body): no dependencies needed.
+  // Nor when the sequence cannot have the blocks OrderedTasks::run needs to share it (a small
+  // island): recording the dependencies of tasks that will run in order anyway cost the
+  // falling 250-sphere pour a fifth of its step on 2 threads (docs/benchmarks.md, "Pours on two
+  // threads").
   const int grain = settings.exactManifoldFinish ? 2 : 4;
-  order.reset(members, grain, members > 1 && tbb::this_task_arena::max_concurrency() > 1);
+  const bool shareable = taskBound >= static_cast<std::size_t>(solvers::parallel::OrderedTasks::kMinimumBlocks) *
+                                          static_cast<std::size_t>(grain);
+  order.reset(members, grain, members > 1 && shareable && tbb::this_task_arena::max_concurrency() > 1);
 }
 
 template <int d>
@@ -760,6 +766,7 @@ void ContactWorkspace<d>::addOrdered(solvers::parallel::OrderedTasks& order, con
 
 template <int d>
 typename ContactWorkspace<d>::IslandSchedule& ContactWorkspace<d>::startSchedule(int island, ImpulseMode mode,
+                                                                                  std::size_t taskBound,
                                                                                   double* clampEnergyChange,
                                                                                   int* clampsApplied) {
   IslandSchedule& s = schedules_[island];
@@ -770,7 +777,7 @@ typename ContactWorkspace<d>::IslandSchedule& ContactWorkspace<d>::startSchedule
   s.impulses.clear();
   s.clamps.clear();
   s.energyChange.clear();
-  startOrder(s.order, island);
+  startOrder(s.order, island, taskBound);
   s.collisionSweepRecorded = false;
   s.tasks.clear();
   s.jointPairs.clear();
@@ -914,7 +921,7 @@ int ContactWorkspace<d>::collisionSweep(int island, int sweep, double* clampEner
   }
   if (sweep == 0 && lastCollisionImpulses == 0 && list.size() >= 64 && tbb::this_task_arena::max_concurrency() > 1)
     return speculativeCollisionSweep(island, clampEnergyChange, clampsApplied);
-  IslandSchedule& s = startSchedule(island, ImpulseMode::Collision, clampEnergyChange, clampsApplied);
+  IslandSchedule& s = startSchedule(island, ImpulseMode::Collision, list.size(), clampEnergyChange, clampsApplied);
   s.collisionSweepRecorded = s.order.tracking();  // later sweeps of the step reuse the tasks
   return runCollisionTasks(s, island, sweep, 0);
 }
@@ -948,16 +955,17 @@ int ContactWorkspace<d>::speculativeCollisionSweep(int island, double* clampEner
   }
   if (k == n) return 0;
   // 3. The rest as the ordered sweep runs them (recorded afresh; later sweeps record their own).
-  IslandSchedule& s = startSchedule(island, ImpulseMode::Collision, clampEnergyChange, clampsApplied);
+  IslandSchedule& s = startSchedule(island, ImpulseMode::Collision, n - k, clampEnergyChange, clampsApplied);
   return runCollisionTasks(s, island, 0, k);
 }
 
 template <int d>
 int ContactWorkspace<d>::contactSweeps(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange,
                                        int* clampsApplied) {
-  IslandSchedule& s = startSchedule(island, mode, clampEnergyChange, clampsApplied);
   const auto& list = islandPairsByLevel[island];
   const int iterations = settings.contactIterations, levelIterations = settings.contactLevelIterations;
+  IslandSchedule& s = startSchedule(island, mode, list.size() * iterations * levelIterations, clampEnergyChange,
+                                    clampsApplied);
   for (int it = 0; it < iterations; ++it) {
     for (std::size_t begin = 0; begin < list.size();) {
       std::size_t end = begin;
@@ -987,8 +995,11 @@ int ContactWorkspace<d>::contactSweeps(int island, ImpulseMode mode, bool onlyCo
 template <int d>
 int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange,
                                         int* clampsApplied) {
-  IslandSchedule& s = startSchedule(island, mode, clampEnergyChange, clampsApplied);
   const auto& list = islandPairsByLevel[island];
+  // At most one task per pair and level iteration, and one freeze per body.
+  IslandSchedule& s = startSchedule(island, mode,
+                                    list.size() * settings.shockLevelIterations + islands.members[island].size(),
+                                    clampEnergyChange, clampsApplied);
   // Per level, what each of its pairs does in every level iteration (the level's pairs and which
   // bodies are frozen do not change during them): a joint solve of the upper body against its
   // partners of infinite mass, at the first of its pairs with such a partner; nothing, for the

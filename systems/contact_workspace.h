@@ -222,7 +222,9 @@ class ContactWorkspace {
   // `order` for the island; `addOrdered` appends a task touching the given bodies, declaring
   // those of finite mass as written, those frozen (per island member, `frozen`) as read, and
   // static and kinematic ones, which contact never changes, not at all.
-  void startOrder(solvers::parallel::OrderedTasks& order, int island) const;
+  // `taskBound`: at most how many tasks will be added (dependencies are recorded only if that
+  // many could be shared).
+  void startOrder(solvers::parallel::OrderedTasks& order, int island, std::size_t taskBound) const;
   void addOrdered(solvers::parallel::OrderedTasks& order, const std::vector<char>& frozen, const int* touched,
                   int count) const;
   int memberIndex(int body) const { return memberIndex_[body]; }
@@ -277,7 +279,8 @@ class ContactWorkspace {
     bool collisionSweepRecorded = false;
     std::vector<solvers::collision::ContactPoint<d>> scratch;  // narrow phase, when run in order
   };
-  IslandSchedule& startSchedule(int island, ImpulseMode mode, double* clampEnergyChange, int* clampsApplied);
+  IslandSchedule& startSchedule(int island, ImpulseMode mode, std::size_t taskBound, double* clampEnergyChange,
+                                int* clampsApplied);
   // Whether body i has infinite mass at the point of the sequence being recorded.
   bool infiniteIn(const IslandSchedule& s, int body) const;
   // Appends a task touching the given bodies (see addOrdered); on one thread it runs at once.

@@ -139,7 +139,8 @@ int ResolveInterpenetration<d>::pushApart(ContactWorkspace<d>& ws, const solvers
     auto& range = plan.range;
     tasks.clear();
     centralPairs.clear();
-    ws.startOrder(order, island);
+    // At most one task per body and level iteration, and one freeze per body.
+    ws.startOrder(order, island, ws.islands.members[island].size() * (s.pushOutLevelIterations + 1));
     const auto& members = ws.islands.members[island];
     auto& frozen = plan.frozen;
     frozen.assign(members.size(), 0);
