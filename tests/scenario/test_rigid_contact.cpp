@@ -442,10 +442,13 @@ TEST(RandomDrops, KeepTheEnergyRules) {
   //    and a 1 cm box at the foot of a wall, pushed down by the wall's bottom face and up by the
   //    ground (the box slid through the wall's foot at ground level). Now a later round lets
   //    such a wall push through another face (escapeThroughBoxFace).
-  // Deepest overlaps now (single chaotic runs): 37 0.6 %, 39 0.07 %, 40 0.09 %, 108 0.3 %,
-  // 142 1.0 %, 186 2.0 %, 204 1.8 %, 412 0.24 %, 1316 0.09 %.
+  //  - 1840 13.9 % (with walls reaching through the ground, grounded_box.h): a light box pressed
+  //    into the ground by a heavy capsule lying on it, pushed up into the capsule by a later
+  //    round, which was undone. Now a later round ties a focus body's overlapping dynamic pairs.
+  // Deepest overlaps now (single chaotic runs): 37 0.05 %, 39 0.07 %, 40 0.09 %, 108 1.2 %,
+  // 142 1.2 %, 186 2.0 %, 204 1.1 %, 412 0.6 %, 1316 0.09 %, 1840 2.0 %.
   const Registry registry = builtins();
-  for (int seed : {37, 39, 40, 108, 142, 186, 204, 412, 1316}) {
+  for (int seed : {37, 39, 40, 108, 142, 186, 204, 412, 1316, 1840}) {
     SCOPED_TRACE("random_drop_" + std::to_string(seed));
     const double deepest =
         deepestOverlapWithoutEnergyGain(loadScene(kScenes + "random_drop_" + std::to_string(seed) + ".json"), registry);
