@@ -444,6 +444,9 @@ void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
       active_.assign(ws.islands.members.size(), 0);
       focus_.assign(ws.bodies.size(), 0);
       tie_.assign(ws.pairs.size(), 0);
+      const auto dynamicPair = [&](const ContactPairState& p) {
+        return !ws.bodies[p.a].infinite() && !ws.bodies[p.b].infinite();
+      };
       for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
         const ContactPairState& p = ws.pairs[k];
         const int j = knownIndex_[k];
@@ -453,25 +456,23 @@ void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
         else if (ratio_[k] > s.pushOutRoundOverlap) ++residual;
         else continue;
         focus_[p.a] = focus_[p.b] = 1;
-        tie_[k] = !ws.bodies[p.a].infinite() && !ws.bodies[p.b].infinite();
+        tie_[k] = dynamicPair(p);
         const int island = ws.islands.islandOf[ws.bodies[p.a].infinite() ? p.b : p.a];
         if (island >= 0) active_[island] = 1;
       }
-      // A focus body's overlapping pairs with other dynamic bodies are tied as well: a light
-      // box pressed into the ground by a heavy body lying on it was pushed up into that body,
-      // which sat on a higher level, and the round was undone (3-D random drops 516, 1687 and
-      // 1840: 5-14 % deep for a step; none of 2500 seeds over 5 % with this tie).
+      // The focus bodies' dynamic neighbours:
+      // - their overlapping pairs are tied as well: a light box pressed into the ground by a
+      //   heavy body lying on it was pushed up into that body, which sat on a higher level, and
+      //   the round was undone (3-D random drops 516, 1687 and 1840: 5-14 % deep for a step;
+      //   none of 2500 seeds over 5 % with this tie);
+      // - they are partners, whose pairs with statics pushApart takes.
+      partner_.assign(ws.bodies.size(), 0);
       for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
         const ContactPairState& p = ws.pairs[k];
-        if ((focus_[p.a] || focus_[p.b]) && !ws.bodies[p.a].infinite() && !ws.bodies[p.b].infinite() &&
-            depth_[k] > s.pushOutTolerance)
-          tie_[k] = 1;
-      }
-      // The dynamic neighbours of the focus bodies (pushApart takes their pairs with statics).
-      partner_.assign(ws.bodies.size(), 0);
-      for (const ContactPairState& p : ws.pairs) {
-        if (focus_[p.a] && !ws.bodies[p.a].infinite() && !ws.bodies[p.b].infinite()) partner_[p.b] = 1;
-        if (focus_[p.b] && !ws.bodies[p.b].infinite() && !ws.bodies[p.a].infinite()) partner_[p.a] = 1;
+        if (!dynamicPair(p) || !(focus_[p.a] || focus_[p.b])) continue;
+        if (depth_[k] > s.pushOutTolerance) tie_[k] = 1;
+        if (focus_[p.a]) partner_[p.b] = 1;
+        if (focus_[p.b]) partner_[p.a] = 1;
       }
     }
     if (missed + deeper + residual == 0 || !s.pushOut || !s.pushOutNewOverlaps || rounds >= s.pushOutRounds) break;
