@@ -236,9 +236,31 @@ void featureContacts(const PreparedGeometry<d>& f, const Pose<d>& poseF, const V
   Pose<d> rel;  // F in S's frame
   rel.R = poseS.R.transpose() * poseF.R;
   rel.x = poseS.R.transpose() * (poseF.x - poseS.x);
+  const auto& bounds = s.impl().localBounds;
+  const GeometryType typeF = f.geometry().type;
+  if (typeF == GeometryType::Box || typeF == GeometryType::Convex || typeF == GeometryType::Mesh) {
+    // Plain vertices (no radius, no end axis): every box pair of a pile comes here twice per
+    // narrow phase, so they are read straight from the shape instead of through the scratch
+    // list. The arithmetic is the general loop's below with radius 0, written the same way so
+    // that the results are bitwise the same (0.0 - distance keeps the sign of a zero depth).
+    for (const auto& vertex : f.impl().vertices) {
+      const Vec<d> x = rel.R * vertex + rel.x;
+      if (bounds.squaredExteriorDistance(x) > margin * margin) continue;
+      const SurfaceDistance<d> sd = signedDistance<d>(s, x, margin + 0.0);
+      const double depth = 0.0 - sd.distance;
+      if (!(depth >= -margin)) continue;
+      const Vec<d> onF = x - 0.0 * sd.normal;
+      const Vec<d> n = poseS.R * sd.normal;
+      ContactPoint<d> c;
+      c.point = poseS.R * (0.5 * (sd.surfacePoint + onF)) + poseS.x;
+      c.normal = shapeIsA ? Vec<d>(-n) : n;
+      c.depth = depth;
+      out.push_back(c);
+    }
+    return;
+  }
   scratch.clear();
   featurePoints<d>(f, rel, Vec<d>(poseS.R.transpose() * deepest), scratch);
-  const auto& bounds = s.impl().localBounds;
   for (const auto& p : scratch) {
     // Farther than margin + radius from S's box is farther from S: skip the exact query (big
     // hulls have many vertices and many faces). Squared: no root for the many rejected points.
