@@ -234,7 +234,8 @@ bool boxBoxNearestPoints(const Geometry<3>& a, const Pose<3>& poseA, const Geome
   return true;
 }
 
-BoxBoxAxis boxBoxAxis(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& b, const Pose<3>& poseB) {
+BoxBoxAxis boxBoxAxis(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& b, const Pose<3>& poseB,
+                      double stopAbove) {
   const Vec3 D = poseA.x - poseB.x;  // from B to A
   const Eigen::Matrix3d C = poseA.R.transpose() * poseB.R;  // C(i, j) = a_i . b_j
   const Eigen::Matrix3d absC = C.cwiseAbs();
@@ -258,14 +259,24 @@ BoxBoxAxis boxBoxAxis(const Geometry<3>& a, const Pose<3>& poseA, const Geometry
       best.code = code;
     }
   };
+  // A gap above stopAbove already decides the caller's question (apart by more than it cares
+  // about): the remaining axes could only make the gap larger.
+  auto stop = [&] {
+    if (!(separation > stopAbove)) return false;
+    best.separation = separation;
+    best.leastOverlap = -separation;
+    return true;
+  };
   for (int i = 0; i < 3; ++i) {
     const double along = D.dot(poseA.R.col(i));
     consider(std::abs(along) - (hA[i] + hB.dot(absC.row(i).transpose())), along, i, true,
              [&] { return Vec3(poseA.R.col(i)); });
+    if (stop()) return best;
   }
   for (int j = 0; j < 3; ++j) {
     const double along = D.dot(poseB.R.col(j));
     consider(std::abs(along) - (hA.dot(absC.col(j)) + hB[j]), along, 3 + j, true, [&] { return Vec3(poseB.R.col(j)); });
+    if (stop()) return best;
   }
   // Edge pairs in A's frame: b_j is column j of C and u = a_i x b_j, so a_k.u and b_k.u are
   // entries of C (their radii need no products), and |u| = sine of the angle between the edges.
@@ -273,7 +284,7 @@ BoxBoxAxis boxBoxAxis(const Geometry<3>& a, const Pose<3>& poseA, const Geometry
   // loop over i then j): no index arithmetic, and a_i x b_j read off C without products. The
   // same numbers as Vec3::Unit(i).cross(C.col(j)) (its other terms are exact zeros).
   const Vec3 DA = poseA.R.transpose() * D;
-  auto edge = [&](auto iConstant, auto jConstant) {
+  auto edge = [&](auto iConstant, auto jConstant) -> bool {
     constexpr int i = decltype(iConstant)::value, j = decltype(jConstant)::value;
     constexpr int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
     Vec3 uA;
@@ -281,19 +292,21 @@ BoxBoxAxis boxBoxAxis(const Geometry<3>& a, const Pose<3>& poseA, const Geometry
     uA[i1] = -C(i2, j);
     uA[i2] = C(i1, j);
     const double length = uA.norm();
-    if (length < kParallelSine) return;
+    if (length < kParallelSine) return false;
     const double inverseLength = 1 / length;
     const double along = DA.dot(uA) * inverseLength;
     const double radii = hA[i1] * absC(i2, j) + hA[i2] * absC(i1, j) + hB[j1] * absC(i, j2) + hB[j2] * absC(i, j1);
     consider(std::abs(along) - radii * inverseLength, along, 6 + 3 * i + j, false,
              [&] { return Vec3(poseA.R * (uA * inverseLength)); });
+    return stop();
   };
   using I0 = std::integral_constant<int, 0>;
   using I1 = std::integral_constant<int, 1>;
   using I2 = std::integral_constant<int, 2>;
-  edge(I0{}, I0{}), edge(I0{}, I1{}), edge(I0{}, I2{});
-  edge(I1{}, I0{}), edge(I1{}, I1{}), edge(I1{}, I2{});
-  edge(I2{}, I0{}), edge(I2{}, I1{}), edge(I2{}, I2{});
+  if (edge(I0{}, I0{}) || edge(I0{}, I1{}) || edge(I0{}, I2{}) ||  //
+      edge(I1{}, I0{}) || edge(I1{}, I1{}) || edge(I1{}, I2{}) ||  //
+      edge(I2{}, I0{}) || edge(I2{}, I1{}) || edge(I2{}, I2{}))
+    return best;
   best.leastOverlap = -separation;
   // Apart: report the largest gap (a lower bound on the distance); the axis is then irrelevant.
   if (separation > 0) best.separation = separation;

@@ -23,7 +23,10 @@ struct BoxBoxAxis {
   Eigen::Vector3d leastOverlapNormal = Eigen::Vector3d::UnitY();
   double leastOverlap = kInfinity;  // the overlap along it (< 0: apart)
 };
-BoxBoxAxis boxBoxAxis(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& b, const Pose<3>& poseB);
+// stopAbove: return as soon as some axis shows a gap larger than this (then only `separation`
+// > stopAbove is meaningful: the gap found so far, a lower bound on the full test's).
+BoxBoxAxis boxBoxAxis(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& b, const Pose<3>& poseB,
+                      double stopAbove = kInfinity);
 
 // The contacts of two overlapping boxes on `axis` (what FCL's box-box returns): for a face axis
 // the incident face of the other box clipped against the reference face, one point per clipped

@@ -109,7 +109,7 @@ enum class BoxMain { None, Clipped, Nearest };
 // (then neither could the feature points find anything), or nothing within it.
 BoxMain boxBoxMain(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb, double margin, BoxBoxAxis& sat,
                    std::vector<CP>& main) {
-  sat = boxBoxAxis(a.geometry(), pa, b.geometry(), pb);
+  sat = boxBoxAxis(a.geometry(), pa, b.geometry(), pb, margin);
   if (sat.separation > margin) return BoxMain::None;
   if (boxBoxContacts(a.geometry(), pa, b.geometry(), pb, sat, main) > 0) return BoxMain::Clipped;
   if (!(margin > 0)) return BoxMain::None;
