@@ -156,24 +156,29 @@ void ContactWorkspace<d>::ensureGeometry(World<d>& world) {
   entities_ = current;
   geometries_.clear();
   centreShift_.assign(entities_.size(), VecD::Zero());
-  // Static boxes standing on a static half-space reach down through it (grounded_box.h): the
-  // bodies' poses are those of the scene, as statics never move.
+  // Static boxes standing on a static half-space reach down through it, and those standing on
+  // another static box reach into it (grounded_box.h): the bodies' poses are those of the scene,
+  // as statics never move, and the supports are the boxes as the scene gives them.
   std::vector<col::HalfSpaceInWorld<d>> grounds;
+  std::vector<col::BoxInWorld<d>> supports;
   for (Entity e : entities_) {
     const RigidBody<d>& rb = *world.template get<RigidBody<d>>(e);
     const Shape<d>& shape = *world.template get<Shape<d>>(e);
-    if (rb.isStatic && shape.type == ShapeType::Plane)
-      grounds.push_back({rotationOf<d>(rb.orientation) * shape.normal, rb.x});
+    if (!rb.isStatic) continue;
+    if (shape.type == ShapeType::Plane) grounds.push_back({rotationOf<d>(rb.orientation) * shape.normal, rb.x});
+    const col::Geometry<d> g = collisionGeometryOf(shape);
+    if (g.type == col::GeometryType::Box) supports.push_back({{rb.x, rotationOf<d>(rb.orientation)}, g.halfExtents});
   }
   for (std::size_t i = 0; i < entities_.size(); ++i) {
     const RigidBody<d>& rb = *world.template get<RigidBody<d>>(entities_[i]);
     col::Geometry<d> g = collisionGeometryOf(*world.template get<Shape<d>>(entities_[i]));
-    if (rb.isStatic && g.type == col::GeometryType::Box && !grounds.empty()) {
+    if (rb.isStatic && g.type == col::GeometryType::Box && (!grounds.empty() || supports.size() > 1)) {
       col::Pose<d> pose;
       pose.x = rb.x;
       pose.R = rotationOf<d>(rb.orientation);
-      // A face within the push-out tolerance of the plane stands on it.
-      centreShift_[i] = col::extendBoxThroughGround<d>(g, pose, grounds, world.settings().contact.pushOutTolerance);
+      // A face within the push-out tolerance of the plane or the support stands on it.
+      centreShift_[i] =
+          col::extendBoxThroughGround<d>(g, pose, grounds, world.settings().contact.pushOutTolerance, supports);
     }
     geometries_.push_back(std::make_unique<col::PreparedGeometry<d>>(g));
   }

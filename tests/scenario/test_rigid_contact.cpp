@@ -694,12 +694,18 @@ TEST(PushOutRounds, ANeedleAtAWallsFootLeavesThroughTheWallsInnerFace) {
   // - Wall standing on the ground: its box reaches down through the plane (grounded_box.h), so
   //   its bottom face is no way out, and already the first round pushes the needle out of the
   //   inner face.
+  // - Wall standing on a floor box 1 m thick instead of the plane: the wall reaches into the
+  //   floor box, and again the first round suffices.
   const Registry registry = builtins();
-  auto run = [&](double wallBottom, int rounds) {
+  auto run = [&](double wallBottom, int rounds, bool floorBox = false) {
+    const std::string ground =
+        floorBox ? R"({"name": "ground", "shape": {"type": "box", "half_extents": [5, 0.5, 5]},
+       "rigid_body": {"static": true, "position": [0, -0.5, 0]}, "collider": {"restitution": 0, "friction": 0.5}},)"
+                 : R"({"name": "ground", "shape": {"type": "plane", "normal": [0, 1, 0]}, "rigid_body": {"static": true},
+       "collider": {"restitution": 0, "friction": 0.5}},)";
     const std::string text = R"({"dimension": 3, "time": {"dt": 0.016666666666666666, "end": 0.016666666666666666},
       "gravity": [0, 0, 0], "entities": [
-      {"name": "ground", "shape": {"type": "plane", "normal": [0, 1, 0]}, "rigid_body": {"static": true},
-       "collider": {"restitution": 0, "friction": 0.5}},
+      )" + ground + R"(
       {"name": "wall", "shape": {"type": "box", "half_extents": [1, 1, 0.1]},
        "rigid_body": {"static": true, "position": [0, )" + std::to_string(1 + wallBottom) + R"(, -0.1]}, "collider": {"restitution": 0, "friction": 0.5}},
       {"name": "needle", "shape": {"type": "box", "half_extents": [0.005, 0.005, 0.1]},
@@ -715,12 +721,15 @@ TEST(PushOutRounds, ANeedleAtAWallsFootLeavesThroughTheWallsInnerFace) {
   EXPECT_LT(hoverFour, 0.01);
   EXPECT_NEAR(hoverFourX.z(), 0.05 + 0.05, 2e-3);  // out of the wall's inner face, z = 0
   EXPECT_NEAR(hoverFourX.y(), 0.005, 2e-3);        // resting on the ground, not pushed into it
-  for (int rounds : {1, 4}) {
-    const auto [ratio, x] = run(0, rounds);
-    EXPECT_LT(ratio, 0.01) << rounds << " rounds";
-    EXPECT_NEAR(x.z(), 0.05 + 0.05, 2e-3) << rounds << " rounds";
-    EXPECT_NEAR(x.y(), 0.005, 2e-3) << rounds << " rounds";
-  }
+  for (bool floorBox : {false, true})
+    for (int rounds : {1, 4}) {
+      const auto [ratio, x] = run(0, rounds, floorBox);
+      EXPECT_LT(ratio, 0.01) << rounds << " rounds, floor box " << floorBox;
+      EXPECT_NEAR(x.z(), 0.05 + 0.05, 2e-3) << rounds << " rounds, floor box " << floorBox;
+      EXPECT_NEAR(x.y(), 0.005, 2e-3) << rounds << " rounds, floor box " << floorBox;
+    }
+  // The same hovering wall over the floor box: not extended, so only the later rounds help.
+  EXPECT_GT(run(0.001, 1, true).first, 0.5);
 }
 
 TEST(PushOutRounds, TheFirstStepThatNeedsFurtherRoundsEndsShallowerWithThem) {

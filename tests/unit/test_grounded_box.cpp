@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -121,4 +122,94 @@ TEST(GroundedBox, ANeedleAtTheFootOfAGroundedWallIsPushedOutOfItsSideNotDown) {
   const ContactPoint<3> after = deepest(extended, at(wallPose.x + shift));
   EXPECT_NEAR(after.normal.z(), 1, 1e-9);
   EXPECT_NEAR(after.depth, 0.05, 1e-9);
+}
+
+namespace {
+
+// A floor slab 10 m square with its top face at y = 0, `thickness` deep.
+BoxInWorld<3> floorSlab(double thickness) {
+  return {at(Vec3(0, -0.5 * thickness, 0)), Vec3(5, 0.5 * thickness, 5)};
+}
+
+}  // namespace
+
+TEST(GroundedBox, AWallOnAFloorBoxReachesIntoItNoFurtherThanItsFarFace) {
+  for (const auto& [thickness, expectedLow] : {std::pair{6.0, -4.0}, std::pair{0.1, -0.1}}) {
+    Geometry<3> wall = box3(0.1, 1, 2);
+    const Pose<3> pose = at(Vec3(3, 1, 0));
+    const Vec3 shift = extendBoxThroughGround<3>(wall, pose, {}, 1e-5, {floorSlab(thickness)});
+    const auto [low, high] = extentAlong(wall, pose, shift, Vec3::UnitY());
+    EXPECT_NEAR(high, 2, kTight) << thickness;  // the top where it was
+    EXPECT_NEAR(low, expectedLow, kTight) << thickness;  // its own size down, or to the slab's bottom
+    EXPECT_EQ(shift.x(), 0);
+    EXPECT_EQ(shift.z(), 0);
+    EXPECT_EQ(wall.halfExtents.x(), 0.1);
+    EXPECT_EQ(wall.halfExtents.z(), 2);
+  }
+}
+
+TEST(GroundedBox, OnlyABoxWhoseFaceLiesOnTheSupportsFaceIsExtended) {
+  auto unchanged = [](Geometry<3> g, const Pose<3>& pose, const std::vector<BoxInWorld<3>>& supports) {
+    const Geometry<3> before = g;
+    const Vec3 shift = extendBoxThroughGround<3>(g, pose, {}, 1e-5, supports);
+    return shift == Vec3::Zero() && g.halfExtents == before.halfExtents;
+  };
+  const std::vector<BoxInWorld<3>> floor{floorSlab(1)};
+  EXPECT_FALSE(unchanged(box3(0.1, 1, 2), at(Vec3(4.9, 1, 0)), floor));  // flush with the slab's edge
+  EXPECT_TRUE(unchanged(box3(0.1, 1, 2), at(Vec3(4.95, 1, 0)), floor));  // overhanging it by 5 cm
+  EXPECT_TRUE(unchanged(box3(0.1, 1, 2), at(Vec3(0, 1 + 2e-5, 0)), floor));  // hovering past the tolerance
+  EXPECT_FALSE(unchanged(box3(0.1, 1, 2), at(Vec3(0, 0.8, 0)), floor));  // sunk 20 cm
+  EXPECT_TRUE(unchanged(box3(0.1, 1, 2), at(Vec3(0, -0.6, 0)), floor));  // centre in the slab
+  const Eigen::Matrix3d tilted = Eigen::AngleAxisd(0.1, Vec3::UnitX()).toRotationMatrix();
+  EXPECT_TRUE(unchanged(box3(0.1, 1, 2), at(Vec3(0, 1.2, 0), tilted), floor));  // no face on the slab's
+  const BoxInWorld<3> itself{at(Vec3(0, 1, 0)), Vec3(0.1, 1, 2)};
+  EXPECT_TRUE(unchanged(box3(0.1, 1, 2), itself.pose, {itself}));  // the box is no support of its own
+  // A turned slab: the wall stands on its face, whatever the slab's frame.
+  const Eigen::Matrix3d turned = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()).toRotationMatrix();
+  const BoxInWorld<3> turnedSlab{at(Vec3(0, -0.5, 0), turned), Vec3(0.5, 5, 5)};
+  EXPECT_FALSE(unchanged(box3(0.1, 1, 2), at(Vec3(3, 1, 0)), {turnedSlab}));
+}
+
+TEST(GroundedBox, AGroundedFloorBoxIsNoObstacleToTheWallOnIt) {
+  // Plane first, then the slab: a wall standing on a slab that lies on the ground reaches into
+  // the slab; the slab itself reaches through the plane.
+  const std::vector<HalfSpaceInWorld<3>> ground{{Vec3::UnitY(), Vec3(0, -1, 0)}};
+  Geometry<3> slab = box3(5, 0.5, 5);
+  const Vec3 slabShift = extendBoxThroughGround<3>(slab, at(Vec3(0, -0.5, 0)), ground, 1e-5, {floorSlab(1)});
+  EXPECT_NEAR(slabShift.y(), -5, kTight);
+  Geometry<3> wall = box3(0.1, 1, 2);
+  const Vec3 shift = extendBoxThroughGround<3>(wall, at(Vec3(3, 1, 0)), ground, 1e-5, {floorSlab(1)});
+  EXPECT_NEAR(shift.y(), -0.5, kTight);  // down to the slab's bottom, 1 m
+}
+
+TEST(GroundedBox, In2DAWallOnAFloorBox) {
+  Geometry<2> wall = box2(0.1, 1);
+  Pose<2> pose;
+  pose.x = Vec2(2, 1);
+  BoxInWorld<2> floor;
+  floor.pose.x = Vec2(0, -0.25);
+  floor.halfExtents = Vec2(5, 0.25);
+  const Vec2 shift = extendBoxThroughGround<2>(wall, pose, {}, 1e-5, {floor});
+  EXPECT_NEAR(shift.y(), -0.25, kTight);
+  EXPECT_NEAR(wall.halfExtents.y(), 1.25, kTight);
+  pose.x = Vec2(5, 1);  // half over the edge
+  Geometry<2> overhanging = box2(0.1, 1);
+  EXPECT_EQ(extendBoxThroughGround<2>(overhanging, pose, {}, 1e-5, {floor}), Vec2::Zero());
+}
+
+TEST(GroundedBox, ANeedleAtTheFootOfAWallOnAFloorBoxIsPushedOutOfTheWallsSide) {
+  // As ANeedleAtTheFootOfAGroundedWall... with a 1 m floor slab instead of the plane.
+  const Geometry<3> given = box3(1, 1, 0.1);
+  const Pose<3> wallPose = at(Vec3(0, 1, -0.1));
+  Geometry<3> grounded = given;
+  const Vec3 shift = extendBoxThroughGround<3>(grounded, wallPose, {}, 1e-5, {floorSlab(1)});
+  EXPECT_NEAR(shift.y(), -0.5, kTight);
+  const PreparedGeometry<3> needle(box3(0.005, 0.005, 0.1)), extended(grounded);
+  std::vector<ContactPoint<3>> points;
+  findContacts<3>(needle, at(Vec3(0, 0.004, 0.05)), extended, at(wallPose.x + shift), ContactQuery{}, points);
+  ASSERT_FALSE(points.empty());
+  const auto deepest = *std::max_element(points.begin(), points.end(),
+                                         [](const auto& p, const auto& q) { return p.depth < q.depth; });
+  EXPECT_NEAR(deepest.normal.z(), 1, 1e-9);
+  EXPECT_NEAR(deepest.depth, 0.05, 1e-9);
 }
