@@ -442,6 +442,8 @@ void parseContactSettings(const Config& c, ContactSettings& s) {
   s.pushOutNewOverlaps = c.boolean("push_out_new_overlaps", s.pushOutNewOverlaps);
   count("push_out_rounds", s.pushOutRounds, 1);
   s.pushOutRoundOverlap = c.number("push_out_round_overlap", s.pushOutRoundOverlap, Bound::NonNegative);
+  s.pushOutJoint = c.boolean("push_out_joint", s.pushOutJoint);
+  s.pushOutJointOverlap = c.number("push_out_joint_overlap", s.pushOutJointOverlap, Bound::NonNegative);
   s.velocityContact = c.boolean("velocity_contact", s.velocityContact);
   s.energyClamp = c.boolean("energy_clamp", s.energyClamp);
   s.sweptCollisions = c.boolean("swept_collisions", s.sweptCollisions);

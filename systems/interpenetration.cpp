@@ -29,6 +29,7 @@
 #include <limits>
 #include <utility>
 
+#include "solvers/contact/joint_push_out.h"
 #include "solvers/contact/push_out.h"
 #include "systems/opposed_statics.h"
 #include "systems/rigid_contact.h"
@@ -318,6 +319,141 @@ int ResolveInterpenetration<d>::pushApart(ContactWorkspace<d>& ws, const solvers
 }
 
 template <int d>
+bool ResolveInterpenetration<d>::movedOrNew(const ContactWorkspace<d>& ws, std::size_t k) const {
+  return knownIndex_[k] < 0 || moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b];
+}
+
+template <int d>
+int ResolveInterpenetration<d>::growAndMeasure(ContactWorkspace<d>& ws) {
+  // The pairs where the bodies in moved_ now are (the growth merges new pairs into the sorted
+  // list); the known ones keep their depths, moved to their places, and the pairs with a moved
+  // body and the new ones are measured again.
+  knownPairs_.clear();
+  for (const ContactPairState& p : ws.pairs) knownPairs_.emplace_back(p.a, p.b);
+  knownDepth_ = depth_;
+  knownRatio_ = ratio_;
+  const int added = ws.growPairs([](const ContactBody<d>& b) { return std::array<col::Pose<d>, 1>{b.candidate}; });
+  knownIndex_.resize(ws.pairs.size());
+  for (std::size_t k = 0, j = 0; k < ws.pairs.size(); ++k) {
+    const bool known = j < knownPairs_.size() && knownPairs_[j] == std::make_pair(ws.pairs[k].a, ws.pairs[k].b);
+    knownIndex_[k] = known ? static_cast<int>(j++) : -1;
+  }
+  if (added > 0) {
+    depth_.assign(ws.pairs.size(), 0.0);
+    ratio_.assign(ws.pairs.size(), 0.0);
+    for (std::size_t k = 0; k < ws.pairs.size(); ++k)
+      if (knownIndex_[k] >= 0) depth_[k] = knownDepth_[knownIndex_[k]], ratio_[k] = knownRatio_[knownIndex_[k]];
+  }
+  measurePairs(ws, [&](std::size_t k) { return movedOrNew(ws, k); });
+  return added;
+}
+
+template <int d>
+int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newPairs) {
+  const ContactSettings& s = ws.settings;
+  // The jam: the dynamic bodies of the pairs still deeper than pushOutJointOverlap, and the
+  // dynamic bodies that overlap them or their overlapping neighbours (kJointRings rings: what
+  // they are pushed against must be able to give way). Everything else is a fixed partner.
+  const std::size_t n = ws.bodies.size();
+  moved_.assign(n, 0);
+  double reach = 0;  // the deepest of those overlaps: about how far the solve moves a body
+  for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
+    if (!(ratio_[k] > s.pushOutJointOverlap && depth_[k] > s.pushOutTolerance)) continue;
+    reach = std::max(reach, depth_[k]);
+    for (int b : {ws.pairs[k].a, ws.pairs[k].b})
+      if (!ws.bodies[b].infinite()) moved_[b] = 1;
+  }
+  if (!(reach > 0)) return 0;
+  for (int ring = 0; ring < kJointRings; ++ring) {
+    jamRing_ = moved_;
+    bool grew = false;
+    for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
+      const ContactPairState& p = ws.pairs[k];
+      if (!(depth_[k] > s.pushOutTolerance) || ws.bodies[p.a].infinite() || ws.bodies[p.b].infinite()) continue;
+      if (jamRing_[p.a] != jamRing_[p.b]) moved_[p.a] = moved_[p.b] = 1, grew = true;
+    }
+    if (!grew) break;
+  }
+  jamIndex_.assign(n, -1);
+  jamBodies_.clear();
+  savedPoses_.clear();
+  for (std::size_t b = 0; b < n; ++b) {
+    if (!moved_[b]) continue;
+    const ContactBody<d>& B = ws.bodies[b];
+    jamIndex_[b] = static_cast<int>(jamBodies_.size());
+    con::JointBody<d> body;
+    body.inverseMass = B.inverseMass();
+    body.inverseInertia = B.inverseInertia0;
+    jamBodies_.push_back(body);
+    savedPoses_.push_back({static_cast<int>(b), B.x0, B.q0});
+  }
+  double worstBefore = 0;
+  for (std::size_t k = 0; k < ws.pairs.size(); ++k)
+    if (moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]) worstBefore = std::max(worstBefore, ratio_[k]);
+  // Linearised at the current poses, solved, applied; again from where that left the bodies
+  // (the rotations are first order, and a body may have come near one it was not paired with:
+  // the broad phase grows after each pass). Points within `reach` of touching are constraints
+  // too, so that the bodies are not pushed into neighbours that did not overlap yet. No point of
+  // a body moves by more than twice `reach` in a pass (a light, thin body turns cheaply in the
+  // solve's metric, and a large turn is far from its linearisation), and a pass that leaves the
+  // jam deeper than the pass before is undone and ends the solve.
+  std::vector<col::ContactPoint<d>> scratch;
+  col::ContactQuery query;
+  query.margin = reach;
+  int passes = 0;
+  double worstNow = worstBefore;
+  for (int pass = 0; pass < kJointPasses; ++pass) {
+    jamPoints_.clear();
+    for (const ContactPairState& p : ws.pairs) {
+      if (!(moved_[p.a] || moved_[p.b])) continue;
+      const ContactBody<d>& A = ws.bodies[p.a];
+      const ContactBody<d>& B = ws.bodies[p.b];
+      if (A.infinite() && B.infinite()) continue;
+      scratch.clear();
+      col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, query, scratch);
+      for (const auto& c : scratch) {
+        con::JointPoint<d> q;
+        q.a = jamIndex_[p.a];
+        q.b = jamIndex_[p.b];
+        q.ra = c.point - A.x0;
+        q.rb = c.point - B.x0;
+        q.n = c.normal;
+        q.depth = c.depth;
+        jamPoints_.push_back(q);
+      }
+    }
+    if (jamPoints_.empty()) break;
+    con::solveJointPushOut<d>(jamBodies_, jamPoints_, kJointSweeps, 1e-3 * s.pushOutTolerance, jamMoves_);
+    double largest = 0;
+    for (const SavedPose& saved : savedPoses_) {
+      const con::JointMove<d>& m = jamMoves_[jamIndex_[saved.body]];
+      largest = std::max(largest, m.dx.norm() + m.dtheta.norm() * ws.bodies[saved.body].geometry->boundingRadius());
+    }
+    const double scale = largest > 2 * reach ? 2 * reach / largest : 1.0;
+    passStart_.clear();
+    for (const SavedPose& saved : savedPoses_) {
+      ContactBody<d>& B = ws.bodies[saved.body];
+      passStart_.push_back({saved.body, B.x0, B.q0});
+      const con::JointMove<d>& m = jamMoves_[jamIndex_[saved.body]];
+      setBasePose<d>(B, B.x0 + scale * m.dx, rotatedBy<d>(B.q0, con::AngVec<d>(scale * m.dtheta)));
+    }
+    newPairs += growAndMeasure(ws);
+    double worst = 0;
+    for (std::size_t k = 0; k < ws.pairs.size(); ++k)
+      if (moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]) worst = std::max(worst, ratio_[k]);
+    if (!(worst < worstNow)) {
+      for (const SavedPose& p : passStart_) setBasePose<d>(ws.bodies[p.body], p.x, p.q);
+      measurePairs(ws, [&](std::size_t k) { return moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]; });
+      break;
+    }
+    worstNow = worst;
+    ++passes;
+    if (worst <= 0.1 * s.pushOutRoundOverlap) break;  // well under what called for the solve
+  }
+  return passes;
+}
+
+template <int d>
 void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (ws.bodies.empty()) return;
@@ -391,27 +527,8 @@ void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
     // for another round and for Step V's islands. Then the deepest remaining overlap of any pair
     // of the broad phase, measured again where a body moved and for the pairs the growth added
     // (the known ones keep their depths, moved to their places in the merged list).
-    knownPairs_.clear();
-    for (const ContactPairState& p : ws.pairs) knownPairs_.emplace_back(p.a, p.b);
-    knownDepth_ = depth_;
-    knownRatio_ = ratio_;
-    const int added = ws.growPairs(candidatePoses);
-    newPairs += added;
-    knownIndex_.resize(ws.pairs.size());
-    for (std::size_t k = 0, j = 0; k < ws.pairs.size(); ++k) {
-      const bool known = j < knownPairs_.size() && knownPairs_[j] == std::make_pair(ws.pairs[k].a, ws.pairs[k].b);
-      knownIndex_[k] = known ? static_cast<int>(j++) : -1;
-    }
-    if (added > 0) {
-      depth_.assign(ws.pairs.size(), 0.0);
-      ratio_.assign(ws.pairs.size(), 0.0);
-      for (std::size_t k = 0; k < ws.pairs.size(); ++k)
-        if (knownIndex_[k] >= 0) depth_[k] = knownDepth_[knownIndex_[k]], ratio_[k] = knownRatio_[knownIndex_[k]];
-    }
-    const auto remeasured = [&](std::size_t k) {
-      return knownIndex_[k] < 0 || moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b];
-    };
-    measurePairs(ws, remeasured);
+    newPairs += growAndMeasure(ws);
+    const auto remeasured = [&](std::size_t k) { return movedOrNew(ws, k); };
     if (rounds > 1) {
       // Pushing the bodies of a few pairs apart can drive them into others: a round whose
       // deepest overlap among the pairs it touched (the new ones included) is deeper than before
@@ -477,6 +594,9 @@ void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
     }
     if (missed + deeper + residual == 0 || !s.pushOut || !s.pushOutNewOverlaps || rounds >= s.pushOutRounds) break;
   }
+  // Overlaps the rounds left deeper than pushOutJointOverlap: a jam, pushed apart at once.
+  int jointSolves = 0;
+  if (s.pushOut && s.pushOutNewOverlaps && s.pushOutJoint) jointSolves = pushJamsApart(ws, newPairs);
   double worst = 0, worstDepth = 0;
   for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
     worstDepth = std::max(worstDepth, depth_[k]);
@@ -494,6 +614,8 @@ void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
   ctx.diagnostics.set("push_out_new_overlaps", newOverlaps);
   ctx.diagnostics.set("push_out_rounds", rounds - undone);
   ctx.diagnostics.set("push_out_rounds_undone", undone);
+  // Joint passes over a jam that were kept (each left it shallower than the pass before).
+  ctx.diagnostics.set("push_out_joint_passes", jointSolves);
   ctx.diagnostics.set("push_out_overlaps_found_after", missed);
   ctx.diagnostics.set("broad_phase_pairs_added_in_push_out", newPairs);
   ctx.diagnostics.set("max_penetration", worstDepth);

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "ecs/system.h"
+#include "solvers/contact/joint_push_out.h"
 #include "systems/contact_workspace.h"
 
 namespace monolith {
@@ -135,6 +136,23 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   std::vector<double> knownDepth_, knownRatio_;  // and their measurements
   std::vector<int> knownIndex_;                  // per pair after the growth: its index before, or -1
   std::vector<char> moved_;       // per body: in an island push-out worked on
+  // The pairs whose depths growAndMeasure measured again: a body in moved_, or new.
+  bool movedOrNew(const ContactWorkspace<d>& ws, std::size_t k) const;
+  // After bodies in moved_ moved: the broad phase grown where they are, the depths carried over
+  // and measured again (movedOrNew); returns the pairs added.
+  int growAndMeasure(ContactWorkspace<d>& ws);
+  // The jam left after the rounds pushed apart at once (solvers/contact/joint_push_out.h), pass
+  // by pass while each leaves its pairs shallower. Returns the passes kept; adds to newPairs.
+  int pushJamsApart(ContactWorkspace<d>& ws, int& newPairs);
+  static constexpr int kJointPasses = 16;  // linearisations, at most
+  static constexpr int kJointRings = 2;    // neighbours of neighbours of the deep pairs' bodies
+  std::vector<char> jamRing_;              // the jam before a ring is added
+  static constexpr int kJointSweeps = 2000;  // Gauss-Seidel sweeps per linearisation, at most
+  std::vector<int> jamIndex_;  // per body: its index in the joint solve, or -1 (a fixed partner)
+  std::vector<solvers::contact::JointBody<d>> jamBodies_;
+  std::vector<solvers::contact::JointPoint<d>> jamPoints_;
+  std::vector<solvers::contact::JointMove<d>> jamMoves_;
+  std::vector<SavedPose> passStart_;  // the jam's poses before a joint pass, to undo it
   std::vector<char> newOverlap_;  // per pair: not processed in Step II, yet overlapping now (or tied)
   std::vector<int> pairLevel_;    // per pair: its level in push-out
   std::vector<std::pair<int, int>> edges_;

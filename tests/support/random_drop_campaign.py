@@ -8,6 +8,7 @@ that differs on N threads.
 
     /usr/bin/python3 tests/support/random_drop_campaign.py FIRST LAST [--monolith build/monolith]
         [--threads 2] [--work /tmp/random_drops] [--dimension 2] [--compare-threads 1]
+        [--set solvers.contact.KEY=VALUE ...]
 
 One line per seed: its wall time and OK, or what it broke. Plain Python, no modules needed.
 """
@@ -33,7 +34,7 @@ def state_hash(out):
         return None
 
 
-def check(seed, monolith, threads, work, dimension=3, compare_threads=0):
+def check(seed, monolith, threads, work, dimension=3, compare_threads=0, overrides=()):
     if dimension == 2:
         generate_contact_scenes.random_drop_2d(work, seed)
         scene = os.path.join(work, "random_drop_2d_%d.json" % seed)
@@ -43,7 +44,9 @@ def check(seed, monolith, threads, work, dimension=3, compare_threads=0):
     out = os.path.join(work, "out_%d" % seed)
     start = time.time()
     try:
-        run = subprocess.run([monolith, "run", scene, "--threads", str(threads), "--no-frames", "--out", out, "--quiet"],
+        settings = [arg for pair in overrides for arg in ("--set", pair)]
+        run = subprocess.run([monolith, "run", scene, "--threads", str(threads), "--no-frames", "--out", out, "--quiet"]
+                             + settings,
                              capture_output=True, text=True, timeout=600)
     except subprocess.TimeoutExpired:
         return ["no result in 600 s"], time.time() - start
@@ -76,7 +79,8 @@ def check(seed, monolith, threads, work, dimension=3, compare_threads=0):
         # The same scene on another thread count must end in bitwise the same state.
         other = out + "_threads_%d" % compare_threads
         subprocess.run([monolith, "run", scene, "--threads", str(compare_threads), "--no-frames", "--out", other,
-                        "--quiet"], capture_output=True, text=True, timeout=600)
+                        "--quiet"] + [arg for pair in overrides for arg in ("--set", pair)],
+                       capture_output=True, text=True, timeout=600)
         mine, theirs = state_hash(out), state_hash(other)
         if mine is None or mine != theirs:
             flags.append("state on %d threads %s, on %d threads %s" % (threads, mine, compare_threads, theirs))
@@ -94,11 +98,14 @@ def main():
                         help="2: the 2-D drops of generate_contact_scenes.py --random-2d")
     parser.add_argument("--compare-threads", type=int, default=0, metavar="N",
                         help="also run each seed on N threads and flag a final state that differs")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="a scene override for every run (monolith run --set), repeatable")
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
     broken = 0
     for seed in range(args.first, args.last + 1):
-        flags, seconds = check(seed, args.monolith, args.threads, args.work, args.dimension, args.compare_threads)
+        flags, seconds = check(seed, args.monolith, args.threads, args.work, args.dimension, args.compare_threads,
+                               args.set)
         broken += 1 if flags else 0
         print("%d %.1fs %s" % (seed, seconds, "OK" if not flags else " | ".join(flags)), flush=True)
     print("%d of %d seeds flagged" % (broken, args.last - args.first + 1))

@@ -1,0 +1,177 @@
+#include "solvers/contact/joint_push_out.h"
+
+#include <Eigen/QR>
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+
+namespace monolith::solvers::contact {
+
+namespace {
+
+// Per point: its rows' angular parts r x n, their images under the inverse inertias, and the
+// inverse of the point's effective mass along n (the diagonal of J M^{-1} J^T).
+template <int d>
+struct Row {
+  AngVec<d> ca = AngVec<d>::Zero(), cb = AngVec<d>::Zero(), inertiaCa = AngVec<d>::Zero(), inertiaCb = AngVec<d>::Zero();
+  double inverseMass = 0;
+};
+
+// Up to this many points the multipliers come from the exact active-set solve below; beyond, from
+// Gauss-Seidel sweeps (whose convergence slows with the mass ratio: 1e6 gives ~1e6 sweeps).
+constexpr int kDenseJointPoints = 96;
+
+// The dual of the program, min 1/2 l^T A l - depth^T l over l >= 0 with A = J M^{-1} J^T, by the
+// active-set method of Lawson and Hanson: the point whose constraint is violated most joins the
+// free set, the free multipliers solve their equations (the least-norm solution: redundant
+// points, a face's corners, make them singular), and a multiplier that would turn negative stops
+// the step at zero and leaves the set. Exact to rounding where the program is feasible.
+template <int d>
+void solveDense(const std::vector<JointBody<d>>& bodies, const std::vector<JointPoint<d>>& points,
+                const std::vector<Row<d>>& rows, std::vector<double>& lambda) {
+  const int m = static_cast<int>(points.size());
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(m, m);
+  Eigen::VectorXd depth(m);
+  // A(k, l) = sum over the bodies of both points of the product of their rows through M^{-1}.
+  auto coupling = [&](int k, int l) {
+    const JointPoint<d>& p = points[k];
+    const JointPoint<d>& q = points[l];
+    double sum = 0;
+    for (int side = 0; side < 2; ++side) {
+      const int body = side == 0 ? p.a : p.b;
+      if (body < 0) continue;
+      const double sp = side == 0 ? 1.0 : -1.0;
+      const AngVec<d>& cp = side == 0 ? rows[k].ca : rows[k].cb;
+      for (int other = 0; other < 2; ++other) {
+        if ((other == 0 ? q.a : q.b) != body) continue;
+        const double sq = other == 0 ? 1.0 : -1.0;
+        const AngVec<d>& iq = other == 0 ? rows[l].inertiaCa : rows[l].inertiaCb;
+        sum += sp * sq * (bodies[body].inverseMass * p.n.dot(q.n) + cp.dot(iq));
+      }
+    }
+    return sum;
+  };
+  double largest = 0;
+  for (int k = 0; k < m; ++k) {
+    depth[k] = points[k].depth;
+    for (int l = 0; l <= k; ++l) A(k, l) = A(l, k) = coupling(k, l);
+    largest = std::max(largest, A(k, k));
+  }
+  if (!(largest > 0)) return;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(m);
+  std::vector<char> free(m, 0);
+  std::vector<int> index;
+  const double tolerance = 1e-12 * largest * (1 + depth.cwiseAbs().maxCoeff());
+  for (int iteration = 0; iteration < 4 * m + 10; ++iteration) {
+    const Eigen::VectorXd gradient = A * x - depth;
+    int entering = -1;
+    for (int k = 0; k < m; ++k)
+      if (!free[k] && gradient[k] < -tolerance && (entering < 0 || gradient[k] < gradient[entering])) entering = k;
+    if (entering < 0) break;
+    free[entering] = 1;
+    for (int inner = 0; inner < m + 1; ++inner) {
+      index.clear();
+      for (int k = 0; k < m; ++k)
+        if (free[k]) index.push_back(k);
+      const int f = static_cast<int>(index.size());
+      Eigen::MatrixXd Aff(f, f);
+      Eigen::VectorXd bf(f);
+      for (int i = 0; i < f; ++i) {
+        bf[i] = depth[index[i]];
+        for (int j = 0; j < f; ++j) Aff(i, j) = A(index[i], index[j]);
+      }
+      const Eigen::VectorXd z = Aff.completeOrthogonalDecomposition().solve(bf);
+      double step = 1;
+      for (int i = 0; i < f; ++i)
+        if (z[i] <= 0) {
+          const double drop = x[index[i]] - z[i];
+          step = std::min(step, drop > 0 ? x[index[i]] / drop : 0.0);
+        }
+      for (int i = 0; i < f; ++i) x[index[i]] += step * (z[i] - x[index[i]]);
+      if (step >= 1) break;
+      for (int i = 0; i < f; ++i)
+        if (x[index[i]] <= 0) x[index[i]] = 0, free[index[i]] = 0;
+    }
+  }
+  for (int k = 0; k < m; ++k) lambda[k] = std::max(0.0, x[k]);
+}
+
+}  // namespace
+
+template <int d>
+double solveJointPushOut(const std::vector<JointBody<d>>& bodies, const std::vector<JointPoint<d>>& points, int sweeps,
+                         double tolerance, std::vector<JointMove<d>>& moves) {
+  moves.assign(bodies.size(), JointMove<d>{});
+  std::vector<Row<d>> rows(points.size());
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const JointPoint<d>& p = points[k];
+    Row<d>& r = rows[k];
+    double mass = 0;
+    if (p.a >= 0) {
+      r.ca = cross<d>(p.ra, p.n);
+      r.inertiaCa = bodies[p.a].inverseInertia * r.ca;
+      mass += bodies[p.a].inverseMass + r.ca.dot(r.inertiaCa);
+    }
+    if (p.b >= 0) {
+      r.cb = cross<d>(p.rb, p.n);
+      r.inertiaCb = bodies[p.b].inverseInertia * r.cb;
+      mass += bodies[p.b].inverseMass + r.cb.dot(r.inertiaCb);
+    }
+    r.inverseMass = mass > 0 ? 1 / mass : 0;
+  }
+  // The separation the moves give along n at point k ((dtheta x r).n = dtheta.(r x n)).
+  auto gained = [&](std::size_t k) {
+    const JointPoint<d>& p = points[k];
+    double s = 0;
+    if (p.a >= 0) s += p.n.dot(moves[p.a].dx) + rows[k].ca.dot(moves[p.a].dtheta);
+    if (p.b >= 0) s -= p.n.dot(moves[p.b].dx) + rows[k].cb.dot(moves[p.b].dtheta);
+    return s;
+  };
+  std::vector<double> lambda(points.size(), 0.0);
+  if (points.size() <= static_cast<std::size_t>(kDenseJointPoints)) {
+    solveDense<d>(bodies, points, rows, lambda);
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const JointPoint<d>& p = points[k];
+      if (p.a >= 0) {
+        moves[p.a].dx += lambda[k] * bodies[p.a].inverseMass * p.n;
+        moves[p.a].dtheta += lambda[k] * rows[k].inertiaCa;
+      }
+      if (p.b >= 0) {
+        moves[p.b].dx -= lambda[k] * bodies[p.b].inverseMass * p.n;
+        moves[p.b].dtheta -= lambda[k] * rows[k].inertiaCb;
+      }
+    }
+    sweeps = 0;
+  }
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    double largest = 0;  // the largest correction of a point's separation in this sweep
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const JointPoint<d>& p = points[k];
+      if (!(rows[k].inverseMass > 0)) continue;
+      const double next = std::max(0.0, lambda[k] + (p.depth - gained(k)) * rows[k].inverseMass);
+      const double change = next - lambda[k];
+      if (change == 0) continue;
+      largest = std::max(largest, std::abs(change) / rows[k].inverseMass);
+      lambda[k] = next;
+      if (p.a >= 0) {
+        moves[p.a].dx += change * bodies[p.a].inverseMass * p.n;
+        moves[p.a].dtheta += change * rows[k].inertiaCa;
+      }
+      if (p.b >= 0) {
+        moves[p.b].dx -= change * bodies[p.b].inverseMass * p.n;
+        moves[p.b].dtheta -= change * rows[k].inertiaCb;
+      }
+    }
+    if (largest <= tolerance) break;
+  }
+  double violation = 0;
+  for (std::size_t k = 0; k < points.size(); ++k) violation = std::max(violation, points[k].depth - gained(k));
+  return violation;
+}
+
+template double solveJointPushOut<2>(const std::vector<JointBody<2>>&, const std::vector<JointPoint<2>>&, int, double,
+                                     std::vector<JointMove<2>>&);
+template double solveJointPushOut<3>(const std::vector<JointBody<3>>&, const std::vector<JointPoint<3>>&, int, double,
+                                     std::vector<JointMove<3>>&);
+
+}  // namespace monolith::solvers::contact
