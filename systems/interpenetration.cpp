@@ -395,8 +395,9 @@ int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newP
   // the broad phase grows after each pass). Points within `reach` of touching are constraints
   // too, so that the bodies are not pushed into neighbours that did not overlap yet. No point of
   // a body moves by more than twice `reach` in a pass (a light, thin body turns cheaply in the
-  // solve's metric, and a large turn is far from its linearisation), and a pass that leaves the
-  // jam deeper than the pass before is undone and ends the solve.
+  // solve's metric, and a large turn is far from its linearisation); a pass that leaves the jam
+  // no shallower than the pass before is tried again at half the step, three times, and then
+  // undone, which ends the solve.
   std::vector<col::ContactPoint<d>> scratch;
   col::ContactQuery query;
   query.margin = reach;
@@ -429,18 +430,26 @@ int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newP
       const con::JointMove<d>& m = jamMoves_[jamIndex_[saved.body]];
       largest = std::max(largest, m.dx.norm() + m.dtheta.norm() * ws.bodies[saved.body].geometry->boundingRadius());
     }
-    const double scale = largest > 2 * reach ? 2 * reach / largest : 1.0;
     passStart_.clear();
     for (const SavedPose& saved : savedPoses_) {
-      ContactBody<d>& B = ws.bodies[saved.body];
+      const ContactBody<d>& B = ws.bodies[saved.body];
       passStart_.push_back({saved.body, B.x0, B.q0});
-      const con::JointMove<d>& m = jamMoves_[jamIndex_[saved.body]];
-      setBasePose<d>(B, B.x0 + scale * m.dx, rotatedBy<d>(B.q0, con::AngVec<d>(scale * m.dtheta)));
     }
-    newPairs += growAndMeasure(ws);
-    double worst = 0;
-    for (std::size_t k = 0; k < ws.pairs.size(); ++k)
-      if (moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]) worst = std::max(worst, ratio_[k]);
+    // Backtracking: the full step (within the bound above), else half of it, a quarter, an
+    // eighth, while the jam ends no shallower.
+    double scale = largest > 2 * reach ? 2 * reach / largest : 1.0;
+    double worst = worstNow;
+    for (int attempt = 0; attempt < kJointHalvings + 1; ++attempt, scale *= 0.5) {
+      for (const SavedPose& start : passStart_) {
+        const con::JointMove<d>& m = jamMoves_[jamIndex_[start.body]];
+        setBasePose<d>(ws.bodies[start.body], start.x + scale * m.dx, rotatedBy<d>(start.q, con::AngVec<d>(scale * m.dtheta)));
+      }
+      newPairs += growAndMeasure(ws);
+      worst = 0;
+      for (std::size_t k = 0; k < ws.pairs.size(); ++k)
+        if (moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]) worst = std::max(worst, ratio_[k]);
+      if (worst < worstNow) break;
+    }
     if (!(worst < worstNow)) {
       for (const SavedPose& p : passStart_) setBasePose<d>(ws.bodies[p.body], p.x, p.q);
       measurePairs(ws, [&](std::size_t k) { return moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]; });

@@ -145,6 +145,7 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   // by pass while each leaves its pairs shallower. Returns the passes kept; adds to newPairs.
   int pushJamsApart(ContactWorkspace<d>& ws, int& newPairs);
   static constexpr int kJointPasses = 16;  // linearisations, at most
+  static constexpr int kJointHalvings = 3;  // of a pass's step that leaves the jam no shallower
   static constexpr int kJointRings = 2;    // neighbours of neighbours of the deep pairs' bodies
   std::vector<char> jamRing_;              // the jam before a ring is added
   static constexpr int kJointSweeps = 2000;  // Gauss-Seidel sweeps per linearisation, at most
