@@ -3,6 +3,7 @@
 // dBoxBox and fcl::distance, which they replace for box pairs (narrow_phase_3d.cpp). In a box
 // pyramid every pair is a box pair, queried ~56 times per step; FCL's general machinery (request
 // and result objects, GJK for the distance) cost several times the geometry itself.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <type_traits>
@@ -81,40 +82,60 @@ int cull(ClipVertex* points, int n, int cap) {
   return m;
 }
 
-int faceContacts(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& b, const Pose<3>& poseB,
-                 const BoxBoxAxis& axis, std::vector<ContactPoint<3>>& out) {
-  // Reference box: the one whose face normal is the axis; nRef points out of it.
+// A face axis's reference face (of the box whose face normal the axis is; nRef out of it) and
+// the other box's incident face in its coordinates: the polygon faceContacts clips.
+struct FacePair {
+  Vec3 nRef, e1, e2, faceCentre;
+  double limit1 = 0, limit2 = 0;  // the reference face's half extents along e1, e2
+  ClipVertex polygon[4];
+};
+
+FacePair facePair(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& b, const Pose<3>& poseB,
+                  const BoxBoxAxis& axis) {
+  FacePair f;
   const bool refIsA = axis.code < 3;
   const Pose<3>& ref = refIsA ? poseA : poseB;
   const Pose<3>& inc = refIsA ? poseB : poseA;
   const Vec3& hRef = refIsA ? a.halfExtents : b.halfExtents;
   const Vec3& hInc = refIsA ? b.halfExtents : a.halfExtents;
   const int k = refIsA ? axis.code : axis.code - 3;
-  const Vec3 nRef = refIsA ? Vec3(-axis.normal) : axis.normal;
+  f.nRef = refIsA ? Vec3(-axis.normal) : axis.normal;
   const int u1 = (k + 1) % 3, u2 = (k + 2) % 3;
-  const Vec3 e1 = ref.R.col(u1), e2 = ref.R.col(u2);
-  const Vec3 faceCentre = ref.x + hRef[k] * nRef;
+  f.e1 = ref.R.col(u1);
+  f.e2 = ref.R.col(u2);
+  f.limit1 = hRef[u1];
+  f.limit2 = hRef[u2];
+  f.faceCentre = ref.x + hRef[k] * f.nRef;
   // Incident face: the face of the other box whose outward normal opposes nRef most.
   int m = 0;
   double best = -1;
   for (int j = 0; j < 3; ++j) {
-    const double c = std::abs(inc.R.col(j).dot(nRef));
+    const double c = std::abs(inc.R.col(j).dot(f.nRef));
     if (c > best) best = c, m = j;
   }
-  const double s = -sign(inc.R.col(m).dot(nRef));
+  const double s = -sign(inc.R.col(m).dot(f.nRef));
   const int i1 = (m + 1) % 3, i2 = (m + 2) % 3;
   const Vec3 incCentre = inc.x + s * hInc[m] * inc.R.col(m);
   const Vec3 f1 = hInc[i1] * inc.R.col(i1), f2 = hInc[i2] * inc.R.col(i2);
-  ClipVertex polygon[8], scratch[8];
   int n = 0;
   for (const auto& c : {std::array<double, 2>{1, 1}, {-1, 1}, {-1, -1}, {1, -1}}) {
-    const Vec3 v = incCentre + c[0] * f1 + c[1] * f2 - faceCentre;
-    polygon[n++] = {v.dot(e1), v.dot(e2), -v.dot(nRef)};
+    const Vec3 v = incCentre + c[0] * f1 + c[1] * f2 - f.faceCentre;
+    f.polygon[n++] = {v.dot(f.e1), v.dot(f.e2), -v.dot(f.nRef)};
   }
-  n = clip(polygon, n, 0, 1, hRef[u1], scratch);
-  n = clip(scratch, n, 0, -1, hRef[u1], polygon);
-  n = clip(polygon, n, 1, 1, hRef[u2], scratch);
-  n = clip(scratch, n, 1, -1, hRef[u2], polygon);
+  return f;
+}
+
+int faceContacts(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& b, const Pose<3>& poseB,
+                 const BoxBoxAxis& axis, std::vector<ContactPoint<3>>& out) {
+  const FacePair f = facePair(a, poseA, b, poseB, axis);
+  const Vec3 &nRef = f.nRef, &e1 = f.e1, &e2 = f.e2, &faceCentre = f.faceCentre;
+  ClipVertex polygon[8], scratch[8];
+  int n = 4;
+  std::copy(f.polygon, f.polygon + 4, polygon);
+  n = clip(polygon, n, 0, 1, f.limit1, scratch);
+  n = clip(scratch, n, 0, -1, f.limit1, polygon);
+  n = clip(polygon, n, 1, 1, f.limit2, scratch);
+  n = clip(scratch, n, 1, -1, f.limit2, polygon);
   int kept = 0;
   for (int i = 0; i < n; ++i)
     if (polygon[i].depth >= 0) polygon[kept++] = polygon[i];
@@ -128,6 +149,17 @@ int faceContacts(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& 
     out.push_back(c);
   }
   return kept;
+}
+
+// Whether a corner of the incident face survives faceContacts' clipping and depth test: inside
+// the reference face's rectangle by the clip's own comparisons (a vertex on an edge is kept) and
+// at or below the face. Then faceContacts reports at least one point.
+bool cornerInFace(const FacePair& f) {
+  for (const ClipVertex& v : f.polygon)
+    if (1 * v.x - f.limit1 <= 0 && -1 * v.x - f.limit1 <= 0 && 1 * v.y - f.limit2 <= 0 && -1 * v.y - f.limit2 <= 0 &&
+        v.depth >= 0)
+      return true;
+  return false;
 }
 
 int edgeContact(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& b, const Pose<3>& poseB,
@@ -311,6 +343,15 @@ BoxBoxAxis boxBoxAxis(const Geometry<3>& a, const Pose<3>& poseA, const Geometry
   // Apart: report the largest gap (a lower bound on the distance); the axis is then irrelevant.
   if (separation > 0) best.separation = separation;
   return best;
+}
+
+bool boxBoxContactsExist(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& b, const Pose<3>& poseB,
+                         const BoxBoxAxis& axis, std::vector<ContactPoint<3>>& scratch) {
+  if (!(axis.separation <= 0) || axis.code < 0) return false;
+  if (axis.code >= 6) return true;  // an edge pair gives its one point
+  if (cornerInFace(facePair(a, poseA, b, poseB, axis))) return true;
+  scratch.clear();
+  return faceContacts(a, poseA, b, poseB, axis, scratch) > 0;
 }
 
 int boxBoxContacts(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& b, const Pose<3>& poseB,

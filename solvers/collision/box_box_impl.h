@@ -37,6 +37,11 @@ BoxBoxAxis boxBoxAxis(const Geometry<3>& a, const Pose<3>& poseA, const Geometry
 int boxBoxContacts(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& b, const Pose<3>& poseB,
                    const BoxBoxAxis& axis, std::vector<ContactPoint<3>>& out);
 
+// Whether boxBoxContacts would report any point, without computing them all where a corner of
+// the incident face already lies inside the reference face (scratch: for the full clip else).
+bool boxBoxContactsExist(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& b, const Pose<3>& poseB,
+                         const BoxBoxAxis& axis, std::vector<ContactPoint<3>>& scratch);
+
 // Nearest points of two boxes the axis test found apart (axis.separation > 0), exactly: the least
 // of the vertex-to-box distances both ways and, unless a vertex already reaches the axis' gap
 // (a lower bound on the distance, reached in face contacts), of the edge-to-edge distances.

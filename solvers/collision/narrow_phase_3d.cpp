@@ -107,11 +107,14 @@ enum class BoxMain { None, Clipped, Nearest };
 // clipping (box_box.cpp) instead of FCL's dBoxBox; apart but within the margin, one contact
 // between the exact nearest points instead of fcl::distance. None: farther apart than the margin
 // (then neither could the feature points find anything), or nothing within it.
+// touchOnly: only whether there is a main contact matters (`main` may be left incomplete).
 BoxMain boxBoxMain(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb, double margin, BoxBoxAxis& sat,
-                   std::vector<CP>& main) {
+                   std::vector<CP>& main, bool touchOnly = false) {
   sat = boxBoxAxis(a.geometry(), pa, b.geometry(), pb, margin);
   if (sat.separation > margin) return BoxMain::None;
-  if (boxBoxContacts(a.geometry(), pa, b.geometry(), pb, sat, main) > 0) return BoxMain::Clipped;
+  if (touchOnly ? boxBoxContactsExist(a.geometry(), pa, b.geometry(), pb, sat, main)
+                : boxBoxContacts(a.geometry(), pa, b.geometry(), pb, sat, main) > 0)
+    return BoxMain::Clipped;
   if (!(margin > 0)) return BoxMain::None;
   Vec3 onA, onB;
   CP c;
@@ -284,7 +287,7 @@ bool touches3(const PG& a, const Pose<3>& poseA, const PG& b, const Pose<3>& pos
     Scratch& s = scratch();
     s.main.clear();
     BoxBoxAxis sat;
-    return boxBoxMain(a, poseA, b, poseB, margin, sat, s.main) != BoxMain::None;
+    return boxBoxMain(a, poseA, b, poseB, margin, sat, s.main, /*touchOnly=*/true) != BoxMain::None;
   }
   thread_local std::vector<CP> found;
   found.clear();
