@@ -55,6 +55,12 @@ void setBasePose(ContactBody<d>& b, const Eigen::Matrix<double, d, 1>& x, const 
   b.candidate.R = b.R0;
 }
 
+// Where the broad phase looks for a body in push-out: its current (candidate) pose.
+template <int d>
+std::array<col::Pose<d>, 1> candidatePoseOf(const ContactBody<d>& b) {
+  return {b.candidate};
+}
+
 }  // namespace
 
 template <int d>
@@ -332,7 +338,7 @@ int ResolveInterpenetration<d>::growAndMeasure(ContactWorkspace<d>& ws) {
   for (const ContactPairState& p : ws.pairs) knownPairs_.emplace_back(p.a, p.b);
   knownDepth_ = depth_;
   knownRatio_ = ratio_;
-  const int added = ws.growPairs([](const ContactBody<d>& b) { return std::array<col::Pose<d>, 1>{b.candidate}; });
+  const int added = ws.growPairs(candidatePoseOf<d>);
   knownIndex_.resize(ws.pairs.size());
   for (std::size_t k = 0, j = 0; k < ws.pairs.size(); ++k) {
     const bool known = j < knownPairs_.size() && knownPairs_[j] == std::make_pair(ws.pairs[k].a, ws.pairs[k].b);
@@ -376,20 +382,24 @@ int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newP
   }
   jamIndex_.assign(n, -1);
   jamBodies_.clear();
-  savedPoses_.clear();
+  passStart_.clear();  // the jam's bodies, and their poses before each pass
   for (std::size_t b = 0; b < n; ++b) {
     if (!moved_[b]) continue;
-    const ContactBody<d>& B = ws.bodies[b];
     jamIndex_[b] = static_cast<int>(jamBodies_.size());
     con::JointBody<d> body;
-    body.inverseMass = B.inverseMass();
-    body.inverseInertia = B.inverseInertia0;
+    body.inverseMass = ws.bodies[b].inverseMass();
+    body.inverseInertia = ws.bodies[b].inverseInertia0;
     jamBodies_.push_back(body);
-    savedPoses_.push_back({static_cast<int>(b), B.x0, B.q0});
+    passStart_.push_back({static_cast<int>(b), ws.bodies[b].x0, ws.bodies[b].q0});
   }
-  double worstBefore = 0;
-  for (std::size_t k = 0; k < ws.pairs.size(); ++k)
-    if (moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]) worstBefore = std::max(worstBefore, ratio_[k]);
+  const auto inJam = [&](std::size_t k) { return moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]; };
+  const auto deepestInJam = [&] {
+    double worst = 0;
+    for (std::size_t k = 0; k < ws.pairs.size(); ++k)
+      if (inJam(k)) worst = std::max(worst, ratio_[k]);
+    return worst;
+  };
+  double worstNow = deepestInJam();
   // Linearised at the current poses, solved, applied; again from where that left the bodies
   // (the rotations are first order, and a body may have come near one it was not paired with:
   // the broad phase grows after each pass). Points within `reach` of touching are constraints
@@ -402,11 +412,11 @@ int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newP
   col::ContactQuery query;
   query.margin = reach;
   int passes = 0;
-  double worstNow = worstBefore;
   for (int pass = 0; pass < kJointPasses; ++pass) {
     jamPoints_.clear();
-    for (const ContactPairState& p : ws.pairs) {
-      if (!(moved_[p.a] || moved_[p.b])) continue;
+    for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
+      if (!inJam(k)) continue;
+      const ContactPairState& p = ws.pairs[k];
       const ContactBody<d>& A = ws.bodies[p.a];
       const ContactBody<d>& B = ws.bodies[p.b];
       if (A.infinite() && B.infinite()) continue;
@@ -426,14 +436,12 @@ int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newP
     if (jamPoints_.empty()) break;
     con::solveJointPushOut<d>(jamBodies_, jamPoints_, kJointSweeps, 1e-3 * s.pushOutTolerance, jamMoves_);
     double largest = 0;
-    for (const SavedPose& saved : savedPoses_) {
-      const con::JointMove<d>& m = jamMoves_[jamIndex_[saved.body]];
-      largest = std::max(largest, m.dx.norm() + m.dtheta.norm() * ws.bodies[saved.body].geometry->boundingRadius());
-    }
-    passStart_.clear();
-    for (const SavedPose& saved : savedPoses_) {
-      const ContactBody<d>& B = ws.bodies[saved.body];
-      passStart_.push_back({saved.body, B.x0, B.q0});
+    for (SavedPose& start : passStart_) {
+      const ContactBody<d>& B = ws.bodies[start.body];
+      start.x = B.x0;
+      start.q = B.q0;
+      const con::JointMove<d>& m = jamMoves_[jamIndex_[start.body]];
+      largest = std::max(largest, m.dx.norm() + m.dtheta.norm() * B.geometry->boundingRadius());
     }
     // Backtracking: the full step (within the bound above), else half of it, a quarter, an
     // eighth, while the jam ends no shallower.
@@ -445,14 +453,12 @@ int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newP
         setBasePose<d>(ws.bodies[start.body], start.x + scale * m.dx, rotatedBy<d>(start.q, con::AngVec<d>(scale * m.dtheta)));
       }
       newPairs += growAndMeasure(ws);
-      worst = 0;
-      for (std::size_t k = 0; k < ws.pairs.size(); ++k)
-        if (moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]) worst = std::max(worst, ratio_[k]);
+      worst = deepestInJam();
       if (worst < worstNow) break;
     }
     if (!(worst < worstNow)) {
       for (const SavedPose& p : passStart_) setBasePose<d>(ws.bodies[p.body], p.x, p.q);
-      measurePairs(ws, [&](std::size_t k) { return moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]; });
+      measurePairs(ws, inJam);
       break;
     }
     worstNow = worst;
@@ -473,11 +479,10 @@ void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
   for (auto& b : ws.bodies)
     if (!b.isStatic) setBasePose<d>(b, b.body->x, b.body->orientation);
   const ContactSettings& s = ws.settings;
-  const auto candidatePoses = [](const ContactBody<d>& b) { return std::array<col::Pose<d>, 1>{b.candidate}; };
 
   // The pairs where Step IV put the bodies (Step III's impulses moved them too), then those that
   // overlap there though Step II did not process them.
-  int newPairs = ws.growPairs(candidatePoses);
+  int newPairs = ws.growPairs(candidatePoseOf<d>);
   // Every pair's deepest overlap where Step IV put the bodies (the queries only read: in
   // parallel, each in its own slot). It finds the pairs Step II did not process that overlap
   // (newOverlap_), the islands with nothing to push apart (skipped below: every task there

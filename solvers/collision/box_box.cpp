@@ -156,8 +156,7 @@ int faceContacts(const Geometry<3>& a, const Pose<3>& poseA, const Geometry<3>& 
 // at or below the face. Then faceContacts reports at least one point.
 bool cornerInFace(const FacePair& f) {
   for (const ClipVertex& v : f.polygon)
-    if (1 * v.x - f.limit1 <= 0 && -1 * v.x - f.limit1 <= 0 && 1 * v.y - f.limit2 <= 0 && -1 * v.y - f.limit2 <= 0 &&
-        v.depth >= 0)
+    if (v.x - f.limit1 <= 0 && -v.x - f.limit1 <= 0 && v.y - f.limit2 <= 0 && -v.y - f.limit2 <= 0 && v.depth >= 0)
       return true;
   return false;
 }

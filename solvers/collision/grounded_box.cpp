@@ -40,6 +40,12 @@ Eigen::Matrix<double, d, 1> extendBoxThroughGround(Geometry<d>& box, const Pose<
   const VecD given = box.halfExtents;
   const double reach = 2 * given.maxCoeff();  // before any extension: the box's own size
   Eigen::Matrix<bool, d, 1> extended = Eigen::Matrix<bool, d, 1>::Constant(false);
+  // Body axis i reaches `length` further out of the face at -sign h_i; the opposite face stays.
+  auto extend = [&](int i, double sign, double length) {
+    box.halfExtents(i) = given(i) + 0.5 * length;
+    shift(i) = -sign * 0.5 * length;
+    extended(i) = true;
+  };
   for (const HalfSpaceInWorld<d>& ground : grounds) {
     const double height = ground.normal.dot(pose.x - ground.point);  // of the centre
     if (!(height > 0)) continue;
@@ -49,11 +55,8 @@ Eigen::Matrix<double, d, 1> extendBoxThroughGround(Geometry<d>& box, const Pose<
       const double sign = along > 0 ? 1.0 : -1.0;
       // The face whose outward normal points into the ground (body coordinate -sign h_i), and
       // how far above the plane it lies.
-      const double h = given(i);
-      if (height - h > tolerance) continue;
-      box.halfExtents(i) = h + 0.5 * reach;
-      shift(i) = -sign * 0.5 * reach;
-      extended(i) = true;
+      if (height - given(i) > tolerance) continue;
+      extend(i, sign, reach);
     }
   }
   const double radius = given.norm();
@@ -74,10 +77,7 @@ Eigen::Matrix<double, d, 1> extendBoxThroughGround(Geometry<d>& box, const Pose<
         if (!footprintInside<d>(given, pose, i, sign, support, j, tolerance)) continue;
         // Down to the support's far face at most: the extension stays inside the support.
         const double length = std::min(reach, bottom + 2 * support.halfExtents(j));
-        if (!(length > 0)) continue;
-        box.halfExtents(i) = given(i) + 0.5 * length;
-        shift(i) = -sign * 0.5 * length;
-        extended(i) = true;
+        if (length > 0) extend(i, sign, length);
       }
     }
   }

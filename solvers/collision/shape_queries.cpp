@@ -237,6 +237,17 @@ void featureContacts(const PreparedGeometry<d>& f, const Pose<d>& poseF, const V
   rel.R = poseS.R.transpose() * poseF.R;
   rel.x = poseS.R.transpose() * (poseF.x - poseS.x);
   const auto& bounds = s.impl().localBounds;
+  // The contact of a point onF of F against S, whose surface lies as sd says: midway between
+  // the two surfaces, with S's normal, negated when S is A
+  // (normals point out of B).
+  auto emit = [&](const SurfaceDistance<d>& sd, double depth, const Vec<d>& onF) {
+    const Vec<d> n = poseS.R * sd.normal;
+    ContactPoint<d> c;
+    c.point = poseS.R * (0.5 * (sd.surfacePoint + onF)) + poseS.x;
+    c.normal = shapeIsA ? Vec<d>(-n) : n;
+    c.depth = depth;
+    out.push_back(c);
+  };
   const GeometryType typeF = f.geometry().type;
   if (typeF == GeometryType::Box || typeF == GeometryType::Convex || typeF == GeometryType::Mesh) {
     // Plain vertices (no radius, no end axis): every box pair of a pile comes here twice per
@@ -249,13 +260,7 @@ void featureContacts(const PreparedGeometry<d>& f, const Pose<d>& poseF, const V
       const SurfaceDistance<d> sd = signedDistance<d>(s, x, margin + 0.0);
       const double depth = 0.0 - sd.distance;
       if (!(depth >= -margin)) continue;
-      const Vec<d> onF = x - 0.0 * sd.normal;
-      const Vec<d> n = poseS.R * sd.normal;
-      ContactPoint<d> c;
-      c.point = poseS.R * (0.5 * (sd.surfacePoint + onF)) + poseS.x;
-      c.normal = shapeIsA ? Vec<d>(-n) : n;
-      c.depth = depth;
-      out.push_back(c);
+      emit(sd, depth, x - 0.0 * sd.normal);
     }
     return;
   }
@@ -284,13 +289,7 @@ void featureContacts(const PreparedGeometry<d>& f, const Pose<d>& poseF, const V
       depth = -sd.distance;
       if (!(depth >= -margin)) continue;
     }
-    const Vec<d> n = poseS.R * sd.normal;
-    const Vec<d> onS = sd.surfacePoint;
-    ContactPoint<d> c;
-    c.point = poseS.R * (0.5 * (onS + onF)) + poseS.x;
-    c.normal = shapeIsA ? Vec<d>(-n) : n;
-    c.depth = depth;
-    out.push_back(c);
+    emit(sd, depth, onF);
   }
 }
 

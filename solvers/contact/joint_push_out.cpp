@@ -127,42 +127,36 @@ double solveJointPushOut(const std::vector<JointBody<d>>& bodies, const std::vec
     if (p.b >= 0) s -= p.n.dot(moves[p.b].dx) + rows[k].cb.dot(moves[p.b].dtheta);
     return s;
   };
+  // A change of point k's multiplier, moved into the bodies (dx = M^{-1} J^T dlambda).
+  auto apply = [&](std::size_t k, double change) {
+    const JointPoint<d>& p = points[k];
+    if (p.a >= 0) {
+      moves[p.a].dx += change * bodies[p.a].inverseMass * p.n;
+      moves[p.a].dtheta += change * rows[k].inertiaCa;
+    }
+    if (p.b >= 0) {
+      moves[p.b].dx -= change * bodies[p.b].inverseMass * p.n;
+      moves[p.b].dtheta -= change * rows[k].inertiaCb;
+    }
+  };
   std::vector<double> lambda(points.size(), 0.0);
   if (points.size() <= static_cast<std::size_t>(kDenseJointPoints)) {
     solveDense<d>(bodies, points, rows, lambda);
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      const JointPoint<d>& p = points[k];
-      if (p.a >= 0) {
-        moves[p.a].dx += lambda[k] * bodies[p.a].inverseMass * p.n;
-        moves[p.a].dtheta += lambda[k] * rows[k].inertiaCa;
+    for (std::size_t k = 0; k < points.size(); ++k) apply(k, lambda[k]);
+  } else {
+    for (int sweep = 0; sweep < sweeps; ++sweep) {
+      double largest = 0;  // the largest correction of a point's separation in this sweep
+      for (std::size_t k = 0; k < points.size(); ++k) {
+        if (!(rows[k].inverseMass > 0)) continue;
+        const double next = std::max(0.0, lambda[k] + (points[k].depth - gained(k)) * rows[k].inverseMass);
+        const double change = next - lambda[k];
+        if (change == 0) continue;
+        largest = std::max(largest, std::abs(change) / rows[k].inverseMass);
+        lambda[k] = next;
+        apply(k, change);
       }
-      if (p.b >= 0) {
-        moves[p.b].dx -= lambda[k] * bodies[p.b].inverseMass * p.n;
-        moves[p.b].dtheta -= lambda[k] * rows[k].inertiaCb;
-      }
+      if (largest <= tolerance) break;
     }
-    sweeps = 0;
-  }
-  for (int sweep = 0; sweep < sweeps; ++sweep) {
-    double largest = 0;  // the largest correction of a point's separation in this sweep
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      const JointPoint<d>& p = points[k];
-      if (!(rows[k].inverseMass > 0)) continue;
-      const double next = std::max(0.0, lambda[k] + (p.depth - gained(k)) * rows[k].inverseMass);
-      const double change = next - lambda[k];
-      if (change == 0) continue;
-      largest = std::max(largest, std::abs(change) / rows[k].inverseMass);
-      lambda[k] = next;
-      if (p.a >= 0) {
-        moves[p.a].dx += change * bodies[p.a].inverseMass * p.n;
-        moves[p.a].dtheta += change * rows[k].inertiaCa;
-      }
-      if (p.b >= 0) {
-        moves[p.b].dx -= change * bodies[p.b].inverseMass * p.n;
-        moves[p.b].dtheta -= change * rows[k].inertiaCb;
-      }
-    }
-    if (largest <= tolerance) break;
   }
   double violation = 0;
   for (std::size_t k = 0; k < points.size(); ++k) violation = std::max(violation, points[k].depth - gained(k));

@@ -80,6 +80,21 @@ TEST(JointPushOut, APointAlreadyApartOnlyStopsAnApproach) {
   EXPECT_NEAR(moves[0].dx.x(), -0.15, 1e-9);
 }
 
+TEST(JointPushOut, AChainTooLongForTheExactSolveIsSolvedBySweeps) {
+  // Wall | A_0 | ... | A_99 along x, each 1 cm into the one before (100 points: beyond the exact
+  // solve's 96, so Gauss-Seidel sweeps): A_i moves (i + 1) cm, as little as the chain allows.
+  std::vector<JointBody<2>> bodies;
+  std::vector<JointPoint<2>> points;
+  const Eigen::Vector2d x = Eigen::Vector2d::UnitX();
+  for (int i = 0; i < 100; ++i) {
+    bodies.push_back(body<2>(1, 1));
+    points.push_back(point<2>(i, i - 1, -0.5 * x, i == 0 ? Eigen::Vector2d::Zero() : Eigen::Vector2d(0.5 * x), x, 0.01));
+  }
+  std::vector<JointMove<2>> moves;
+  EXPECT_LT(solveJointPushOut<2>(bodies, points, kSweeps, 1e-15, moves), 1e-9);
+  for (int i = 0; i < 100; ++i) EXPECT_NEAR(moves[i].dx.x(), 0.01 * (i + 1), 1e-9) << i;
+}
+
 namespace {
 
 // The same program solved by brute force: every subset of the points taken as tight, its
