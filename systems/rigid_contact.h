@@ -147,7 +147,7 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   static constexpr int kJointPasses = 16;  // linearisations, at most
   static constexpr int kJointHalvings = 3;  // of a pass's step that leaves the jam no shallower
   static constexpr int kJointRings = 2;    // neighbours of neighbours of the deep pairs' bodies
-  std::vector<char> jamRing_;              // the jam before a ring is added
+  std::vector<char> jamRing_, jamNext_;    // the bodies a ring grows from, and those it adds
   static constexpr int kJointSweeps = 2000;  // Gauss-Seidel sweeps per linearisation, at most
   std::vector<int> jamIndex_;  // per body: its index in the joint solve, or -1 (a fixed partner)
   std::vector<solvers::contact::JointBody<d>> jamBodies_;
