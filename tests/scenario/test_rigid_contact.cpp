@@ -499,6 +499,25 @@ TEST(JointPushOut, AJamThatTheRoundsLeaveDeepIsPushedApartAtOnce) {
   EXPECT_GT(passes, 0);
 }
 
+TEST(JointPushOut, ABodyWithinReachOfAJamGivesWay) {
+  // random_drop_2d_385, the first 35 steps. With the code of 64f07ff, whose jam took in only
+  // the bodies overlapping it, steps 10, 11 and 35 ended 23-37 % deep; at step 35 a needle 2.5 cm into a light disk in
+  // the corner of the wall and the ground, a second disk 2.9 cm off the needle's other side
+  // along the same normal. That disk did not overlap, so it stayed fixed, no translation fitted,
+  // and every scaled step of the linearised solve (a 13 rad turn) made the jam deeper. Now the
+  // jam takes in the bodies within its deepest overlap of touching it, and grows between passes.
+  const Registry registry = builtins();
+  Simulation<2> sim(loadScene(kScenes + "random_drop_2d_385.json"), registry);
+  double deepest = 0, passes = 0;
+  for (int step = 0; step < 35; ++step) {
+    const auto diag = sim.step();
+    deepest = std::max(deepest, diag.at("max_penetration_ratio"));
+    passes += diag.at("push_out_joint_passes");
+  }
+  EXPECT_LT(deepest, 0.05);  // measured 1.8 % (step 26)
+  EXPECT_GT(passes, 0);      // the jam solve did run
+}
+
 TEST(PushOutNewOverlaps, APushIntoAnUntouchedNeighbourIsUndoneInTheSameStep) {
   // No gravity, no motion. Sphere C is sunk 5 cm into the static box A; box D sits 1.08 cm above
   // C's shoulder, inside C's bounding box (so the pair is in the broad phase) but not touching,
