@@ -368,7 +368,7 @@ int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newP
   jamBodies_.clear();
   passStart_.clear();  // the jam's bodies, and their poses before each pass
   double reach = 0;     // the deepest of the first deep overlaps: about how far a body moves
-  std::vector<col::ContactPoint<d>> scratch;
+  std::vector<col::ContactPoint<d>>& scratch = jamContacts_;
   col::ContactQuery query;
   // Adds the deep pairs' dynamic bodies (all deep pairs the first time; later, those with a body
   // already in the jam: a pass may have pushed a jam body deep into a fixed partner) and their

@@ -153,6 +153,7 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   std::vector<solvers::contact::JointBody<d>> jamBodies_;
   std::vector<solvers::contact::JointPoint<d>> jamPoints_;
   std::vector<solvers::contact::JointMove<d>> jamMoves_;
+  std::vector<solvers::collision::ContactPoint<d>> jamContacts_;  // one pair's narrow phase, kept
   std::vector<SavedPose> passStart_;  // the jam's bodies and their poses before a pass, to undo it
   std::vector<char> newOverlap_;  // per pair: not processed in Step II, yet overlapping now (or tied)
   std::vector<int> pairLevel_;    // per pair: its level in push-out
