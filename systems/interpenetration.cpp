@@ -368,8 +368,6 @@ int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newP
   jamBodies_.clear();
   passStart_.clear();  // the jam's bodies, and their poses before each pass
   double reach = 0;     // the deepest of the first deep overlaps: about how far a body moves
-  std::vector<col::ContactPoint<d>>& scratch = jamContacts_;
-  col::ContactQuery query;
   // Adds the deep pairs' dynamic bodies (all deep pairs the first time; later, those with a body
   // already in the jam: a pass may have pushed a jam body deep into a fixed partner) and their
   // rings. Returns whether the jam grew.
@@ -385,7 +383,6 @@ int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newP
         if (!ws.bodies[b].infinite() && !moved_[b]) moved_[b] = jamRing_[b] = 1, grew = true;
     }
     if (!grew) return false;
-    query.margin = reach;
     for (int ring = 0; ring < kJointRings; ++ring) {
       jamNext_.assign(n, 0);
       bool ringGrew = false;
@@ -393,14 +390,9 @@ int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newP
         const ContactPairState& p = ws.pairs[k];
         const bool fromA = jamRing_[p.a] && !moved_[p.b], fromB = jamRing_[p.b] && !moved_[p.a];
         if (!(fromA || fromB) || ws.bodies[p.a].infinite() || ws.bodies[p.b].infinite()) continue;
-        bool near = depth_[k] > 0;
-        if (!near) {
-          const ContactBody<d>& A = ws.bodies[p.a];
-          const ContactBody<d>& B = ws.bodies[p.b];
-          scratch.clear();
-          near = col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, query, scratch) > 0;
-        }
-        if (!near) continue;
+        const ContactBody<d>& A = ws.bodies[p.a];
+        const ContactBody<d>& B = ws.bodies[p.b];
+        if (!(depth_[k] > 0) && !col::touches(*A.geometry, A.candidate, *B.geometry, B.candidate, reach)) continue;
         jamNext_[fromA ? p.b : p.a] = 1;
         ringGrew = true;
       }
@@ -421,6 +413,9 @@ int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newP
     return true;
   };
   if (!growJam(true)) return 0;
+  std::vector<col::ContactPoint<d>>& scratch = jamContacts_;
+  col::ContactQuery query;
+  query.margin = reach;  // the passes' points: overlapping, or within reach of touching
   const auto inJam = [&](std::size_t k) { return moved_[ws.pairs[k].a] || moved_[ws.pairs[k].b]; };
   const auto deepestInJam = [&] {
     double worst = 0;
@@ -440,7 +435,6 @@ int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newP
   int passes = 0;
   for (int pass = 0; pass < kJointPasses; ++pass) {
     if (pass > 0 && growJam(false)) worstNow = deepestInJam();
-    query.margin = reach;
     jamPoints_.clear();
     for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
       if (!inJam(k)) continue;
