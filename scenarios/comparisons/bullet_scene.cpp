@@ -10,9 +10,11 @@
 // per-step figures would not compare (`--sleep` turns Bullet's default deactivation back on).
 //
 // Prints one row per run: us/step, the largest distance of a dynamic body from its start after
-// the run, the final kinetic energy, and the deepest contact penetration over the smaller body's
+// the run, the final kinetic energy, the deepest contact penetration over the smaller body's
 // size at any step (Bullet's own contact distances, measured at the start of each step, i.e. on
-// the state the step before produced) — the columns of bench_rigid_contact's tables.
+// the state the step before produced) — the columns of bench_rigid_contact's tables — and the
+// largest rise of the total energy (kinetic + gravity's potential) over its initial value after
+// any step, relative to that value (issue 3's rule: at most 0.1 %).
 //
 // usage: compare_bullet SCENE.json [--dt 1/60|SECONDS] [--end SECONDS] [--iterations N] [--sleep] [--ccd]
 //   --ccd: Bullet's continuous collision detection on every dynamic body (off by default, as in
@@ -247,6 +249,21 @@ int main(int argc, char** argv) {
     world.addRigidBody(scene.bodies[i].get());
   }
 
+  // Kinetic and total (kinetic + gravity's potential) energy of the dynamic bodies.
+  const auto energies = [&] {
+    double kinetic = 0, potential = 0;
+    for (const auto& body : scene.bodies) {
+      if (body->getInvMass() == 0) continue;
+      const double m = 1 / double(body->getInvMass());
+      const btVector3 v = body->getLinearVelocity(), w = body->getAngularVelocity();
+      kinetic += 0.5 * m * double(v.length2()) + 0.5 * double(w.dot(body->getInvInertiaTensorWorld().inverse() * w));
+      potential -= m * double(scene.gravity.dot(body->getCenterOfMassPosition()));
+    }
+    return std::make_pair(kinetic, kinetic + potential);
+  };
+  const double initialEnergy = energies().second;
+  double highestEnergy = initialEnergy;
+
   const long steps = std::lround(scene.end / scene.dt);
   double wall = 0, penetration = 0;
   for (long n = 0; n < steps; ++n) {
@@ -260,25 +277,25 @@ int main(int argc, char** argv) {
       for (int p = 0; p < manifold->getNumContacts(); ++p)
         penetration = std::max(penetration, -double(manifold->getContactPoint(p).getDistance()) / size);
     }
+    highestEnergy = std::max(highestEnergy, energies().second);
   }
-  double drift = 0, kinetic = 0;
+  double drift = 0;
   int dynamic = 0;
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const btRigidBody& b = *scene.bodies[i];
     if (b.getInvMass() == 0) continue;
     ++dynamic;
     drift = std::max(drift, double((b.getCenterOfMassPosition() - scene.start[i]).length()));
-    const btVector3 v = b.getLinearVelocity(), w = b.getAngularVelocity();
-    const btVector3 Iw = b.getInvInertiaTensorWorld().inverse() * w;
-    kinetic += 0.5 * double(v.length2()) / double(b.getInvMass()) + 0.5 * double(w.dot(Iw));
   }
+  const double kinetic = energies().first;
   for (auto& b : scene.bodies) world.removeRigidBody(b.get());
 
   std::printf("| engine | scene | bodies | dt | steps | solver iterations | sleeping | us/step | max drift | final KE | "
-              "max penetration / size | CCD |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+              "max penetration / size | max energy rise | CCD |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   const std::string name = o.scene.substr(o.scene.find_last_of('/') + 1);
-  std::printf("| Bullet %d (%zu-byte btScalar) | %s | %d | 1/%.4g | %ld | %d | %s | %.1f | %.2e | %.2e | %.2e | %s |\n",
+  std::printf("| Bullet %d (%zu-byte btScalar) | %s | %d | 1/%.4g | %ld | %d | %s | %.1f | %.2e | %.2e | %.2e | %.3g %% | %s |\n",
               btGetVersion(), sizeof(btScalar), name.c_str(), dynamic, 1 / scene.dt, steps, o.iterations,
-              o.sleep ? "on" : "off", 1e6 * wall / steps, drift, kinetic, penetration, o.ccd ? "on" : "off");
+              o.sleep ? "on" : "off", 1e6 * wall / steps, drift, kinetic, penetration,
+              100 * (highestEnergy - initialEnergy) / std::abs(initialEnergy), o.ccd ? "on" : "off");
   return 0;
 }
