@@ -3,8 +3,9 @@
 // against on the same machine and the same scene instead of quoting a figure.
 //
 // What carries over from the scene: gravity, dt and end time, and each entity's shape (sphere,
-// box or plane; anything else is refused), mass (inertia from the shape), pose, velocities,
-// friction and restitution. Monolith combines a pair's coefficients by their minimum
+// box or plane), mass (inertia from the shape), pose, velocities, friction and restitution.
+// Anything else (other shapes, an explicit inertia, kinematic motion, forces, fluids, 2-D) is
+// refused with the JSON path, rather than compared as a different scene. Monolith combines a pair's coefficients by their minimum
 // (systems/contact_workspace.cpp, findPairImpulse); Bullet's combination callbacks are set to the
 // same rule. Sleeping is off by default: a sleeping body costs nothing and Monolith has none, so
 // per-step figures would not compare (`--sleep` turns Bullet's default deactivation back on).
@@ -27,6 +28,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -121,6 +123,17 @@ double number(const json& object, const char* key, double fallback, const std::s
   return j.get<double>();
 }
 
+// Fails naming the first key of `object` that is not in `known`.
+void refuseOtherKeys(const json& object, std::initializer_list<const char*> known, const std::string& path) {
+  if (!object.is_object()) fail(path + ": expected an object");
+  for (const auto& item : object.items()) {
+    bool listed = false;
+    for (const char* k : known) listed = listed || item.key() == k;
+    // `path` is "FILE:" for the file's top level, else a JSON path ("FILE: entities[3]").
+    if (!listed) fail(path + (path.back() == ':' ? " " : ".") + item.key() + ": not carried over to Bullet");
+  }
+}
+
 btScalar combineFrictionByMinimum(const btCollisionObject* a, const btCollisionObject* b) {
   return std::min(a->getFriction(), b->getFriction());
 }
@@ -150,6 +163,8 @@ Scene load(const Options& o) {
     fail(o.scene + ": not JSON: " + e.what());
   }
   Scene s;
+  // Monolith's own solver settings ("solvers") have no Bullet counterpart and are left out.
+  refuseOtherKeys(root, {"description", "dimension", "time", "gravity", "entities", "solvers"}, o.scene + ":");
   if (root.value("dimension", 3) != 3) fail(o.scene + ": dimension: only 3-D scenes run in Bullet here");
   if (root.contains("gravity")) s.gravity = vec3(root["gravity"], o.scene + ": gravity");
   const json time = root.value("time", json::object());
@@ -160,9 +175,13 @@ Scene load(const Options& o) {
   for (std::size_t e = 0; e < root["entities"].size(); ++e) {
     const json& entity = root["entities"][e];
     const std::string path = o.scene + ": entities[" + std::to_string(e) + "]";
-    if (!entity.contains("rigid_body")) continue;  // not a rigid body (fluid, probes ...)
+    // Anything not listed here (a kinematic motion, forces, a fluid ...) would make Bullet run
+    // a different scene: refused.
+    refuseOtherKeys(entity, {"name", "shape", "rigid_body", "collider"}, path);
+    if (!entity.contains("rigid_body")) fail(path + ".rigid_body: every entity must be a rigid body here");
     const json& rb = entity["rigid_body"];
-    if (rb.contains("inertia")) fail(path + ".rigid_body.inertia: an explicit inertia is not carried over");
+    refuseOtherKeys(rb, {"static", "mass", "position", "orientation", "velocity", "angular_velocity"},
+                    path + ".rigid_body");
     if (!entity.contains("shape")) fail(path + ".shape: a rigid body needs a shape");
     const json& shape = entity["shape"];
     const std::string type = shape.value("type", "");

@@ -524,8 +524,8 @@ TEST(JointPushOut, ATurnCostsWhatMovingItsFarthestPointWould) {
   // random_drop_2d_1421, the first 27 steps. At step 27 a disk (0.83 kg) pressed a small box
   // (0.57 kg, 13 x 7 cm) into the corner of the wall and the ground, 1.5 cm deep. Weighted by
   // its inertia alone the box turned cheaply, so the jam solve asked it to turn its corner by
-  // 7-54 cm; every scaled step made the jam deeper, the pass was undone, and the step ended 22 %
-  // deep (with the code of 50f5733). A turn now costs at least what moving the body's farthest
+  // 7-54 cm; scaled down, two passes gained little, the third made the jam deeper at every
+  // halving and was undone, and the step ended 22 % deep (with the code of 50f5733). A turn now costs at least what moving the body's farthest
   // point as far would (turnMetricInverse in systems/interpenetration.cpp).
   const Registry registry = builtins();
   Simulation<2> sim(loadScene(kScenes + "random_drop_2d_1421.json"), registry);
