@@ -8,9 +8,11 @@
 //  * mixed_pile (boxes, spheres, capsules, cylinders, octahedra): us/step on 1 and 2 threads,
 //    deepest overlap, final kinetic energy, 1T == 2T.
 //
-// usage: bench_rigid_contact [pyramid|pour|mixed|all, default all] [seconds] [pyramid scene, e.g. pyramid_20]
-//                            [key=value scene overrides for the pyramids, e.g. solvers.contact.contact_iterations=4;
-//                             frames=30 or frames=60: only that step size; threads=N: only N threads]
+// usage: bench_rigid_contact [pyramid|pour|mixed|all, default all] [seconds]
+//                            [pyramid scene, e.g. pyramid_20; or with pour: 250, 1000, 4000 or all]
+//                            [key=value scene overrides for the pyramids and pours, e.g.
+//                             solvers.contact.contact_iterations=4; frames=30 or frames=60: only that
+//                             pyramid step size; threads=N: only N threads]
 //   seconds: simulated time per run; pour default 1.0, pyramids default the scenes' 10 s (a
 //   shorter run is for quick comparisons while profiling; report the 10 s numbers).
 #include <chrono>
@@ -116,7 +118,8 @@ void pyramids(const Registry& registry, double seconds, const std::string& only,
   }
 }
 
-void pour(const Registry& registry, double seconds) {
+void pour(const Registry& registry, double seconds, const std::string& only, const std::vector<Override>& extra,
+          const std::vector<int>& threadCounts) {
   const std::string dir = (std::filesystem::temp_directory_path() / "monolith_pour").string();
   std::filesystem::create_directories(dir);
   const std::string cmd = "python3 " + kScenes + "generate_contact_scenes.py " + dir + " --pour 250 1000 4000";
@@ -127,16 +130,21 @@ void pour(const Registry& registry, double seconds) {
   std::printf("\n| N spheres | threads | steps | us/step | us/sphere-step | speed-up | max penetration / size | 1T == 2T |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
   for (int n : {250, 1000, 4000}) {
+    const std::string name = "pour_spheres_" + std::to_string(n);
+    if (!only.empty() && only != "all" && only != name && only != std::to_string(n)) continue;
     char end[64];
     std::snprintf(end, sizeof end, "%.17g", seconds);
-    const SceneSpec scene = loadScene(dir + "/pour_spheres_" + std::to_string(n) + ".json", {{"time.end", end}});
+    std::vector<Override> overrides = extra;
+    overrides.push_back({"time.end", end});
+    const SceneSpec scene = loadScene(dir + "/" + name + ".json", overrides);
     TimedRun oneThread;
-    for (int threads : {1, 2}) {
+    for (int threads : threadCounts) {
       const TimedRun run = runTimed(scene, registry, threads);
-      if (threads == 1) oneThread = run;
+      if (threads == threadCounts.front()) oneThread = run;
       const double us = 1e6 * run.wall / run.steps;
       std::printf("| %d | %d | %ld | %.0f | %.3f | %.2f | %.2e | %s |\n", n, threads, run.steps, us, us / n,
-                  oneThread.wall / run.wall, run.penetration, sameText(threads, run, oneThread));
+                  oneThread.wall / run.wall, run.penetration,
+                  threadCounts.front() == 1 ? sameText(threads, run, oneThread) : "-");
       std::fflush(stdout);
     }
   }
@@ -183,7 +191,8 @@ int main(int argc, char** argv) {
     else extra.push_back({key, value});
   }
   if (what == "pyramid" || what == "all") pyramids(registry, seconds, argc > 3 ? argv[3] : "", extra, choice);
-  if (what == "pour" || what == "all") pour(registry, seconds > 0 ? seconds : 1.0);
+  if (what == "pour" || what == "all")
+    pour(registry, seconds > 0 ? seconds : 1.0, argc > 3 && what == "pour" ? argv[3] : "", extra, choice.threads);
   if (what == "mixed" || what == "all") mixedPile(registry);
   return 0;
 }
