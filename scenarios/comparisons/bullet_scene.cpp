@@ -26,112 +26,38 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <fstream>
-#include <initializer_list>
 #include <limits>
 #include <memory>
-#include <nlohmann/json.hpp>
-#include <sstream>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "scene_file.h"
+
 namespace {
 
-using nlohmann::json;
+using namespace comparisons;
 constexpr double kInfinite = std::numeric_limits<double>::infinity();
+constexpr const char* kUsage = "SCENE.json [--dt 1/60|SECONDS] [--end SECONDS] [--iterations N] [--sleep] [--ccd]";
 
-struct Options {
-  std::string scene;
-  double dt = 0, end = 0;  // 0: the scene's
-  int iterations = 10;     // btContactSolverInfo's default
-  bool sleep = false;
-  bool ccd = false;  // Bullet's continuous collision detection for fast bodies
+struct Options : CommonOptions {
+  int iterations = 10;  // btContactSolverInfo's default
+  bool ccd = false;     // Bullet's continuous collision detection for fast bodies
 };
-
-[[noreturn]] void fail(const std::string& why) {
-  std::fprintf(stderr, "compare_bullet: %s\n", why.c_str());
-  std::exit(3);
-}
-
-// A number (or "1/60") from the command line, positive and finite.
-double positive(const std::string& text, const char* what) {
-  double value = 0;
-  const auto slash = text.find('/');
-  char* end = nullptr;
-  if (slash != std::string::npos) {
-    const double num = std::strtod(text.substr(0, slash).c_str(), &end);
-    const double den = std::strtod(text.substr(slash + 1).c_str(), &end);
-    value = num / den;
-  } else {
-    value = std::strtod(text.c_str(), &end);
-    if (*end != '\0') value = -1;
-  }
-  if (!std::isfinite(value) || value <= 0) {
-    std::fprintf(stderr, "compare_bullet: %s must be a positive number, got '%s'\n", what, text.c_str());
-    std::exit(2);
-  }
-  return value;
-}
 
 Options parse(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      if (++i == argc) {
-        std::fprintf(stderr, "compare_bullet: %s needs a value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[i];
-    };
-    if (a == "--sleep") o.sleep = true;
-    else if (a == "--ccd") o.ccd = true;
-    else if (a == "--dt") o.dt = positive(next(), "--dt");
-    else if (a == "--end") o.end = positive(next(), "--end");
-    else if (a == "--iterations") o.iterations = static_cast<int>(positive(next(), "--iterations"));
-    else if (o.scene.empty() && a.rfind("--", 0) != 0) o.scene = a;
-    else {
-      std::fprintf(stderr,
-                   "usage: compare_bullet SCENE.json [--dt 1/60|SECONDS] [--end SECONDS] [--iterations N] [--sleep] [--ccd]\n");
-      std::exit(2);
-    }
-  }
-  if (o.scene.empty()) {
-    std::fprintf(stderr, "usage: compare_bullet SCENE.json [--dt 1/60|SECONDS] [--end SECONDS] [--iterations N] [--sleep] [--ccd]\n");
-    std::exit(2);
-  }
+  static_cast<CommonOptions&>(o) = parseCommon(argc, argv, kUsage, [&](const std::string& a, auto&& next) {
+    if (a == "--ccd") return o.ccd = true;
+    if (a != "--iterations") return false;
+    o.iterations = static_cast<int>(positive(next(), "--iterations", kUsage));
+    return true;
+  });
   return o;
 }
 
-// A JSON value at `path` that must be an array of 3 finite numbers.
 btVector3 vec3(const json& j, const std::string& path) {
-  if (!j.is_array() || j.size() != 3) fail(path + ": expected an array of 3 numbers");
-  double v[3];
-  for (int k = 0; k < 3; ++k) {
-    if (!j[k].is_number() || !std::isfinite(j[k].get<double>())) fail(path + ": expected finite numbers");
-    v[k] = j[k].get<double>();
-  }
+  const auto v = numbers<3>(j, path);
   return btVector3(btScalar(v[0]), btScalar(v[1]), btScalar(v[2]));
-}
-
-double number(const json& object, const char* key, double fallback, const std::string& path) {
-  if (!object.contains(key)) return fallback;
-  const json& j = object.at(key);
-  if (!j.is_number() || !std::isfinite(j.get<double>())) fail(path + "." + key + ": expected a finite number");
-  return j.get<double>();
-}
-
-// Fails naming the first key of `object` that is not in `known`.
-void refuseOtherKeys(const json& object, std::initializer_list<const char*> known, const std::string& path) {
-  if (!object.is_object()) fail(path + ": expected an object");
-  for (const auto& item : object.items()) {
-    bool listed = false;
-    for (const char* k : known) listed = listed || item.key() == k;
-    // `path` is "FILE:" for the file's top level, else a JSON path ("FILE: entities[3]").
-    if (!listed) fail(path + (path.back() == ':' ? " " : ".") + item.key() + ": not carried over to Bullet");
-  }
 }
 
 btScalar combineFrictionByMinimum(const btCollisionObject* a, const btCollisionObject* b) {
@@ -143,7 +69,7 @@ btScalar combineRestitutionByMinimum(const btCollisionObject* a, const btCollisi
 
 struct Scene {
   btVector3 gravity{0, btScalar(-9.81), 0};
-  double dt = 0, end = 0;
+  SceneTime time;
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
   std::vector<std::unique_ptr<btDefaultMotionState>> states;
   std::vector<std::unique_ptr<btRigidBody>> bodies;
@@ -152,36 +78,25 @@ struct Scene {
 };
 
 Scene load(const Options& o) {
-  std::ifstream in(o.scene);
-  if (!in) fail(o.scene + ": cannot open");
-  std::stringstream text;
-  text << in.rdbuf();
-  json root;
-  try {
-    root = json::parse(text.str(), nullptr, true, /*ignore_comments=*/true);
-  } catch (const std::exception& e) {
-    fail(o.scene + ": not JSON: " + e.what());
-  }
+  const json root = readSceneFile(o.scene);
   Scene s;
   // Monolith's own solver settings ("solvers") have no Bullet counterpart and are left out.
-  refuseOtherKeys(root, {"description", "dimension", "time", "gravity", "entities", "solvers"}, o.scene + ":");
+  refuseOtherKeys(root, {"description", "dimension", "time", "gravity", "entities", "solvers"}, o.scene + ":",
+                  "Bullet");
   if (root.value("dimension", 3) != 3) fail(o.scene + ": dimension: only 3-D scenes run in Bullet here");
   if (root.contains("gravity")) s.gravity = vec3(root["gravity"], o.scene + ": gravity");
-  const json time = root.value("time", json::object());
-  s.dt = o.dt > 0 ? o.dt : number(time, "dt", 0, o.scene + ": time");
-  s.end = o.end > 0 ? o.end : number(time, "end", 0, o.scene + ": time");
-  if (!(s.dt > 0) || !(s.end > 0)) fail(o.scene + ": time: expected positive dt and end");
+  s.time = sceneTime(root, o);
   if (!root.contains("entities") || !root["entities"].is_array()) fail(o.scene + ": entities: expected an array");
   for (std::size_t e = 0; e < root["entities"].size(); ++e) {
     const json& entity = root["entities"][e];
     const std::string path = o.scene + ": entities[" + std::to_string(e) + "]";
     // Anything not listed here (a kinematic motion, forces, a fluid ...) would make Bullet run
     // a different scene: refused.
-    refuseOtherKeys(entity, {"name", "shape", "rigid_body", "collider"}, path);
+    refuseOtherKeys(entity, {"name", "shape", "rigid_body", "collider"}, path, "Bullet");
     if (!entity.contains("rigid_body")) fail(path + ".rigid_body: every entity must be a rigid body here");
     const json& rb = entity["rigid_body"];
     refuseOtherKeys(rb, {"static", "mass", "position", "orientation", "velocity", "angular_velocity"},
-                    path + ".rigid_body");
+                    path + ".rigid_body", "Bullet");
     if (!entity.contains("shape")) fail(path + ".shape: a rigid body needs a shape");
     const json& shape = entity["shape"];
     const std::string type = shape.value("type", "");
@@ -213,10 +128,8 @@ Scene load(const Options& o) {
     if (type != "plane") {
       pose.setOrigin(x);
       if (rb.contains("orientation")) {
-        const json& q = rb["orientation"];
-        if (!q.is_array() || q.size() != 4) fail(path + ".rigid_body.orientation: expected [w, x, y, z]");
-        pose.setRotation(btQuaternion(btScalar(q[1].get<double>()), btScalar(q[2].get<double>()),
-                                      btScalar(q[3].get<double>()), btScalar(q[0].get<double>())).normalized());
+        const auto q = numbers<4>(rb["orientation"], path + ".rigid_body.orientation");  // [w, x, y, z]
+        pose.setRotation(btQuaternion(btScalar(q[1]), btScalar(q[2]), btScalar(q[3]), btScalar(q[0])).normalized());
       }
     }
     const double mass = isStatic ? 0 : number(rb, "mass", 1.0, path + ".rigid_body");
@@ -283,11 +196,11 @@ int main(int argc, char** argv) {
   const double initialEnergy = energies().second;
   double highestEnergy = initialEnergy;
 
-  const long steps = std::lround(scene.end / scene.dt);
+  const long steps = scene.time.steps;
   double wall = 0, penetration = 0;
   for (long n = 0; n < steps; ++n) {
     const auto t0 = std::chrono::steady_clock::now();
-    world.stepSimulation(btScalar(scene.dt), 0);  // no sub-steps: exactly one step of dt
+    world.stepSimulation(btScalar(scene.time.dt), 0);  // no sub-steps: exactly one step of dt
     wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {  // outside the timed part
       const btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
@@ -311,9 +224,8 @@ int main(int argc, char** argv) {
 
   std::printf("| engine | scene | bodies | dt | steps | solver iterations | sleeping | us/step | max drift | final KE | "
               "max penetration / size | max energy rise | CCD |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-  const std::string name = o.scene.substr(o.scene.find_last_of('/') + 1);
   std::printf("| Bullet %d (%zu-byte btScalar) | %s | %d | 1/%.4g | %ld | %d | %s | %.1f | %.2e | %.2e | %.2e | %.3g %% | %s |\n",
-              btGetVersion(), sizeof(btScalar), name.c_str(), dynamic, 1 / scene.dt, steps, o.iterations,
+              btGetVersion(), sizeof(btScalar), fileName(o.scene).c_str(), dynamic, 1 / scene.time.dt, steps, o.iterations,
               o.sleep ? "on" : "off", 1e6 * wall / steps, drift, kinetic, penetration,
               100 * (highestEnergy - initialEnergy) / std::abs(initialEnergy), o.ccd ? "on" : "off");
   return 0;
