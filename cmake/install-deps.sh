@@ -8,7 +8,7 @@ PACKAGES=(
   cmake make g++ pkg-config
   libeigen3-dev libtbb-dev libfcl-dev libccd-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libbullet-dev
+  libbullet-dev libbox2d-dev
   python3 python3-vtk9
 )
 missing=()
