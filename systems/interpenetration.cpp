@@ -66,8 +66,7 @@ template <int d>
 con::AngMat<d> turnMetricInverse(const ContactBody<d>& b) {
   if (b.inverseInertia0.isZero(0)) return b.inverseInertia0;  // a body that does not turn
   const double r = b.geometry->boundingRadius();
-  const con::AngMat<d> inertia = b.inverseInertia0.inverse();
-  return (inertia + b.mass * r * r * con::AngMat<d>::Identity()).inverse();
+  return (b.inertia0 + b.mass * r * r * con::AngMat<d>::Identity()).inverse();
 }
 
 // Where the broad phase looks for a body in push-out: its current (candidate) pose.
