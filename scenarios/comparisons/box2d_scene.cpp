@@ -36,7 +36,6 @@ using namespace comparisons;
 constexpr double kInfinite = std::numeric_limits<double>::infinity();
 constexpr const char* kUsage =
     "SCENE.json [--dt 1/60|SECONDS] [--end SECONDS] [--velocity-iterations N] [--position-iterations N] [--sleep]";
-constexpr int kMaxVertices = b2_maxPolygonVertices;
 
 struct Options : CommonOptions {
   int velocityIterations = 8, positionIterations = 3;  // Box2D's recommended defaults
@@ -149,8 +148,8 @@ std::vector<Body> load(const Options& o, const json& root, b2World& world) {
       made.size = 2 * r;
     } else if (type == "polygon") {
       const json& list = shape.value("vertices", json());
-      if (!list.is_array() || list.size() < 3 || list.size() > std::size_t(kMaxVertices))
-        fail(path + ".shape.vertices: expected 3 to " + std::to_string(kMaxVertices) + " vertices (Box2D's limit)");
+      if (!list.is_array() || list.size() < 3 || list.size() > std::size_t(b2_maxPolygonVertices))
+        fail(path + ".shape.vertices: expected 3 to " + std::to_string(b2_maxPolygonVertices) + " vertices (Box2D's limit)");
       std::vector<b2Vec2> v;
       for (std::size_t i = 0; i < list.size(); ++i)
         v.push_back(vec2(list[i], path + ".shape.vertices[" + std::to_string(i) + "]"));
@@ -203,11 +202,7 @@ int main(int argc, char** argv) {
   MinimumCoefficients coefficients;
   world.SetContactListener(&coefficients);
   std::vector<Body> bodies = load(o, root, world);
-  std::vector<double> sizeOf(bodies.size());
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    bodies[i].body->GetUserData().pointer = i;
-    sizeOf[i] = bodies[i].size;
-  }
+  for (std::size_t i = 0; i < bodies.size(); ++i) bodies[i].body->GetUserData().pointer = i;
 
   // Kinetic and total (kinetic + gravity's potential) energy of the dynamic bodies.
   const auto energies = [&] {
@@ -234,8 +229,8 @@ int main(int argc, char** argv) {
       if (!c->IsTouching()) continue;
       b2WorldManifold manifold;
       c->GetWorldManifold(&manifold);
-      const double size = std::min(sizeOf[c->GetFixtureA()->GetBody()->GetUserData().pointer],
-                                   sizeOf[c->GetFixtureB()->GetBody()->GetUserData().pointer]);
+      const double size = std::min(bodies[c->GetFixtureA()->GetBody()->GetUserData().pointer].size,
+                                   bodies[c->GetFixtureB()->GetBody()->GetUserData().pointer].size);
       for (int p = 0; p < c->GetManifold()->pointCount; ++p)
         penetration = std::max(penetration, -double(manifold.separations[p]) / size);
     }

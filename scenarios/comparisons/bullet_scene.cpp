@@ -47,9 +47,9 @@ struct Options : CommonOptions {
 Options parse(int argc, char** argv) {
   Options o;
   static_cast<CommonOptions&>(o) = parseCommon(argc, argv, kUsage, [&](const std::string& a, auto&& next) {
-    if (a == "--ccd") return o.ccd = true;
-    if (a != "--iterations") return false;
-    o.iterations = static_cast<int>(positive(next(), "--iterations", kUsage));
+    if (a == "--ccd") o.ccd = true;
+    else if (a == "--iterations") o.iterations = static_cast<int>(positive(next(), a.c_str(), kUsage));
+    else return false;
     return true;
   });
   return o;
