@@ -3,17 +3,27 @@
 // against on the same machine and the same scene instead of quoting a figure.
 //
 // What carries over from the scene: gravity, dt and end time, and each entity's shape (sphere,
-// box or plane), mass (inertia from the shape), pose, velocities, friction and restitution.
-// Anything else (other shapes, an explicit inertia, kinematic motion, forces, fluids, 2-D) is
-// refused with the JSON path, rather than compared as a different scene. Monolith combines a pair's coefficients by their minimum
+// box, capsule, cylinder, convex hull or plane), mass, inertia, pose, velocities, friction and
+// restitution. The inertia is Monolith's own (components/shape.h, or the scene's principal
+// moments), not Bullet's: Bullet gives capsules and hulls the inertia of their bounding box, which
+// would make a different body. Anything else (a triangle mesh, a non-diagonal inertia, kinematic
+// motion, forces, fluids, 2-D) is refused with the JSON path, rather than compared as a different
+// scene. Monolith combines a pair's coefficients by their minimum
 // (systems/contact_workspace.cpp, findPairImpulse); Bullet's combination callbacks are set to the
 // same rule. Sleeping is off by default: a sleeping body costs nothing and Monolith has none, so
 // per-step figures would not compare (`--sleep` turns Bullet's default deactivation back on).
 //
+// Collision margins: Bullet keeps boxes and cylinders at their size by colliding a core shrunk by
+// the margin (default 0.04) and rounded by it, so a body thinner than twice the margin would get
+// a core of negative size. Each body's margin is therefore min(0.04, a quarter of its smallest
+// size); unit boxes keep Bullet's default. A hull is shrunk by its margin
+// (btConvexHullComputer) so that with the margin added it is the scene's hull with rounded edges.
+//
 // Prints one row per run: us/step, the largest distance of a dynamic body from its start after
 // the run, the final kinetic energy, the deepest contact penetration over the smaller body's
 // size at any step (Bullet's own contact distances, measured at the start of each step, i.e. on
-// the state the step before produced) — the columns of bench_rigid_contact's tables — and the
+// the state the step before produced; sizes as Monolith measures them,
+// solvers/collision/geometry.h) — the columns of bench_rigid_contact's tables — and the
 // largest rise of the total energy (kinetic + gravity's potential) over its initial value after
 // any step, relative to that value (issue 3's rule: at most 0.1 %).
 //
@@ -21,6 +31,7 @@
 //   --ccd: Bullet's continuous collision detection on every dynamic body (off by default, as in
 //   Bullet).
 #include <btBulletDynamicsCommon.h>
+#include <LinearMath/btConvexHullComputer.h>
 
 #include <algorithm>
 #include <chrono>
@@ -31,7 +42,9 @@
 #include <string>
 #include <vector>
 
+#include "components/shape.h"
 #include "scene_file.h"
+#include "solvers/collision/geometry.h"
 
 namespace {
 
@@ -67,6 +80,136 @@ btScalar combineRestitutionByMinimum(const btCollisionObject* a, const btCollisi
   return std::min(a->getRestitution(), b->getRestitution());
 }
 
+constexpr double kBulletMargin = 0.04;  // Bullet's default collision margin (CONVEX_DISTANCE_MARGIN)
+
+// The margin of a body of the given smallest size: Bullet's default, or a quarter of the size
+// for a thin body (see the top of this file).
+btScalar marginFor(double size) { return btScalar(std::min(kBulletMargin, 0.25 * size)); }
+
+// A scene shape in Bullet, with its size as Monolith measures it and Monolith's description of it
+// (for the inertia).
+struct MadeShape {
+  std::unique_ptr<btCollisionShape> shape;
+  double size = kInfinite;
+  monolith::Shape<3> monolithShape;
+};
+
+double positiveNumber(const json& shape, const char* key, const std::string& path) {
+  const double value = number(shape, key, 0, path);
+  if (!(value > 0)) fail(path + "." + key + ": expected a positive number");
+  return value;
+}
+
+// The smallest size of a shape as Monolith's narrow phase measures it (a box's smallest extent,
+// a hull's least width ...), so that the overlap column means the same thing in both programs.
+double monolithSize(const monolith::solvers::collision::Geometry<3>& g, const std::string& path) {
+  try {
+    return monolith::solvers::collision::PreparedGeometry<3>(g).minimumSize();
+  } catch (const std::exception& e) {
+    fail(path + ": " + e.what());
+  }
+}
+
+MadeShape makeShape(const json& shape, const std::string& path, bool isStatic, const btVector3& x) {
+  namespace col = monolith::solvers::collision;
+  MadeShape m;
+  col::Geometry<3> g;
+  const std::string type = shape.value("type", "");
+  if (type == "sphere") {
+    refuseOtherKeys(shape, {"type", "radius"}, path, "Bullet");
+    const double r = positiveNumber(shape, "radius", path);
+    m.shape = std::make_unique<btSphereShape>(btScalar(r));
+    m.monolithShape.type = monolith::ShapeType::Sphere;
+    m.monolithShape.radius = r;
+    m.size = 2 * r;
+  } else if (type == "box") {
+    refuseOtherKeys(shape, {"type", "half_extents"}, path, "Bullet");
+    const auto h = numbers<3>(shape.value("half_extents", json()), path + ".half_extents");
+    if (!(std::min({h[0], h[1], h[2]}) > 0)) fail(path + ".half_extents: expected positive numbers");
+    m.monolithShape.type = monolith::ShapeType::Box;
+    m.monolithShape.halfExtents = Eigen::Vector3d(h[0], h[1], h[2]);
+    m.size = 2 * std::min({h[0], h[1], h[2]});
+    m.shape = std::make_unique<btBoxShape>(btVector3(btScalar(h[0]), btScalar(h[1]), btScalar(h[2])));
+    m.shape->setMargin(marginFor(m.size));  // btBoxShape keeps its extents when the margin changes
+  } else if (type == "capsule" || type == "cylinder") {
+    refuseOtherKeys(shape, {"type", "radius", "half_height"}, path, "Bullet");
+    const double r = positiveNumber(shape, "radius", path), h = positiveNumber(shape, "half_height", path);
+    const bool capsule = type == "capsule";
+    // Monolith's axis is the body's z: Bullet's Z variants. A capsule's height in Bullet is its
+    // segment's length; its margin is its radius.
+    m.monolithShape.type = capsule ? monolith::ShapeType::Capsule : monolith::ShapeType::Cylinder;
+    m.monolithShape.radius = r;
+    m.monolithShape.halfHeight = h;
+    m.size = capsule ? 2 * r : 2 * std::min(r, h);
+    if (capsule) {
+      m.shape = std::make_unique<btCapsuleShapeZ>(btScalar(r), btScalar(2 * h));
+    } else {
+      m.shape = std::make_unique<btCylinderShapeZ>(btVector3(btScalar(r), btScalar(r), btScalar(h)));
+      m.shape->setMargin(marginFor(m.size));  // kept at its size, as a box
+    }
+  } else if (type == "convex") {
+    refuseOtherKeys(shape, {"type", "vertices"}, path, "Bullet");
+    const json& vertices = shape.value("vertices", json());
+    if (!vertices.is_array() || vertices.size() < 4) fail(path + ".vertices: expected at least 4 points");
+    std::vector<double> coordinates;
+    g.type = col::GeometryType::Convex;
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+      const auto v = numbers<3>(vertices[i], path + ".vertices[" + std::to_string(i) + "]");
+      coordinates.insert(coordinates.end(), v.begin(), v.end());
+      g.vertices.emplace_back(v[0], v[1], v[2]);
+    }
+    m.monolithShape.type = monolith::ShapeType::Convex;
+    m.size = monolithSize(g, path);
+    // Shrunk by the margin (at most a quarter of its inner radius), which Bullet adds back.
+    btConvexHullComputer hull;
+    const btScalar shrunk = hull.compute(coordinates.data(), 3 * int(sizeof(double)), int(vertices.size()),
+                                         marginFor(m.size), btScalar(0.25));
+    if (hull.vertices.size() < 4) fail(path + ".vertices: Bullet found no solid hull of these points");
+    auto convex = std::make_unique<btConvexHullShape>();
+    for (int i = 0; i < hull.vertices.size(); ++i) convex->addPoint(hull.vertices[i], false);
+    convex->recalcLocalAabb();
+    convex->setMargin(shrunk);
+    m.shape = std::move(convex);
+  } else if (type == "plane") {
+    refuseOtherKeys(shape, {"type", "normal"}, path, "Bullet");
+    if (!isStatic) fail(path + ": a plane must be static");
+    btVector3 n = vec3(shape.value("normal", json()), path + ".normal");
+    if (n.length2() == 0) fail(path + ".normal: expected a non-zero vector");
+    n.normalize();
+    m.shape = std::make_unique<btStaticPlaneShape>(n, n.dot(x));
+    m.monolithShape.type = monolith::ShapeType::Plane;
+  } else {
+    fail(path + ".type: '" + type + "' is not carried over (sphere, box, capsule, cylinder, convex and plane are)");
+  }
+  return m;
+}
+
+// Principal moments of inertia in the body axes: the scene's, or Monolith's formula for the shape
+// (the same one Monolith uses when the scene gives none).
+btVector3 principalInertia(const json& rb, const monolith::Shape<3>& shape, double mass, const std::string& path) {
+  Eigen::Matrix3d I;
+  if (rb.contains("inertia")) {
+    const json& given = rb["inertia"];
+    if (given.is_array() && given.size() == 3 && given[0].is_array()) {
+      for (int r = 0; r < 3; ++r) {
+        const auto row = numbers<3>(given[r], path + ".inertia[" + std::to_string(r) + "]");
+        for (int c = 0; c < 3; ++c) I(r, c) = row[c];
+      }
+      if (!I.isDiagonal(0))
+        fail(path + ".inertia: a non-diagonal inertia is not carried over (Bullet takes principal moments)");
+    } else {
+      const auto d = numbers<3>(given, path + ".inertia");
+      I = Eigen::Vector3d(d[0], d[1], d[2]).asDiagonal();
+    }
+  } else if (shape.type == monolith::ShapeType::Convex || shape.type == monolith::ShapeType::Plane) {
+    fail(path + ".inertia: a convex hull needs the scene's inertia (Monolith has no formula for it either)");
+  } else {
+    I = shape.inertia(mass);
+  }
+  if (!(I.diagonal().minCoeff() > 0)) fail(path + ".inertia: expected positive moments");
+  return btVector3(btScalar(I(0, 0)), btScalar(I(1, 1)), btScalar(I(2, 2)));
+}
+
 struct Scene {
   btVector3 gravity{0, btScalar(-9.81), 0};
   SceneTime time;
@@ -95,7 +238,7 @@ Scene load(const Options& o) {
     refuseOtherKeys(entity, {"name", "shape", "rigid_body", "collider"}, path, "Bullet");
     if (!entity.contains("rigid_body")) fail(path + ".rigid_body: every entity must be a rigid body here");
     const json& rb = entity["rigid_body"];
-    refuseOtherKeys(rb, {"static", "mass", "position", "orientation", "velocity", "angular_velocity"},
+    refuseOtherKeys(rb, {"static", "mass", "inertia", "position", "orientation", "velocity", "angular_velocity"},
                     path + ".rigid_body", "Bullet");
     if (!entity.contains("shape")) fail(path + ".shape: a rigid body needs a shape");
     const json& shape = entity["shape"];
@@ -104,27 +247,7 @@ Scene load(const Options& o) {
     const btVector3 x = rb.contains("position") ? vec3(rb["position"], path + ".rigid_body.position") : btVector3(0, 0, 0);
     btTransform pose;
     pose.setIdentity();
-    double size = kInfinite;
-    if (type == "sphere") {
-      const double r = number(shape, "radius", 0, path + ".shape");
-      if (!(r > 0)) fail(path + ".shape.radius: expected a positive number");
-      s.shapes.push_back(std::make_unique<btSphereShape>(btScalar(r)));
-      size = 2 * r;
-    } else if (type == "box") {
-      const btVector3 h = vec3(shape.value("half_extents", json()), path + ".shape.half_extents");
-      if (!(h.minAxis() == 0 ? h.x() > 0 : h.minAxis() == 1 ? h.y() > 0 : h.z() > 0))
-        fail(path + ".shape.half_extents: expected positive numbers");
-      s.shapes.push_back(std::make_unique<btBoxShape>(h));
-      size = 2 * double(h.minAxis() == 0 ? h.x() : h.minAxis() == 1 ? h.y() : h.z());
-    } else if (type == "plane") {
-      if (!isStatic) fail(path + ".shape: a plane must be static");
-      btVector3 n = vec3(shape.value("normal", json()), path + ".shape.normal");
-      if (n.length2() == 0) fail(path + ".shape.normal: expected a non-zero vector");
-      n.normalize();
-      s.shapes.push_back(std::make_unique<btStaticPlaneShape>(n, n.dot(x)));
-    } else {
-      fail(path + ".shape.type: '" + type + "' is not carried over (sphere, box and plane are)");
-    }
+    MadeShape made = makeShape(shape, path + ".shape", isStatic, x);
     if (type != "plane") {
       pose.setOrigin(x);
       if (rb.contains("orientation")) {
@@ -135,7 +258,9 @@ Scene load(const Options& o) {
     const double mass = isStatic ? 0 : number(rb, "mass", 1.0, path + ".rigid_body");
     if (!isStatic && !(mass > 0)) fail(path + ".rigid_body.mass: expected a positive number");
     btVector3 inertia(0, 0, 0);
-    if (mass > 0) s.shapes.back()->calculateLocalInertia(btScalar(mass), inertia);
+    if (mass > 0) inertia = principalInertia(rb, made.monolithShape, mass, path + ".rigid_body");
+    s.shapes.push_back(std::move(made.shape));
+    const double size = made.size;
     s.states.push_back(std::make_unique<btDefaultMotionState>(pose));
     btRigidBody::btRigidBodyConstructionInfo info(btScalar(mass), s.states.back().get(), s.shapes.back().get(), inertia);
     const json collider = entity.value("collider", json::object());
