@@ -24,7 +24,14 @@ constexpr int kMaxTiltEvaluations = 64;
 
 }  // namespace
 
-Eigen::Vector2d projection(const PreparedGeometry<3>& g, const Pose<3>& pose, const Vec3& n, int triangle) {
+namespace {
+
+// The shape's extent along n as [lowest, highest], computing only the ends asked for (the
+// descent below needs one end of each shape and evaluates it ~300 times per contact it refines).
+// Each end is computed the same way whether or not the other is, so projection() and the
+// one-sided calls agree bitwise.
+template <bool kLow, bool kHigh>
+Eigen::Vector2d projectionEnds(const PreparedGeometry<3>& g, const Pose<3>& pose, const Vec3& n, int triangle) {
   const Geometry<3>& geo = g.geometry();
   const double c = n.dot(pose.x);
   const Vec3 nb = pose.R.transpose() * n;  // n in the body frame
@@ -42,8 +49,8 @@ Eigen::Vector2d projection(const PreparedGeometry<3>& g, const Pose<3>& pose, co
       double lo = kInfinity, hi = -kInfinity;
       auto visit = [&](const Vec3& v) {
         const double t = nb.dot(v);
-        lo = std::min(lo, t);
-        hi = std::max(hi, t);
+        if constexpr (kLow) lo = std::min(lo, t);
+        if constexpr (kHigh) hi = std::max(hi, t);
       };
       if (geo.type == GeometryType::Mesh && triangle >= 0 && triangle < static_cast<int>(geo.triangles.size())) {
         for (int v : geo.triangles[triangle]) visit(geo.vertices[v]);
@@ -54,6 +61,12 @@ Eigen::Vector2d projection(const PreparedGeometry<3>& g, const Pose<3>& pose, co
     }
   }
   return {c - half, c + half};
+}
+
+}  // namespace
+
+Eigen::Vector2d projection(const PreparedGeometry<3>& g, const Pose<3>& pose, const Vec3& n, int triangle) {
+  return projectionEnds<true, true>(g, pose, n, triangle);
 }
 
 namespace {
@@ -233,11 +246,13 @@ namespace {
 // where gradients would zigzag. Returns the overlap reached; n becomes its axis.
 double descend(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b, const Pose<3>& poseB,
                Vec3& n) {
-  auto overlap = [&](const Vec3& m) { return projection(b, poseB, m, -1)[1] - projection(a, poseA, m, -1)[0]; };
+  auto overlap = [&](const Vec3& m) {
+    return projectionEnds<false, true>(b, poseB, m, -1)[1] - projectionEnds<true, false>(a, poseA, m, -1)[0];
+  };
   double best = overlap(n);
   double step = kInitialTilt;
+  Vec3 u = n.unitOrthogonal(), v = n.cross(u);  // the tilts' basis, found again only when n moves
   for (int evaluation = 0; evaluation < kMaxTiltEvaluations && step > kFinalTilt;) {
-    const Vec3 u = n.unitOrthogonal(), v = n.cross(u);
     bool improved = false;
     for (const Vec3& tilt : {u, Vec3(-u), v, Vec3(-v)}) {
       const Vec3 m = (n + step * tilt).normalized();
@@ -250,7 +265,12 @@ double descend(const PreparedGeometry<3>& a, const Pose<3>& poseA, const Prepare
         break;
       }
     }
-    if (!improved) step *= 0.5;
+    if (improved) {
+      u = n.unitOrthogonal();
+      v = n.cross(u);
+    } else {
+      step *= 0.5;
+    }
   }
   return best;
 }
