@@ -757,16 +757,27 @@ void ContactWorkspace<d>::addOrdered(solvers::parallel::OrderedTasks& order, con
     order.add(nullptr, 0, nullptr, 0);
     return;
   }
-  thread_local std::vector<int> writes, reads;
-  writes.clear();
-  reads.clear();
+  // Most tasks touch two bodies: their lists stay on the stack (this runs once per recorded task).
+  constexpr int kOnStack = 8;
+  int writesOnStack[kOnStack], readsOnStack[kOnStack];
+  thread_local std::vector<int> writesLong, readsLong;
+  int* writes = writesOnStack;
+  int* reads = readsOnStack;
+  if (count > kOnStack) {
+    writesLong.resize(count);
+    readsLong.resize(count);
+    writes = writesLong.data();
+    reads = readsLong.data();
+  }
+  int writeCount = 0, readCount = 0;
   for (int i = 0; i < count; ++i) {
     const ContactBody<d>& b = bodies[touched[i]];
     if (b.isStatic || b.kinematic) continue;
     const int local = memberIndex_[touched[i]];
-    (frozen[local] ? reads : writes).push_back(local);
+    if (frozen[local]) reads[readCount++] = local;
+    else writes[writeCount++] = local;
   }
-  order.add(writes.data(), static_cast<int>(writes.size()), reads.data(), static_cast<int>(reads.size()));
+  order.add(writes, writeCount, reads, readCount);
 }
 
 template <int d>
@@ -865,16 +876,16 @@ void ContactWorkspace<d>::addTask(IslandSchedule& s, const SweepTask& task, cons
     runTask(s, task, -1, s.scratch);
     return;
   }
-  s.tasks.push_back(task);
-  s.impulses.push_back(0);
-  s.clamps.push_back(0);
-  s.energyChange.push_back(0.0);
+  s.tasks.push_back(task);  // its result slots are sized once, by runSchedule
   addOrdered(s.order, s.frozen, touched, count);
 }
 
 template <int d>
 int ContactWorkspace<d>::runSchedule(IslandSchedule& s) {
   if (!s.order.tracking()) return s.impulseSum;  // already run, as recorded
+  s.impulses.assign(s.tasks.size(), 0);
+  s.clamps.assign(s.tasks.size(), 0);
+  s.energyChange.assign(s.tasks.size(), 0.0);
   s.order.run([&](int k) {
     thread_local std::vector<col::ContactPoint<d>> scratch;  // per worker thread
     runTask(s, s.tasks[k], k, scratch);
@@ -917,9 +928,6 @@ int ContactWorkspace<d>::collisionSweep(int island, int sweep, double* clampEner
     // The previous sweep's tasks and dependencies, with this sweep's stamps (recording them
     // again cost about what the second thread saved in a pour's settled pile).
     for (std::size_t k = 0; k < list.size(); ++k) again.tasks[k].stamp = stamp(k);
-    std::fill(again.impulses.begin(), again.impulses.end(), 0);
-    std::fill(again.clamps.begin(), again.clamps.end(), 0);
-    std::fill(again.energyChange.begin(), again.energyChange.end(), 0.0);
     again.energyOut = clampEnergyChange;
     again.clampsOut = clampsApplied;
     return runSchedule(again);
