@@ -247,10 +247,10 @@ int main(int argc, char** argv) {
   std::printf("| engine | scene | bodies | dt | steps | solver iterations | sleeping | us/step | max drift | final KE | "
               "max penetration / size | max energy rise |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::printf("| Box2D %d.%d.%d (%zu-byte float) | %s | %d | 1/%.4g | %ld | %d velocity, %d position | %s | %.1f | %.2e | "
-              "%.2e | %.2e | %.3g %% |\n",
+              "%.2e | %.2e | %s |\n",
               b2_version.major, b2_version.minor, b2_version.revision, sizeof(float), fileName(o.scene).c_str(), dynamic,
               1 / time.dt, time.steps, o.velocityIterations, o.positionIterations, o.sleep ? "on" : "off",
               1e6 * wall / time.steps, drift, energies().first, penetration,
-              100 * (highestEnergy - initialEnergy) / std::abs(initialEnergy));
+              energyRise(highestEnergy, initialEnergy).c_str());
   return 0;
 }

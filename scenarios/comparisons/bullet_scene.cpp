@@ -349,9 +349,9 @@ int main(int argc, char** argv) {
 
   std::printf("| engine | scene | bodies | dt | steps | solver iterations | sleeping | us/step | max drift | final KE | "
               "max penetration / size | max energy rise | CCD |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-  std::printf("| Bullet %d (%zu-byte btScalar) | %s | %d | 1/%.4g | %ld | %d | %s | %.1f | %.2e | %.2e | %.2e | %.3g %% | %s |\n",
+  std::printf("| Bullet %d (%zu-byte btScalar) | %s | %d | 1/%.4g | %ld | %d | %s | %.1f | %.2e | %.2e | %.2e | %s | %s |\n",
               btGetVersion(), sizeof(btScalar), fileName(o.scene).c_str(), dynamic, 1 / scene.time.dt, steps, o.iterations,
               o.sleep ? "on" : "off", 1e6 * wall / steps, drift, kinetic, penetration,
-              100 * (highestEnergy - initialEnergy) / std::abs(initialEnergy), o.ccd ? "on" : "off");
+              energyRise(highestEnergy, initialEnergy).c_str(), o.ccd ? "on" : "off");
   return 0;
 }

@@ -136,4 +136,13 @@ inline SceneTime sceneTime(const json& root, const CommonOptions& o) {
 
 inline std::string fileName(const std::string& path) { return path.substr(path.find_last_of('/') + 1); }
 
+// The largest rise of the total energy over its initial value: relative (issue 3's rule), or in
+// joules when the initial total is zero (a scene whose bodies start at rest at height 0).
+inline std::string energyRise(double highest, double initial) {
+  char text[64];
+  if (initial != 0) std::snprintf(text, sizeof text, "%.3g %%", 100 * (highest - initial) / std::abs(initial));
+  else std::snprintf(text, sizeof text, "%.3g J", highest - initial);
+  return text;
+}
+
 }  // namespace comparisons
