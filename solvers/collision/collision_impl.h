@@ -34,6 +34,10 @@ struct PreparedGeometry<d>::Impl {
   // 3-D convex hull boundary triangles (indices into `vertices`, counter-clockwise seen from
   // outside): exact distances from points outside the hull.
   std::vector<std::array<int, 3>> hullTriangles;
+  // 3-D polytope (Box, Convex): its edges' directions (unit, one per direction up to sign; a
+  // hull's face diagonals too, which only add candidate axes). With the face normals they give
+  // every candidate axis of the exact separating-axis test of two polytopes (contact_axis.cpp).
+  std::vector<VecD> edgeDirections;
   Eigen::AlignedBox<double, d> localBounds;
   // Mesh: a bounding-box tree over the triangles (body frame). FCL's own BVH traversal against a
   // shape costs ~10 us for a few hundred triangles (OBB tests all the way down); the narrow phase

@@ -292,8 +292,44 @@ void extraStarts(const PreparedGeometry<3>& g, const Pose<3>& pose, const Vec3& 
 
 }  // namespace
 
+double leastOverlapOfPolytopes(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b,
+                               const Pose<3>& poseB, Vec3& axis) {
+  double best = kInfinity;
+  auto consider = [&](const Vec3& n) {  // n: unit, world frame
+    const Eigen::Vector2d pa = projection(a, poseA, n, -1), pb = projection(b, poseB, n, -1);
+    const double overlap = std::min(pb[1] - pa[0], pa[1] - pb[0]);
+    if (overlap < best) {
+      best = overlap;
+      axis = n;
+    }
+  };
+  for (const Vec3& n : a.impl().faceNormals) consider(poseA.R * n);
+  for (const Vec3& n : b.impl().faceNormals) consider(poseB.R * n);
+  // Edge against edge: the cross products of their directions (parallel edges give none).
+  for (const Vec3& ea : a.impl().edgeDirections) {
+    const Vec3 ua = poseA.R * ea;
+    for (const Vec3& eb : b.impl().edgeDirections) {
+      const Vec3 n = ua.cross(poseB.R * eb);
+      const double length = n.norm();
+      if (length > 1e-9) consider(n / length);
+    }
+  }
+  return best;
+}
+
 void descendToMinimumOverlap(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b,
                              const Pose<3>& poseB, ContactPoint<3>& c) {
+  auto polytope = [](const PreparedGeometry<3>& g) {
+    return g.geometry().type == GeometryType::Box || g.geometry().type == GeometryType::Convex;
+  };
+  if (polytope(a) && polytope(b)) {
+    Vec3 axis;
+    if (leastOverlapOfPolytopes(a, poseA, b, poseB, axis) < c.depth) {
+      ContactPoint<3> moved;
+      if (contactOnAxis(a, poseA, -1, b, poseB, -1, c.point, axis, kInfinity, moved) && moved.depth < c.depth) c = moved;
+    }
+    return;
+  }
   std::vector<Vec3> starts = {c.normal};
   extraStarts(a, poseA, poseB.x, starts);
   extraStarts(b, poseB, poseA.x, starts);

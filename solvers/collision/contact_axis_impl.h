@@ -46,8 +46,16 @@ void refineAxis(const PreparedGeometry<3>& a, const Pose<3>& poseA, const Prepar
 // is that minimum over all axes), from its own axis and from the local minima MPR tends to miss
 // (box faces, cylinder caps and sides), and moves the contact onto the best. libccd's MPR axis,
 // which FCL returns for every convex pair but box-box, can be degrees away, overstating the depth.
+// Two polytopes (boxes and convex hulls) need no search: their penetration depth is the least
+// overlap over their face normals and the cross products of their edge directions (the
+// separating-axis theorem), and this is what it does for them.
 void descendToMinimumOverlap(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b,
                              const Pose<3>& poseB, ContactPoint<3>& c);
+
+// The least overlap of two polytopes (Box or Convex) over the separating-axis test's candidate
+// axes, and its axis (unit, either sign). Exact: no other direction overlaps less.
+double leastOverlapOfPolytopes(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b,
+                               const Pose<3>& poseB, Eigen::Vector3d& axis);
 
 // True when an axis among the triangle's normal and its in-plane edge normals separates shape A
 // (posed in the mesh's frame) from triangle t by more than `margin`: a cheap exact rejection

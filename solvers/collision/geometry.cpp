@@ -65,6 +65,7 @@ void setBox(typename PreparedGeometry<d>::Impl& impl, const Eigen::Matrix<double
         impl.faceNormals.push_back(sign * VecD::Unit(axis));
         impl.faceOffsets.push_back(h[axis]);
       }
+    for (int axis = 0; axis < 3; ++axis) impl.edgeDirections.push_back(VecD::Unit(axis));
   }
   impl.localBounds = Eigen::AlignedBox<double, d>(-h, h);
 }
@@ -128,6 +129,18 @@ void setPolyhedron(PreparedGeometry<3>::Impl& impl, const std::vector<Eigen::Vec
     for (const auto& v : impl.vertices) offset = std::max(offset, n.dot(v));
     addPlane<3>(impl, n, offset, size);
   }
+  // The triangles' edges, one per direction (a hull's faces share edges, and its flat faces'
+  // diagonals are kept: an extra candidate axis only costs a projection).
+  for (const auto& tri : impl.hullTriangles)
+    for (int e = 0; e < 3; ++e) {
+      const Eigen::Vector3d edge = impl.vertices[tri[(e + 1) % 3]] - impl.vertices[tri[e]];
+      const double length = edge.norm();
+      if (!(length > 1e-12 * size)) continue;
+      const Eigen::Vector3d u = edge / length;
+      bool known = false;
+      for (const auto& k : impl.edgeDirections) known = known || std::abs(k.dot(u)) > 1 - 1e-12;
+      if (!known) impl.edgeDirections.push_back(u);
+    }
 }
 
 std::shared_ptr<fcl::CollisionGeometry<double>> makeFclGeometry(const Geometry<3>& g,

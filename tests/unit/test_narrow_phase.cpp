@@ -937,6 +937,40 @@ TEST(NarrowPhase2, OverlapsAndDeterminism) {
 
 }  // namespace
 
+// The penetration depth of A and B by brute force: the least over all axes m of how far A must
+// move along m to separate, searched on a 36 x 72 grid of axes, then by a compass search from
+// the best ten.
+double bruteLeastOverlap(const PreparedGeometry<3>& A, const Pose<3>& pa, const PreparedGeometry<3>& B,
+                         const Pose<3>& pb) {
+  auto overlap = [&](const Vec3& m) { return projection(B, pb, m, -1)[1] - projection(A, pa, m, -1)[0]; };
+  std::vector<std::pair<double, Vec3>> grid;
+  for (int i = 0; i < 36; ++i)
+    for (int j = 0; j < 72; ++j) {
+      const double th = kPi * (i + 0.5) / 36, ph = kPi * j / 36;
+      const Vec3 m(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
+      grid.push_back({overlap(m), m});
+    }
+  std::partial_sort(grid.begin(), grid.begin() + 10, grid.end(),
+                    [](const auto& x, const auto& y) { return x.first < y.first; });
+  double best = kInfinity;
+  for (int s = 0; s < 10; ++s) {
+    Vec3 n = grid[s].second;
+    double value = grid[s].first, step = 0.05;
+    while (step > 1e-8) {
+      const Vec3 e1 = n.unitOrthogonal(), e2 = n.cross(e1);
+      bool improved = false;
+      for (int k = 0; k < 8 && !improved; ++k) {
+        const Vec3 m = (n + step * (std::cos(kPi * k / 4) * e1 + std::sin(kPi * k / 4) * e2)).normalized();
+        const double v = overlap(m);
+        if (v < value) value = v, n = m, improved = true;
+      }
+      if (!improved) step *= 0.5;
+    }
+    best = std::min(best, value);
+  }
+  return best;
+}
+
 TEST(NarrowPhase3, ShallowRandomCylinderContactsHaveThePenetrationDepth) {
   // As above, with a cylinder against every shape (another cylinder included), 0.01 in along a
   // random direction. The pair's deepest contact must be its penetration depth: the least overlap
@@ -975,33 +1009,7 @@ TEST(NarrowPhase3, ShallowRandomCylinderContactsHaveThePenetrationDepth) {
       offSurface += off > 1e-3;
       ++points;
     }
-    // Brute force: overlap(m) = how far A must move along m to separate.
-    auto overlap = [&](const Vec3& m) { return projection(B, pb, m, -1)[1] - projection(A, pa, m, -1)[0]; };
-    std::vector<std::pair<double, Vec3>> grid;
-    for (int i = 0; i < 36; ++i)
-      for (int j = 0; j < 72; ++j) {
-        const double th = kPi * (i + 0.5) / 36, ph = kPi * j / 36;
-        const Vec3 m(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
-        grid.push_back({overlap(m), m});
-      }
-    std::partial_sort(grid.begin(), grid.begin() + 10, grid.end(),
-                      [](const auto& x, const auto& y) { return x.first < y.first; });
-    double best = kInfinity;
-    for (int s = 0; s < 10; ++s) {
-      Vec3 n = grid[s].second;
-      double value = grid[s].first, step = 0.05;
-      while (step > 1e-8) {
-        const Vec3 e1 = n.unitOrthogonal(), e2 = n.cross(e1);
-        bool improved = false;
-        for (int k = 0; k < 8 && !improved; ++k) {
-          const Vec3 m = (n + step * (std::cos(kPi * k / 4) * e1 + std::sin(kPi * k / 4) * e2)).normalized();
-          const double v = overlap(m);
-          if (v < value) value = v, n = m, improved = true;
-        }
-        if (!improved) step *= 0.5;
-      }
-      best = std::min(best, value);
-    }
+    const double best = bruteLeastOverlap(A, pa, B, pb);
     // The bisection's "touching" pose comes from overlaps(), exact to ~1e-3 for cylinders (MPR),
     // so the true depth may exceed `push` slightly.
     EXPECT_LE(best, push + 2e-3) << "case " << it;
@@ -1024,6 +1032,56 @@ TEST(NarrowPhase3, ShallowRandomCylinderContactsHaveThePenetrationDepth) {
               offSurface, points, worstOff, worstError);
   EXPECT_LE(offSurface, points / 10);
   EXPECT_LT(worstOff, 0.01);
+}
+
+TEST(NarrowPhase3, PolytopePairsTakeTheExactSeparatingAxis) {
+  // Boxes and convex hulls against each other, from shallow to deep: the separating-axis test
+  // over face normals and edge-edge cross products (leastOverlapOfPolytopes) must find the
+  // penetration depth itself -- no axis of the brute force's search overlaps less -- and the
+  // pair's deepest contact must not be deeper. The local descent it replaced for these pairs
+  // stops after 64 evaluations from each start; in mixed_pile two thirds of its descents were
+  // still lowering the overlap in their last 8. The brute force's own compass search stalls on
+  // the polytopes' kinks in some cases (11 of 80 here, up to 3.8 mm above), which is why only
+  // "never below" is exact.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Geometry<3> irregular;
+  irregular.type = GeometryType::Convex;
+  for (int k = 0; k < 9; ++k) irregular.vertices.push_back(Vec3(0.4 * u(rng), 0.3 * u(rng), 0.25 * u(rng)));
+  std::vector<Geometry<3>> shapes = {box3(0.5, 0.3, 0.4), convexCube(0.4), irregular};
+  std::vector<std::unique_ptr<PreparedGeometry<3>>> prepared;
+  for (const auto& g : shapes) prepared.push_back(std::make_unique<PreparedGeometry<3>>(g));
+  int cases = 0, searchShort = 0;
+  double worstBelow = 0, worstAbove = 0, worstContact = 0;
+  for (int it = 0; it < 90; ++it) {
+    const int ia = it % 3, ib = (it / 3) % 3;
+    if (ia == 0 && ib == 0) continue;  // box pairs have their own exact routine (box_box.cpp)
+    const PreparedGeometry<3>& A = *prepared[ia];
+    const PreparedGeometry<3>& B = *prepared[ib];
+    const double push = (it / 9) % 2 ? 0.1 : 0.01;
+    const ShallowCase sc = shallowCase(A, B, push, rng);
+    Vec3 axis;
+    const double depth = leastOverlapOfPolytopes(A, sc.pa, B, sc.pb, axis);
+    const Eigen::Vector2d pa = projection(A, sc.pa, axis, -1), pb = projection(B, sc.pb, axis, -1);
+    EXPECT_NEAR(std::min(pb[1] - pa[0], pa[1] - pb[0]), depth, 1e-12) << "case " << it;
+    const double brute = bruteLeastOverlap(A, sc.pa, B, sc.pb);
+    worstBelow = std::max(worstBelow, depth - brute);  // brute force overlapping less: an axis missed
+    worstAbove = std::max(worstAbove, brute - depth);  // the search not reaching it (its own error)
+    searchShort += brute - depth > 1e-6;
+    std::vector<ContactPoint<3>> got;
+    findContacts<3>(A, sc.pa, B, sc.pb, ContactQuery{}, got);
+    ASSERT_FALSE(got.empty()) << "case " << it;
+    double deepest = -kInfinity;
+    for (const auto& c : got) deepest = std::max(deepest, c.depth);
+    worstContact = std::max(worstContact, deepest - depth);
+    ++cases;
+  }
+  EXPECT_EQ(cases, 80);
+  EXPECT_LT(worstBelow, 1e-12);
+  std::printf("polytope pairs: brute force above the exact depth by more than 1e-6 in %d of %d cases, worst %.2e\n",
+              searchShort, cases, worstAbove);
+  EXPECT_LE(searchShort, cases / 4);  // the brute force mostly reaches it: the check above is not vacuous
+  EXPECT_LT(worstContact, 1e-9);
 }
 
 TEST(NarrowPhase3, AContactOnAFaceLiesUnderTheFeatureThatTouchesIt) {
