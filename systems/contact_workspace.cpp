@@ -757,18 +757,9 @@ void ContactWorkspace<d>::addOrdered(solvers::parallel::OrderedTasks& order, con
     order.add(nullptr, 0, nullptr, 0);
     return;
   }
-  // Most tasks touch two bodies: their lists stay on the stack (this runs once per recorded task).
-  constexpr int kOnStack = 8;
-  int writesOnStack[kOnStack], readsOnStack[kOnStack];
-  thread_local std::vector<int> writesLong, readsLong;
-  int* writes = writesOnStack;
-  int* reads = readsOnStack;
-  if (count > kOnStack) {
-    writesLong.resize(count);
-    readsLong.resize(count);
-    writes = writesLong.data();
-    reads = readsLong.data();
-  }
+  // Room for every touched body, filled by index (this runs once per recorded task).
+  thread_local std::vector<int> writes, reads;
+  if (writes.size() < static_cast<std::size_t>(count)) writes.resize(count), reads.resize(count);
   int writeCount = 0, readCount = 0;
   for (int i = 0; i < count; ++i) {
     const ContactBody<d>& b = bodies[touched[i]];
@@ -777,7 +768,7 @@ void ContactWorkspace<d>::addOrdered(solvers::parallel::OrderedTasks& order, con
     if (frozen[local]) reads[readCount++] = local;
     else writes[writeCount++] = local;
   }
-  order.add(writes, writeCount, reads, readCount);
+  order.add(writes.data(), writeCount, reads.data(), readCount);
 }
 
 template <int d>
@@ -789,10 +780,7 @@ typename ContactWorkspace<d>::IslandSchedule& ContactWorkspace<d>::startSchedule
   s.mode = mode;
   s.energyOut = clampEnergyChange;
   s.clampsOut = clampsApplied;
-  s.impulseSum = 0;
-  s.impulses.clear();
-  s.clamps.clear();
-  s.energyChange.clear();
+  s.impulseSum = 0;  // the per-task result slots are sized by runSchedule
   startOrder(s.order, island, taskBound);
   s.collisionSweepRecorded = false;
   s.tasks.clear();

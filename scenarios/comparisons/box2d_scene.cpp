@@ -108,8 +108,7 @@ std::vector<Body> load(const Options& o, const json& root, b2World& world) {
     const std::string type = shape.value("type", "");
     const bool isStatic = rb.value("static", false);
     const b2Vec2 x = rb.contains("position") ? vec2(rb["position"], path + ".rigid_body.position") : b2Vec2(0, 0);
-    const double mass = isStatic ? 0 : number(rb, "mass", 1.0, path + ".rigid_body");
-    if (!isStatic && !(mass > 0)) fail(path + ".rigid_body.mass: expected a positive number");
+    const double mass = isStatic ? 0 : positiveNumber(rb, "mass", 1.0, path + ".rigid_body");
 
     b2BodyDef def;
     def.type = isStatic ? b2_staticBody : b2_dynamicBody;
@@ -140,8 +139,7 @@ std::vector<Body> load(const Options& o, const json& root, b2World& world) {
       area = 4 * h[0] * h[1];
       made.size = 2 * std::min(h[0], h[1]);
     } else if (type == "disk") {
-      const double r = number(shape, "radius", 0, path + ".shape");
-      if (!(r > 0)) fail(path + ".shape.radius: expected a positive number");
+      const double r = positiveNumber(shape, "radius", 0, path + ".shape");
       circle.m_radius = float(r);
       fixture.shape = &circle;
       area = M_PI * r * r;

@@ -94,12 +94,6 @@ struct MadeShape {
   monolith::Shape<3> monolithShape;
 };
 
-double positiveNumber(const json& shape, const char* key, const std::string& path) {
-  const double value = number(shape, key, 0, path);
-  if (!(value > 0)) fail(path + "." + key + ": expected a positive number");
-  return value;
-}
-
 // The smallest size of a shape as Monolith's narrow phase measures it (a box's smallest extent,
 // a hull's least width ...), so that the overlap column means the same thing in both programs.
 double monolithSize(const monolith::solvers::collision::Geometry<3>& g, const std::string& path) {
@@ -117,7 +111,7 @@ MadeShape makeShape(const json& shape, const std::string& path, bool isStatic, c
   const std::string type = shape.value("type", "");
   if (type == "sphere") {
     refuseOtherKeys(shape, {"type", "radius"}, path, "Bullet");
-    const double r = positiveNumber(shape, "radius", path);
+    const double r = positiveNumber(shape, "radius", 0, path);
     m.shape = std::make_unique<btSphereShape>(btScalar(r));
     m.monolithShape.type = monolith::ShapeType::Sphere;
     m.monolithShape.radius = r;
@@ -133,7 +127,7 @@ MadeShape makeShape(const json& shape, const std::string& path, bool isStatic, c
     m.shape->setMargin(marginFor(m.size));  // btBoxShape keeps its extents when the margin changes
   } else if (type == "capsule" || type == "cylinder") {
     refuseOtherKeys(shape, {"type", "radius", "half_height"}, path, "Bullet");
-    const double r = positiveNumber(shape, "radius", path), h = positiveNumber(shape, "half_height", path);
+    const double r = positiveNumber(shape, "radius", 0, path), h = positiveNumber(shape, "half_height", 0, path);
     const bool capsule = type == "capsule";
     // Monolith's axis is the body's z: Bullet's Z variants. A capsule's height in Bullet is its
     // segment's length; its margin is its radius.
@@ -255,8 +249,7 @@ Scene load(const Options& o) {
         pose.setRotation(btQuaternion(btScalar(q[1]), btScalar(q[2]), btScalar(q[3]), btScalar(q[0])).normalized());
       }
     }
-    const double mass = isStatic ? 0 : number(rb, "mass", 1.0, path + ".rigid_body");
-    if (!isStatic && !(mass > 0)) fail(path + ".rigid_body.mass: expected a positive number");
+    const double mass = isStatic ? 0 : positiveNumber(rb, "mass", 1.0, path + ".rigid_body");
     btVector3 inertia(0, 0, 0);
     if (mass > 0) inertia = principalInertia(rb, made.monolithShape, mass, path + ".rigid_body");
     s.shapes.push_back(std::move(made.shape));

@@ -79,6 +79,13 @@ inline double number(const json& object, const char* key, double fallback, const
   return j.get<double>();
 }
 
+// object[key], a positive finite number, or `fallback` when absent.
+inline double positiveNumber(const json& object, const char* key, double fallback, const std::string& path) {
+  const double value = number(object, key, fallback, path);
+  if (!(value > 0)) fail(path + "." + key + ": expected a positive number");
+  return value;
+}
+
 // An array of n finite numbers.
 template <std::size_t n>
 std::array<double, n> numbers(const json& j, const std::string& path) {
