@@ -38,6 +38,9 @@ struct PreparedGeometry<d>::Impl {
   // hull's face diagonals too, which only add candidate axes). With the face normals they give
   // every candidate axis of the exact separating-axis test of two polytopes (contact_axis.cpp).
   std::vector<VecD> edgeDirections;
+  // 3-D polytope: its edges as vertex index pairs (a hull's face diagonals too, which lie on its
+  // surface): the features a segment's nearest point can meet (capsule_polytope.cpp).
+  std::vector<std::array<int, 2>> edges;
   Eigen::AlignedBox<double, d> localBounds;
   // Mesh: a bounding-box tree over the triangles (body frame). FCL's own BVH traversal against a
   // shape costs ~10 us for a few hundred triangles (OBB tests all the way down); the narrow phase

@@ -57,6 +57,21 @@ void descendToMinimumOverlap(const PreparedGeometry<3>& a, const Pose<3>& poseA,
 double leastOverlapOfPolytopes(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b,
                                const Pose<3>& poseB, Eigen::Vector3d& axis);
 
+// A capsule against a polytope (Box or Convex), exactly (capsule_polytope.cpp): the axis the
+// capsule leaves along (unit, world frame), its overlap along it -- the pair's penetration depth,
+// negative when apart -- and a point near the touching features.
+struct CapsulePolytopeAxis {
+  Eigen::Vector3d axis, near;
+  double depth = 0;
+};
+// False when the two are farther apart than `margin`.
+bool capsulePolytopeAxis(const PreparedGeometry<3>& capsule, const Pose<3>& poseC, const PreparedGeometry<3>& polytope,
+                         const Pose<3>& poseP, double margin, CapsulePolytopeAxis& out);
+// The pair's main contact on that axis (A or B the capsule, the other the polytope); false when
+// farther apart than `margin`.
+bool capsulePolytopeContact(const PreparedGeometry<3>& a, const Pose<3>& poseA, const PreparedGeometry<3>& b,
+                            const Pose<3>& poseB, double margin, ContactPoint<3>& out);
+
 // True when an axis among the triangle's normal and its in-plane edge normals separates shape A
 // (posed in the mesh's frame) from triangle t by more than `margin`: a cheap exact rejection
 // before FCL's test.

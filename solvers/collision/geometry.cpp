@@ -9,6 +9,7 @@
 #include <fcl/geometry/shape/sphere.h>
 #include <fcl/math/bv/OBBRSS.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -66,6 +67,9 @@ void setBox(typename PreparedGeometry<d>::Impl& impl, const Eigen::Matrix<double
         impl.faceOffsets.push_back(h[axis]);
       }
     for (int axis = 0; axis < 3; ++axis) impl.edgeDirections.push_back(VecD::Unit(axis));
+    for (int corner = 0; corner < 8; ++corner)  // corners differing in one coordinate's sign
+      for (int bit : {1, 2, 4})
+        if (!(corner & bit)) impl.edges.push_back({corner, corner | bit});
   }
   impl.localBounds = Eigen::AlignedBox<double, d>(-h, h);
 }
@@ -133,6 +137,8 @@ void setPolyhedron(PreparedGeometry<3>::Impl& impl, const std::vector<Eigen::Vec
   // diagonals are kept: an extra candidate axis only costs a projection).
   for (const auto& tri : impl.hullTriangles)
     for (int e = 0; e < 3; ++e) {
+      const std::array<int, 2> ends = {std::min(tri[e], tri[(e + 1) % 3]), std::max(tri[e], tri[(e + 1) % 3])};
+      if (std::find(impl.edges.begin(), impl.edges.end(), ends) == impl.edges.end()) impl.edges.push_back(ends);
       const Eigen::Vector3d edge = impl.vertices[tri[(e + 1) % 3]] - impl.vertices[tri[e]];
       const double length = edge.norm();
       if (!(length > 1e-12 * size)) continue;

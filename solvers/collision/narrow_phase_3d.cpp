@@ -7,6 +7,8 @@
 // capsule-capsule (closest points of the two segments plus the end caps). These support the
 // margin exactly.
 // Box-box: our separating-axis test and clipped face manifold (box_box.cpp, FCL's contract).
+// Capsule against box or hull: the exact penetration depth and axis (capsule_polytope.cpp) for
+// the main contact, plus the feature points both ways.
 // FCL: the rest. The other pairs give FCL's one point,
 // completed as in the thesis by the vertex-in-shape test both ways (the vertices of A inside B
 // with B's face normal and vice versa). Beyond FCL's contact, the margin is served by
@@ -103,6 +105,11 @@ void capsulePair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
 // How a box pair's main contacts were found (boxBoxMain).
 enum class BoxMain { None, Clipped, Nearest };
 
+bool isPolytope(GeometryType t) { return t == GeometryType::Box || t == GeometryType::Convex; }
+bool isCapsulePolytope(GeometryType ta, GeometryType tb) {
+  return (ta == GeometryType::Capsule && isPolytope(tb)) || (tb == GeometryType::Capsule && isPolytope(ta));
+}
+
 // A box pair's main contacts, appended to `main`: our separating-axis test (`sat`) and face
 // clipping (box_box.cpp) instead of FCL's dBoxBox; apart but within the margin, one contact
 // between the exact nearest points instead of fcl::distance. None: farther apart than the margin
@@ -131,6 +138,7 @@ void generalPair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
     return;
   }
   const bool boxBox = typeOf(a) == GeometryType::Box && typeOf(b) == GeometryType::Box;
+  const bool capsulePolytope = isCapsulePolytope(typeOf(a), typeOf(b));
   const double tolerance = kRedundantDepth * scale;
   s.main.clear();
   s.extra.clear();
@@ -142,12 +150,17 @@ void generalPair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
     boxMain = boxBoxMain(a, pa, b, pb, margin, sat, s.main);
     if (boxMain == BoxMain::None) return;
     s.triangles.assign(s.main.size(), -1);
+  } else if (capsulePolytope) {  // exact (capsule_polytope.cpp): no FCL, no search
+    CP c;
+    if (!capsulePolytopeContact(a, pa, b, pb, margin, c)) return;
+    s.main.push_back(c);
+    s.triangles.push_back(-1);
   } else {
     fclWorked = fclContacts(a, pa, b, pb, s.main, s.triangles);
   }
   const bool clippedManifold = boxMain == BoxMain::Clipped;  // the clipped box-box points: all kept
   // Else from the distance query (exact axis).
-  const bool fromFcl = boxBox ? clippedManifold : !s.main.empty();
+  const bool fromFcl = boxBox ? clippedManifold : !capsulePolytope && !s.main.empty();
   if (fclWorked && s.main.empty()) {  // (not box pairs: boxBoxMain did their distance query)
     if (!(margin > 0)) return;
     CP c;
@@ -163,7 +176,7 @@ void generalPair(const PG& a, const Pose<3>& pa, const PG& b, const Pose<3>& pb,
     const Vec3 towardsB = s.main.empty() ? Vec3(pb.x - pa.x) : Vec3(-s.main[0].normal);
     featureContacts<3>(a, pa, towardsB, b, pb, margin, false, s.features, s.extra);
     featureContacts<3>(b, pb, -towardsB, a, pa, margin, true, s.features, s.extra);
-    if (s.main.size() == 1) {
+    if (s.main.size() == 1 && !capsulePolytope) {
       // The feature contacts' normals are face normals of A and B: candidate separating axes.
       // The one along which the shapes overlap least (if less than along FCL's axis) carries the
       // main contact, as the minimum-translation direction of the pair.
@@ -259,7 +272,7 @@ bool contactsAreCheap(GeometryType ta, GeometryType tb) {
   if (ta == GeometryType::HalfSpace || tb == GeometryType::HalfSpace) return true;
   if (ta == GeometryType::Mesh || tb == GeometryType::Mesh) return ta != tb;
   return ta == GeometryType::Sphere || tb == GeometryType::Sphere ||
-         (ta == GeometryType::Capsule && tb == GeometryType::Capsule);
+         (ta == GeometryType::Capsule && tb == GeometryType::Capsule) || isCapsulePolytope(ta, tb);
 }
 
 }  // namespace
