@@ -1034,6 +1034,15 @@ TEST(NarrowPhase3, ShallowRandomCylinderContactsHaveThePenetrationDepth) {
   EXPECT_LT(worstOff, 0.01);
 }
 
+// The hull of 9 random points in a 0.8 x 0.6 x 0.5 box: faces and edges in no special direction.
+Geometry<3> irregularHull(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  Geometry<3> g;
+  g.type = GeometryType::Convex;
+  for (int k = 0; k < 9; ++k) g.vertices.push_back(Vec3(0.4 * u(rng), 0.3 * u(rng), 0.25 * u(rng)));
+  return g;
+}
+
 TEST(NarrowPhase3, PolytopePairsTakeTheExactSeparatingAxis) {
   // Boxes and convex hulls against each other, from shallow to deep: the separating-axis test
   // over face normals and edge-edge cross products (leastOverlapOfPolytopes) must find the
@@ -1044,10 +1053,7 @@ TEST(NarrowPhase3, PolytopePairsTakeTheExactSeparatingAxis) {
   // the polytopes' kinks in some cases (11 of 80 here, up to 3.8 mm above), which is why only
   // "never below" is exact.
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> u(-1, 1);
-  Geometry<3> irregular;
-  irregular.type = GeometryType::Convex;
-  for (int k = 0; k < 9; ++k) irregular.vertices.push_back(Vec3(0.4 * u(rng), 0.3 * u(rng), 0.25 * u(rng)));
+  const Geometry<3> irregular = irregularHull(rng);
   std::vector<Geometry<3>> shapes = {box3(0.5, 0.3, 0.4), convexCube(0.4), irregular};
   std::vector<std::unique_ptr<PreparedGeometry<3>>> prepared;
   for (const auto& g : shapes) prepared.push_back(std::make_unique<PreparedGeometry<3>>(g));
@@ -1104,10 +1110,7 @@ TEST(NarrowPhase3, CapsuleAgainstPolytopeTakesTheExactAxis) {
   // overlaps less; and where the core is apart, the depth is the radius minus the core's
   // distance found by a search along the segment. The pair's deepest contact must not be deeper.
   std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-1, 1);
-  Geometry<3> irregular;
-  irregular.type = GeometryType::Convex;
-  for (int k = 0; k < 9; ++k) irregular.vertices.push_back(Vec3(0.4 * u(rng), 0.3 * u(rng), 0.25 * u(rng)));
+  const Geometry<3> irregular = irregularHull(rng);
   const std::vector<Geometry<3>> capsules = {capsule3(0.2, 0.4), capsule3(0.05, 0.5)};
   const std::vector<Geometry<3>> polytopes = {box3(0.5, 0.3, 0.4), convexCube(0.4), irregular};
   std::vector<std::unique_ptr<PreparedGeometry<3>>> caps, polys;
