@@ -95,6 +95,12 @@ struct ContactPairState {
   bool swept = false;      // a collision update found it touching along the step's motion (swept_contact.h)
   long checkedStamp = -1;
   int level = 0;
+  // The normal impulse and the net friction impulse (world frame, on a; 2-D uses two entries)
+  // the pair's contact updates applied so far in this stage (Step III's contact and shock
+  // propagation, or Step V's): Coulomb's law over the stage, which shock propagation's friction
+  // may lean on (ContactWorkspace::findPairImpulse, "shockFriction").
+  double stageNormal = 0;
+  std::array<double, 3> stageFriction = {0, 0, 0};
   // How the pair's last manifold solve ended, per point in the narrow phase's order: the exact
   // finish starts the next solve of the pair from it (one pass instead of one per point that
   // turns to sliding). Kept across steps by findPairs.
@@ -180,21 +186,26 @@ class ContactWorkspace {
   // (at most `iterations` sweeps) and applied. Returns how many points carry impulse.
   int updatePair(ContactPairState& pair, ImpulseMode mode, double epsilon, int iterations, double margin,
                  std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
-                 int* clampsApplied) {
+                 int* clampsApplied, bool shockFriction = false) {
     ContactBody<d>& A = bodies[pair.a];
     ContactBody<d>& B = bodies[pair.b];
     const PairImpulse r = findPairImpulse(pair, A, B, mode, epsilon, iterations, margin, scratch, clampEnergyChange,
-                                          clampsApplied);
+                                          clampsApplied, shockFriction);
     if (r.active > 0) applyPairImpulse(pair, A, B, r, mode);
     return r.active;
   }
   // The update's first half: finds the impulse, only reading the bodies (the speculative sweep
-  // runs it on many pairs at once). The pair's own state (processed, swept, the solve's end)
-  // is updated as the update leaves it.
+  // runs it on many pairs at once). The pair's own state (processed, swept, the solve's end,
+  // the stage's impulses) is updated as the update leaves it.
+  // shockFriction (shock propagation; not in the thesis): the pair's friction may lean on the
+  // normal impulse it carried earlier in the stage, and the pair is solved when it slides even
+  // if nothing approaches. The contact sweeps before it remove the approach, so without this
+  // shock propagation's updates carry no normal impulse and cannot stop the slip those sweeps
+  // leave (an off-centre box on a box walked at millimetres per second).
   PairImpulse findPairImpulse(ContactPairState& pair, const ContactBody<d>& A, const ContactBody<d>& B,
                               ImpulseMode mode, double epsilon, int iterations, double margin,
                               std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
-                              int* clampsApplied) const;
+                              int* clampsApplied, bool shockFriction = false) const;
   // The second half: the impulse on both bodies (those of finite mass), their candidates
   // re-advanced; a contact impulse marks the pair contacted (Step V's list).
   void applyPairImpulse(ContactPairState& pair, ContactBody<d>& A, ContactBody<d>& B, const PairImpulse& r,
@@ -261,6 +272,7 @@ class ContactWorkspace {
     int listBegin = 0, listEnd = 0;  // Joint: its pairs, in IslandSchedule::jointPairs
     double epsilon = 0;
     int iterations = 0;
+    bool shockFriction = false;  // Pair, Joint: in shock propagation (findPairImpulse)
     long stamp = 0;  // Collision: the stamp of this check (increasing along the sequence)
   };
   struct IslandSchedule {

@@ -32,6 +32,10 @@ struct PgsPoint {
   VecD ra = VecD::Zero(), rb = VecD::Zero(), n = VecD::Zero();  // lever arms, normal out of b
   Mat<d> K = Mat<d>::Zero();  // K_a + K_b at the point (impulse.h): prepareOnePoint only
   double target = 0, mu = 0;  // target normal velocity, Coulomb coefficient
+  // Normal impulse the point's friction may lean on beyond its own: the Coulomb disk's radius is
+  // mu (lambda + frictionPreload). Shock propagation sets it from what the pair carried earlier
+  // in the stage (ContactWorkspace::findPairImpulse); otherwise 0, the plain Coulomb law.
+  double frictionPreload = 0;
   // Constant velocity of the partner at the point (joint solve against frozen bodies), else 0.
   VecD partnerVelocity = VecD::Zero();
   // Accumulated impulses.
@@ -295,7 +299,7 @@ template <int d, bool movesA, bool movesB>
   const double lambda = std::max(0.0, p.normalImpulse + (p.target - vn) * p.inverseKn);
   // A point that carries nothing and stays unloaded (separating): the Coulomb disk has radius 0,
   // so the step below would change nothing; skip it.
-  bool unloaded = lambda == 0 && p.normalImpulse == 0;
+  bool unloaded = lambda == 0 && p.normalImpulse == 0 && p.frictionPreload == 0;
   for (int k = 0; k < m; ++k) unloaded = unloaded && p.tangentImpulse[k] == 0;
   if (unloaded) return 0.0;
   const double dl = lambda - p.normalImpulse;
@@ -311,7 +315,7 @@ template <int d, bool movesA, bool movesB>
       for (int l = 0; l < m; ++l) f[k] -= p.tangentMass(k, l) * vt[l];
       f2 += f[k] * f[k];
     }
-    const double limit = p.mu * lambda;
+    const double limit = p.mu * (lambda + p.frictionPreload);
     if (f2 > limit * limit) projectFriction<d>(p, f, limit);
     double df2 = 0;
     for (int k = 0; k < m; ++k) {
