@@ -670,10 +670,12 @@ typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
   if (anySliding && slipLeft<d>(points, before) > std::max(tolerance + settings.approachTolerance, kLeanSlip * speedScale)) {
     // Shock propagation, still sliding: solved again with the friction leaning on the stage's
     // normal impulse (projected Gauss-Seidel; the closed forms have only the plain law).
+    // Prepared for sweeps in full: the points may have had only the closed form's or the exact
+    // finish's preparation.
     state = before;
     state.setExactFinish(false);
     for (Point& p : points) {
-      if (onePoint) p.prepareForSolve(false, A.inverseMass() + B.inverseMass(), Ia, Ib);
+      p.prepareForSolve(false, A.inverseMass() + B.inverseMass(), Ia, Ib);
       p.normalImpulse = 0;
       p.tangentImpulse.setZero();
       p.frictionPreload = allowance / double(points.size());
@@ -813,8 +815,9 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
   if (anyApproaching) con::pgsSolve<d>(points, state, iterations, tolerance);
   if (anySliding && slipLeft<d>(points, before) > std::max(tolerance + settings.approachTolerance, kLeanSlip * speedScale)) {
     state = before;
-    state.setExactFinish(false);
+    state.setExactFinish(false);  // and the points prepared for sweeps in full
     for (std::size_t k = 0; k < points.size(); ++k) {
+      points[k].prepareForSolve(false, C.inverseMass(), Iinv, none);
       points[k].normalImpulse = 0;
       points[k].tangentImpulse.setZero();
       points[k].frictionPreload = preloads[k];
