@@ -667,7 +667,8 @@ typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
     con::pgsSolve<d>(points, state, iterations, tolerance);
     if (state.exactFinish) rememberEndStates<d>(pair, points);
   }
-  if (anySliding && slipLeft<d>(points, before) > std::max(tolerance + settings.approachTolerance, kLeanSlip * speedScale)) {
+  const double slipBound = std::max(tolerance + settings.approachTolerance, kLeanSlip * speedScale);
+  if (anySliding && slipLeft<d>(points, before) > slipBound) {
     // Shock propagation, still sliding: solved again with the friction leaning on the stage's
     // normal impulse (projected Gauss-Seidel; the closed forms have only the plain law).
     // Prepared for sweeps in full: the points may have had only the closed form's or the exact
@@ -813,7 +814,8 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
   state.inverseInertiaA = Iinv;
   const con::PgsBodies<d> before = state;
   if (anyApproaching) con::pgsSolve<d>(points, state, iterations, tolerance);
-  if (anySliding && slipLeft<d>(points, before) > std::max(tolerance + settings.approachTolerance, kLeanSlip * speedScale)) {
+  const double slipBound = std::max(tolerance + settings.approachTolerance, kLeanSlip * speedScale);
+  if (anySliding && slipLeft<d>(points, before) > slipBound) {
     state = before;
     state.setExactFinish(false);  // and the points prepared for sweeps in full
     for (std::size_t k = 0; k < points.size(); ++k) {
