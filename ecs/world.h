@@ -107,6 +107,13 @@ struct ContactSettings {
   double thickness = 1e-4;           // contact is processed within this separation (m)
   double pushOutTolerance = 1e-5;    // penetration left alone by push-out (m)
   double approachTolerance = 1e-9;   // |v_rel.n| below this is "not approaching" (m/s)
+  // Sleeping (not in the thesis; systems/sleep.h): an island of dynamic bodies whose every point
+  // has moved slower than sleepSpeed for sleepTime is held still until an awake or moving body
+  // touches it. Off by default: it stops bodies the thesis's scheme would still move by up to
+  // sleepSpeed. Box2D's defaults are 0.01 m/s (and 2 degrees/s) for 0.5 s.
+  bool sleep = false;
+  double sleepSpeed = 0.01;          // m/s, at the body's farthest point from its centre of mass
+  double sleepTime = 0.5;            // s
 };
 
 // Scene-wide physical settings shared by systems (read-only during a step).

@@ -11,6 +11,7 @@
 #include "components/rigid_body.h"
 #include "ecs/plugin.h"
 #include "scenarios/plugin_search.h"
+#include "systems/sleep.h"
 
 namespace monolith {
 
@@ -450,6 +451,9 @@ void parseContactSettings(const Config& c, ContactSettings& s) {
   s.thickness = c.number("thickness", s.thickness, Bound::NonNegative);
   s.pushOutTolerance = c.number("push_out_tolerance", s.pushOutTolerance, Bound::NonNegative);
   s.approachTolerance = c.number("approach_tolerance", s.approachTolerance, Bound::NonNegative);
+  s.sleep = c.boolean("sleep", s.sleep);
+  s.sleepSpeed = c.number("sleep_speed", s.sleepSpeed, Bound::Positive);
+  s.sleepTime = c.number("sleep_time", s.sleepTime, Bound::Positive);
   c.finish();
 }
 }  // namespace
@@ -517,6 +521,7 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
     throw;
   }
   world.settings() = settings;
+  if (settings.contact.sleep) enableSleeping(world);
 }
 
 template void populateWorld<2>(const SceneSpec&, const Registry&, World<2>&);

@@ -27,9 +27,10 @@ void AdvanceRigidPositions<d>::run(World<d>& world, StepContext& ctx) {
   const RigidRotationSettings rule = world.settings().rigidRotation;
   reports_.assign(forces.size(), BodyReport{});
 
+  const auto* sleeps = world.template findPool<Sleep<d>>();
   parallelForEachIndex(forces.size(), [&](std::size_t i) {
     RigidBody<d>* body = bodies.get(forces.entities()[i]);
-    if (!body || body->isStatic) return;
+    if (!body || body->isStatic || isAsleep<d>(sleeps, forces.entities()[i])) return;
     body->x += dt * body->v;
     if constexpr (d == 2) {
       body->orientation += dt * body->omega()(0);

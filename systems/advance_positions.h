@@ -9,6 +9,7 @@
 // without any fix.
 #include "components/forces.h"
 #include "components/rigid_body.h"
+#include "components/sleep.h"
 #include "ecs/system.h"
 
 namespace monolith {
@@ -18,7 +19,7 @@ class AdvanceRigidPositions final : public System<d> {
  public:
   std::string name() const override { return "advance_rigid_positions"; }
   Stage stage() const override { return Stage::AdvancePositions; }
-  std::vector<std::string> reads() const override { return {}; }
+  std::vector<std::string> reads() const override { return {Sleep<d>::kName}; }
   std::vector<std::string> writes() const override { return {RigidBody<d>::kName}; }
   bool needed(const World<d>& w) const override { return w.template count<RigidForces<d>>() > 0; }
   void run(World<d>& world, StepContext& ctx) override;

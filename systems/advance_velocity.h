@@ -6,6 +6,7 @@
 // With constant forces this reproduces free flight exactly (x^{n+1} = x^n + dt v^n + dt^2/2 a).
 #include "components/forces.h"
 #include "components/rigid_body.h"
+#include "components/sleep.h"
 #include "ecs/system.h"
 
 namespace monolith {
@@ -18,7 +19,7 @@ class RigidHalfKick : public System<d> {
     return stage_ == Stage::AdvanceVelocityHalf ? "advance_rigid_velocity_half" : "advance_rigid_velocity";
   }
   Stage stage() const override { return stage_; }
-  std::vector<std::string> reads() const override { return {RigidForces<d>::kName}; }
+  std::vector<std::string> reads() const override { return {RigidForces<d>::kName, Sleep<d>::kName}; }
   std::vector<std::string> writes() const override { return {RigidBody<d>::kName}; }
   bool needed(const World<d>& w) const override { return w.template count<RigidForces<d>>() > 0; }
   void run(World<d>& world, StepContext& ctx) override;

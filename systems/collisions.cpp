@@ -12,6 +12,7 @@ void Collisions<d>::run(World<d>& world, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (!ws.pack(world, ctx.dt, /*subtractKick=*/true)) return;
   ws.findPairs();
+  const int woken = ws.wakeTouchedSleepers(world);  // sleeping on (systems/sleep.h), else 0
   const auto energyBefore = ws.readEnergy();
 
   std::vector<int> impulses(ws.islands.members.size(), 0), clamps(ws.islands.members.size(), 0);
@@ -55,6 +56,7 @@ void Collisions<d>::run(World<d>& world, StepContext& ctx) {
   out.set("collision_pairs_swept", swept);  // fast pairs met where they first touch (swept_contact.h)
   out.set("collision_impulses", impulseCount);
   out.set("collision_energy_clamps", clampCount);
+  if (world.template count<Sleep<d>>() > 0) out.set("bodies_woken", woken);
   out.set("contact_islands", static_cast<double>(ws.islands.members.size()));
   out.set("contact_levels", ws.levels.count());
   // Kinetic energy of the time-n state before and after the collision impulses (Sec. 2.3.2:

@@ -92,7 +92,7 @@ bool mayApproach(const ContactBody<d>& a, const ContactBody<d>& b, const con::An
 template <int d>
 con::AngMat<d> splitInverseInertiaAt(const ContactBody<d>& b, const col::Pose<d>& pose) {
   if constexpr (d == 3) {
-    if (!b.isStatic) return pose.R * b.body->inertiaBodyInverse * pose.R.transpose();
+    if (!b.still()) return pose.R * b.body->inertiaBodyInverse * pose.R.transpose();
   }
   return b.inverseInertia0;
 }
@@ -251,6 +251,7 @@ bool ContactWorkspace<d>::pack(World<d>& world, double stepDt, bool subtractKick
   const auto& colliders = world.template pool<Collider<d>>();
   const auto* kinematics = world.template findPool<KinematicMotion<d>>();
   const auto* forces = world.template findPool<RigidForces<d>>();
+  const auto* sleeps = world.template findPool<Sleep<d>>();
   auto packRange = [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const Entity e = entities_[i];
@@ -261,6 +262,7 @@ bool ContactWorkspace<d>::pack(World<d>& world, double stepDt, bool subtractKick
       b.geometry = geometries_[i].get();
       b.isStatic = rb->isStatic;
       b.kinematic = kinematics && kinematics->get(e);
+      b.asleep = isAsleep<d>(sleeps, e);
       b.frozen = false;
       b.mass = rb->mass;
       b.restitution = c->restitution;
@@ -315,14 +317,14 @@ typename ContactWorkspace<d>::VecD ContactWorkspace<d>::clampFrameVelocity(const
   // kinetic energy in Step V that way), so it is measured in the world, or the kinematic
   // frame of the scene, as the stage's energy is checked.
   if (partner.kinematic) return partner.pointVelocity(r);
-  if (partner.isStatic || kinematicFrameBody_ < 0) return VecD::Zero();
+  if (partner.still() || kinematicFrameBody_ < 0) return VecD::Zero();
   return bodies[kinematicFrameBody_].v;
 }
 
 template <int d>
 void ContactWorkspace<d>::unpack(bool positions) {
   for (ContactBody<d>& b : bodies) {
-    if (b.isStatic || b.kinematic) continue;
+    if (b.isStatic || b.kinematic || b.asleep) continue;
     b.body->v = b.v;
     b.body->L = b.L;
     if (positions) {
@@ -358,7 +360,7 @@ void ContactWorkspace<d>::reportEnergyChange(DiagnosticsSink& out, const std::st
 
 template <int d>
 void ContactWorkspace<d>::updateCandidate(ContactBody<d>& b) const {
-  if (b.isStatic) {
+  if (b.still()) {
     b.candidate.x = b.x0;
     b.candidate.R = b.R0;
     b.inverseInertiaCandidate = b.inverseInertia0;
@@ -382,7 +384,7 @@ col::StepMotion<d> ContactWorkspace<d>::stepMotion(const ContactBody<d>& b) cons
   col::StepMotion<d> m;
   m.start.x = b.x0;
   m.start.R = b.R0;
-  if (b.isStatic) return m;
+  if (b.still()) return m;
   const double k = kick ? 1.0 : 0.0;
   m.translation = b.candidate.x - b.x0;
   const con::AngVec<d> w = b.inverseInertia0 * (b.L + k * b.dL);  // as updateCandidate turns it
@@ -415,7 +417,7 @@ void ContactWorkspace<d>::findPairs() {
     box.min() -= pad;
     box.max() += pad;
     boxes_[i] = box;
-    infinite_[i] = (b.isStatic || b.kinematic) ? 1 : 0;
+    infinite_[i] = (b.isStatic || b.kinematic || b.asleep) ? 1 : 0;
   }
   // Sweep and prune is the faster of the two below about 500 boxes, FCL's dynamic AABB tree
   // above (bench_narrow_phase); both return the same sorted pairs.
@@ -447,7 +449,7 @@ void ContactWorkspace<d>::findPairs() {
 template <int d>
 col::Pose<d> ContactWorkspace<d>::reAdvanced(const ContactBody<d>& b, double k) const {
   col::Pose<d> p;
-  if (b.isStatic) {
+  if (b.still()) {
     p.x = b.x0;
     p.R = b.R0;
     return p;
@@ -523,8 +525,8 @@ int ContactWorkspace<d>::computeLevels() {
     for (std::size_t k = r.begin(); k != r.end(); ++k) {
       const ContactBody<d>& A = bodies[pairs[k].a];
       const ContactBody<d>& B = bodies[pairs[k].b];
-      aOverB[k] = !(A.isStatic || A.kinematic) && touches(pairs[k].a, pairs[k].b);
-      bOverA[k] = !(B.isStatic || B.kinematic) && touches(pairs[k].b, pairs[k].a);
+      aOverB[k] = !(A.isStatic || A.kinematic || A.asleep) && touches(pairs[k].a, pairs[k].b);
+      bOverA[k] = !(B.isStatic || B.kinematic || B.asleep) && touches(pairs[k].b, pairs[k].a);
     }
   });
   for (std::size_t k = 0; k < pairs.size(); ++k) {
@@ -885,7 +887,7 @@ void ContactWorkspace<d>::addOrdered(solvers::parallel::OrderedTasks& order, con
   int writeCount = 0, readCount = 0;
   for (int i = 0; i < count; ++i) {
     const ContactBody<d>& b = bodies[touched[i]];
-    if (b.isStatic || b.kinematic) continue;
+    if (b.isStatic || b.kinematic || b.asleep) continue;
     const int local = memberIndex_[touched[i]];
     if (frozen[local]) reads[readCount++] = local;
     else writes[writeCount++] = local;
@@ -914,7 +916,7 @@ typename ContactWorkspace<d>::IslandSchedule& ContactWorkspace<d>::startSchedule
 template <int d>
 bool ContactWorkspace<d>::infiniteIn(const IslandSchedule& s, int body) const {
   const ContactBody<d>& b = bodies[body];
-  return b.isStatic || b.kinematic || (memberIndex_[body] >= 0 && s.frozen[memberIndex_[body]]);
+  return b.isStatic || b.kinematic || b.asleep || (memberIndex_[body] >= 0 && s.frozen[memberIndex_[body]]);
 }
 
 // What a collision check leaves for the skip test (notes 1.4): the bodies it moved carry its

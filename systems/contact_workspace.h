@@ -18,6 +18,7 @@
 #include "components/kinematic.h"
 #include "components/rigid_body.h"
 #include "components/shape.h"
+#include "components/sleep.h"
 #include "ecs/step_context.h"
 #include "ecs/world.h"
 #include "solvers/collision/broad_phase.h"
@@ -55,6 +56,9 @@ struct ContactBody {
   const solvers::collision::PreparedGeometry<d>* geometry = nullptr;
   bool isStatic = false, kinematic = false;
   bool frozen = false;  // shock propagation / push-out: treated as infinitely massive for now
+  // Asleep (components/sleep.h): held still for the whole step, infinitely massive like a static
+  // body, but with its own collision geometry (a static box's may reach into the ground).
+  bool asleep = false;
   // A sphere with isotropic inertia (3-D): its orientation changes neither its shape in the
   // world nor its world inertia, so candidate poses skip turning it (a sphere pour spent about
   // 15 % of its time there).
@@ -78,7 +82,9 @@ struct ContactBody {
   AngM inverseInertiaCandidate = AngM::Zero();
   long movedStamp = 0;
 
-  bool infinite() const { return isStatic || kinematic || frozen; }
+  bool infinite() const { return isStatic || kinematic || asleep || frozen; }
+  // Held where it is for the whole step (the pose updates skip it).
+  bool still() const { return isStatic || asleep; }
   double inverseMass() const { return infinite() ? 0.0 : 1.0 / mass; }
   AngM inverseInertia() const { return infinite() ? AngM::Zero() : inverseInertia0; }
   AngV omega() const { return inverseInertia0 * L; }
@@ -156,6 +162,13 @@ class ContactWorkspace {
 
   // Broad phase at the candidate poses, then islands; resets pair flags.
   void findPairs();
+  // Step II's start with sleeping on (systems/sleep.cpp): wakes the sleeping bodies a pair of
+  // findPairs joins to an awake dynamic body, and those whose box a moving kinematic body's
+  // reaches, each with the bodies it fell asleep with; gives them the Step I kick they missed,
+  // packs again and finds the pairs again, until nothing more wakes. Returns the bodies woken.
+  int wakeTouchedSleepers(World<d>& world);
+  // The entity of bodies[i].
+  Entity entityOf(std::size_t i) const { return entities_[i]; }
   // Contact-graph levels from the processed pairs (Step III item 1, notes 1.6). First grows the
   // pair list to where the collision impulses sent the bodies (growPairs); returns the pairs
   // that added.

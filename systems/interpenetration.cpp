@@ -513,7 +513,7 @@ void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
   // Where Step IV put the moving bodies (a static one keeps pack's pose: its collision
   // geometry's centre, which for a grounded box is not the body's, grounded_box.h).
   for (auto& b : ws.bodies)
-    if (!b.isStatic) setBasePose<d>(b, b.body->x, b.body->orientation);
+    if (!b.still()) setBasePose<d>(b, b.body->x, b.body->orientation);
   const ContactSettings& s = ws.settings;
 
   // The pairs where Step IV put the bodies (Step III's impulses moved them too), then those that
@@ -654,7 +654,7 @@ void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
   }
 
   for (auto& b : ws.bodies) {
-    if (b.isStatic || b.kinematic) continue;
+    if (b.isStatic || b.kinematic || b.asleep) continue;
     b.v = b.vCollided + b.dv;
     b.L = b.LCollided + b.dL;
   }

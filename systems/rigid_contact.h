@@ -11,6 +11,8 @@
 //                                     velocity is reset to \hat v^n (+ the Step I kick)
 //   velocity_contact         Step V   (Sec. 2.3.2 "Contact Clamping"): contact again on the pairs
 //                                     contact touched, clamped against (x^{n+1}, v^{n+1})
+//   fall_asleep              after Step V, with sleeping on (not in the thesis; systems/sleep.h):
+//                                     islands that have been still long enough are held still
 #include <memory>
 #include <utility>
 #include <vector>
@@ -28,7 +30,10 @@ class RigidContactSystem : public System<d> {
   std::vector<std::string> reads() const override {
     return {Collider<d>::kName, Shape<d>::kName, RigidForces<d>::kName, KinematicMotion<d>::kName};
   }
-  std::vector<std::string> writes() const override { return {RigidBody<d>::kName, "contact_workspace"}; }
+  // Sleep: Step II wakes bodies (wakeTouchedSleepers), fall_asleep puts them to sleep.
+  std::vector<std::string> writes() const override {
+    return {RigidBody<d>::kName, "contact_workspace", Sleep<d>::kName};
+  }
   bool needed(const World<d>& w) const override { return w.template count<Collider<d>>() > 0; }
 
  protected:
@@ -173,7 +178,28 @@ class VelocityContact final : public RigidContactSystem<d> {
   void run(World<d>& world, StepContext& ctx) override;
 };
 
-// The five systems above sharing one workspace, in pipeline order.
+// Sleeping (not in the thesis; systems/sleep.h): after Step V, every dynamic body of an island
+// (the bodies the step's pairs join) that has moved slower than sleep_speed for sleep_time is
+// put to sleep with the others of its island, at rest.
+template <int d>
+class FallAsleep final : public RigidContactSystem<d> {
+ public:
+  using RigidContactSystem<d>::RigidContactSystem;
+  std::string name() const override { return "fall_asleep"; }
+  Stage stage() const override { return Stage::AdvanceVelocity; }
+  bool needed(const World<d>& w) const override {
+    return RigidContactSystem<d>::needed(w) && w.template count<Sleep<d>>() > 0;
+  }
+  void run(World<d>& world, StepContext& ctx) override;
+
+ private:
+  std::vector<double> reach_;  // per body: its farthest point's distance from its centre of mass
+  std::vector<const solvers::collision::PreparedGeometry<d>*> reachOf_;  // the geometry reach_ is of
+  std::vector<int> parent_;    // union-find over the step's pairs
+  std::vector<char> blocked_;  // per island root: a member that may not sleep yet
+};
+
+// The systems above sharing one workspace, in pipeline order.
 template <int d>
 std::vector<std::unique_ptr<System<d>>> makeRigidContactSystems();
 

@@ -50,6 +50,7 @@ std::vector<std::unique_ptr<System<d>>> makeRigidContactSystems() {
   v.push_back(std::make_unique<ShockPropagation<d>>(ws));
   v.push_back(std::make_unique<ResolveInterpenetration<d>>(ws));
   v.push_back(std::make_unique<VelocityContact<d>>(ws));
+  v.push_back(std::make_unique<FallAsleep<d>>(ws));
   return v;
 }
 

@@ -1,0 +1,162 @@
+// Sleeping: the wake test at Step II's start and fall_asleep after Step V (systems/sleep.h).
+#include "systems/sleep.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "components/fluid_obstacle.h"
+#include "systems/rigid_contact.h"
+
+namespace monolith {
+
+namespace col = solvers::collision;
+
+template <int d>
+void enableSleeping(World<d>& world) {
+  std::vector<Entity> eligible;
+  world.template each<Collider<d>, RigidBody<d>>([&](Entity e, Collider<d>&, RigidBody<d>& b) {
+    if (b.isStatic || world.template get<KinematicMotion<d>>(e) || world.template get<FluidObstacle>(e) ||
+        world.template get<Sleep<d>>(e))
+      return;
+    eligible.push_back(e);
+  });
+  for (const Entity e : eligible) world.add(e, Sleep<d>{});
+}
+
+template <int d>
+int ContactWorkspace<d>::wakeTouchedSleepers(World<d>& world) {
+  if (world.template count<Sleep<d>>() == 0) return 0;
+  auto& sleeps = world.template pool<Sleep<d>>();
+  const auto* forces = world.template findPool<RigidForces<d>>();
+  auto groupOf = [&](std::size_t i) { return sleeps.get(entities_[i])->group; };
+  int woken = 0;
+  std::vector<std::int64_t> groups;
+  for (;;) {
+    groups.clear();
+    // A pair of a sleeping body and an awake dynamic one (two bodies of infinite mass never
+    // make a pair: the broad phase skips them).
+    for (const ContactPairState& p : pairs) {
+      const ContactBody<d>& A = bodies[p.a];
+      const ContactBody<d>& B = bodies[p.b];
+      if (A.asleep && !B.infinite()) groups.push_back(groupOf(p.a));
+      if (B.asleep && !A.infinite()) groups.push_back(groupOf(p.b));
+    }
+    // A moving kinematic body: its box (over the step's motion, findPairs) against the sleepers'.
+    for (std::size_t k = 0; k < bodies.size(); ++k) {
+      const ContactBody<d>& K = bodies[k];
+      if (!K.kinematic || (K.v.squaredNorm() == 0 && K.L.squaredNorm() == 0)) continue;
+      for (std::size_t i = 0; i < bodies.size(); ++i)
+        if (bodies[i].asleep && boxes_[k].intersects(boxes_[i])) groups.push_back(groupOf(i));
+    }
+    if (groups.empty()) return woken;
+    std::sort(groups.begin(), groups.end());
+    groups.erase(std::unique(groups.begin(), groups.end()), groups.end());
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      if (!bodies[i].asleep || !std::binary_search(groups.begin(), groups.end(), groupOf(i))) continue;
+      Sleep<d>& s = *sleeps.get(entities_[i]);
+      s.asleep = false;
+      s.stillTime = 0;
+      s.group = -1;
+      // Step I skipped it (systems/advance_velocity.cpp): its kick now, from rest.
+      RigidBody<d>& rb = *bodies[i].body;
+      if (const RigidForces<d>* f = forces ? forces->get(entities_[i]) : nullptr) {
+        rb.v += (0.5 * dt / rb.mass) * f->force;
+        rb.L += 0.5 * dt * f->torque;
+      }
+      ++woken;
+    }
+    // The woken bodies move from here on: pack them as such and find their pairs (with each
+    // other, and with sleepers they touch, which the next pass wakes).
+    pack(world, dt, kick);
+    findPairs();
+  }
+}
+
+namespace {
+// The farthest a point of the geometry lies from the body's centre of mass (a bound: the corner
+// of its body-frame bounding box), so |v| + |w| reach bounds every point's speed.
+template <int d>
+double farthestPoint(const col::PreparedGeometry<d>& g) {
+  const Eigen::AlignedBox<double, d> box = col::worldBounds(g, col::Pose<d>{});
+  return box.min().cwiseAbs().cwiseMax(box.max().cwiseAbs()).norm();
+}
+
+int rootOf(std::vector<int>& parent, int i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+}  // namespace
+
+template <int d>
+void FallAsleep<d>::run(World<d>& world, StepContext& ctx) {
+  ContactWorkspace<d>& ws = *this->ws_;
+  auto& sleeps = world.template pool<Sleep<d>>();
+  const ContactSettings& settings = world.settings().contact;
+  const int n = static_cast<int>(ws.bodies.size());
+  reach_.resize(n);
+  reachOf_.resize(n, nullptr);
+  parent_.resize(n);
+  std::iota(parent_.begin(), parent_.end(), 0);
+  blocked_.assign(n, 0);
+  // Per body: still for long enough? A dynamic body without a Sleep component never sleeps, nor
+  // does its island.
+  auto awakeDynamic = [&](int i) {
+    const ContactBody<d>& b = ws.bodies[i];
+    if (b.isStatic || b.kinematic) return false;
+    const Sleep<d>* s = sleeps.get(ws.entityOf(i));
+    return !s || !s->asleep;
+  };
+  for (int i = 0; i < n; ++i) {
+    if (!awakeDynamic(i)) continue;
+    Sleep<d>* s = sleeps.get(ws.entityOf(i));
+    if (!s) {
+      blocked_[i] = 1;
+      continue;
+    }
+    const ContactBody<d>& b = ws.bodies[i];
+    if (reachOf_[i] != b.geometry) {
+      reach_[i] = farthestPoint(*b.geometry);
+      reachOf_[i] = b.geometry;
+    }
+    const RigidBody<d>& rb = *b.body;
+    const double speed = rb.v.norm() + rb.omega().norm() * reach_[i];
+    s->stillTime = speed <= settings.sleepSpeed ? s->stillTime + ctx.dt : 0.0;
+    if (s->stillTime < settings.sleepTime) blocked_[i] = 1;
+  }
+  // Islands: the awake dynamic bodies the step's pairs join (a pair is a broad-phase one, so
+  // bodies within the contact thickness of each other count as joined: that only delays sleep).
+  for (const ContactPairState& p : ws.pairs) {
+    if (!awakeDynamic(p.a) || !awakeDynamic(p.b)) continue;
+    const int ra = rootOf(parent_, p.a), rb = rootOf(parent_, p.b);
+    if (ra != rb) parent_[std::max(ra, rb)] = std::min(ra, rb);
+  }
+  for (int i = 0; i < n; ++i)
+    if (awakeDynamic(i) && blocked_[i]) blocked_[rootOf(parent_, i)] = 1;
+  // An island's group: its lowest body index (the root, as unions keep the smaller index).
+  int fell = 0, asleep = 0;
+  for (int i = 0; i < n; ++i) {
+    Sleep<d>* s = sleeps.get(ws.entityOf(i));
+    if (!s) continue;
+    if (!s->asleep && awakeDynamic(i) && !blocked_[rootOf(parent_, i)]) {
+      s->asleep = true;
+      s->group = rootOf(parent_, i);
+      RigidBody<d>& rb = *ws.bodies[i].body;
+      rb.v.setZero();
+      rb.L.setZero();
+      ++fell;
+    }
+    asleep += s->asleep ? 1 : 0;
+  }
+  ctx.diagnostics.set("bodies_fallen_asleep", fell);
+  ctx.diagnostics.set("bodies_asleep", asleep);
+}
+
+template void enableSleeping<2>(World<2>&);
+template void enableSleeping<3>(World<3>&);
+template int ContactWorkspace<2>::wakeTouchedSleepers(World<2>&);
+template int ContactWorkspace<3>::wakeTouchedSleepers(World<3>&);
+template class FallAsleep<2>;
+template class FallAsleep<3>;
+
+}  // namespace monolith

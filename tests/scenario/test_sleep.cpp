@@ -1,0 +1,192 @@
+// Sleeping (systems/sleep.h; not in the thesis): a settled island is held still where it stands
+// and costs no pairs; an awake body or a moving kinematic body that reaches a sleeping one wakes
+// it in time for the collision to come out as if it had never slept; 1 and 2 threads agree.
+#include <gtest/gtest.h>
+
+#include "support/scenes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "components/rigid_body.h"
+#include "components/sleep.h"
+#include "scenarios/checkpoint.h"
+#include "scenarios/simulation.h"
+
+using namespace monolith;
+using test::builtins;
+using test::kScenes;
+
+namespace {
+
+using Overrides = std::vector<std::pair<std::string, std::string>>;
+
+const Overrides kShortScheduleExact = {{"solvers.contact.contact_iterations", "1"},
+                                       {"solvers.contact.contact_level_iterations", "1"},
+                                       {"solvers.contact.shock_level_iterations", "1"},
+                                       {"solvers.contact.exact_manifold_finish", "true"}};
+
+Overrides with(Overrides o, const std::string& key, const std::string& value) {
+  o.emplace_back(key, value);
+  return o;
+}
+
+double diagnostic(const std::map<std::string, double>& diag, const std::string& key) {
+  const auto it = diag.find(key);
+  return it == diag.end() ? 0.0 : it->second;
+}
+
+template <int d>
+const RigidBody<d>& bodyNamed(Simulation<d>& sim, const std::string& name) {
+  const RigidBody<d>* b = sim.world().template get<RigidBody<d>>(*sim.world().find(name));
+  if (!b) throw std::runtime_error("no body named " + name);
+  return *b;
+}
+
+}  // namespace
+
+// pyramid_10 on the short exact schedule stands exactly at rest (test_rigid_contact), so every
+// box is still from the first step: all 55 fall asleep together once sleep_time has passed, and
+// from then on no pair is formed and nothing moves. The boxes sleep where the run without
+// sleeping keeps them (to its drift of about 1e-14).
+TEST(Sleep, ASettledPyramidFallsAsleepWhereItStandsAndFormsNoPairs) {
+  const Registry registry = builtins();
+  const Overrides base = with(kShortScheduleExact, "time.end", "3");
+  Simulation<3> awake(loadScene(kScenes + "pyramid_10.json", base), registry);
+  Simulation<3> sleeping(loadScene(kScenes + "pyramid_10.json", with(base, "solvers.contact.sleep", "true")), registry);
+  long fellAt = -1;
+  while (!sleeping.finished()) {
+    awake.step();
+    const auto& diag = sleeping.step();
+    if (fellAt < 0 && diagnostic(diag, "bodies_asleep") == 55) fellAt = sleeping.stepsDone();
+    if (fellAt >= 0 && sleeping.stepsDone() > fellAt) {
+      ASSERT_EQ(diagnostic(diag, "bodies_asleep"), 55) << "a box woke in step " << sleeping.stepsDone();
+      ASSERT_EQ(diag.at("contact_pairs_broad_phase"), 0) << "step " << sleeping.stepsDone();
+      ASSERT_EQ(diag.at("kinetic_energy"), 0) << "step " << sleeping.stepsDone();
+    }
+  }
+  // 0.5 s at dt = 1/30: still for 15 steps after the first, asleep at the end of step 15 or 16.
+  EXPECT_GE(fellAt, 15);
+  EXPECT_LE(fellAt, 16);
+  const auto& a = awake.world().pool<RigidBody<3>>().components();
+  const auto& s = sleeping.world().pool<RigidBody<3>>().components();
+  ASSERT_EQ(a.size(), s.size());
+  double apart = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) apart = std::max(apart, (a[i].x - s[i].x).norm());
+  EXPECT_LT(apart, 1e-12);
+}
+
+namespace {
+// Zero gravity: a box at rest, and a ball flying at it head on at 2 m/s, both perfectly elastic
+// and without friction; they meet at t = 1.0065 s, after the box has fallen asleep (0.5 s).
+constexpr const char* kBallAtBox = R"({ "dimension": 3, "time": { "dt": 0.016666666666666666, "end": 2.0 },
+  "gravity": [0, 0, 0],
+  "entities": [
+    { "name": "box", "shape": { "type": "box", "half_extents": [0.5, 0.5, 0.5] },
+      "rigid_body": { "mass": 1, "position": [0, 0, 0] }, "collider": { "restitution": 1, "friction": 0 } },
+    { "name": "ball", "shape": { "type": "sphere", "radius": 0.5 },
+      "rigid_body": { "mass": 1, "position": [-3.013, 0, 0], "velocity": [2, 0, 0] },
+      "collider": { "restitution": 1, "friction": 0 } } ] })";
+}  // namespace
+
+// Equal masses, e = 1, head on: the ball stops and the box leaves at 2 m/s. A box that stayed
+// asleep would send the ball back at -2 m/s. Woken in the step the ball's box reaches it, the
+// box is what it would have been awake (it was at rest), so the run equals the one without
+// sleeping to the last bit.
+TEST(Sleep, ABallFlyingIntoASleepingBoxWakesItAndTakesItsSpeed) {
+  const Registry registry = builtins();
+  Simulation<3> plain(parseScene(kBallAtBox, "ball_at_box.json"), registry);
+  Simulation<3> sleeping(parseScene(kBallAtBox, "ball_at_box.json", {{"solvers.contact.sleep", "true"}}), registry);
+  double asleepBeforeImpact = 0, woken = 0;
+  while (!sleeping.finished()) {
+    plain.step();
+    const auto& diag = sleeping.step();
+    if (sleeping.time() > 0.9 && sleeping.time() < 0.95) asleepBeforeImpact = diag.at("bodies_asleep");
+    woken += diagnostic(diag, "bodies_woken");
+  }
+  EXPECT_EQ(asleepBeforeImpact, 1);
+  EXPECT_EQ(woken, 1);
+  EXPECT_NEAR(bodyNamed(sleeping, "box").v.x(), 2.0, 1e-12);
+  EXPECT_NEAR(bodyNamed(sleeping, "ball").v.x(), 0.0, 1e-12);
+  for (const char* name : {"box", "ball"}) {
+    EXPECT_EQ(0, std::memcmp(bodyNamed(plain, name).x.data(), bodyNamed(sleeping, name).x.data(), 3 * sizeof(double)))
+        << name;
+    EXPECT_EQ(0, std::memcmp(bodyNamed(plain, name).v.data(), bodyNamed(sleeping, name).v.data(), 3 * sizeof(double)))
+        << name;
+  }
+}
+
+namespace {
+// The elevator (scenarios/scenes/elevator.json) with the platform starting at t = 1.5 s, after
+// the box on it has fallen asleep.
+constexpr const char* kLateElevator = R"({ "dimension": 3, "time": { "dt": 0.03333333333333333, "end": 3.0 },
+  "gravity": [0, -9.81, 0], "solvers": { "contact": { "sleep": true } },
+  "entities": [
+    { "name": "platform", "shape": { "type": "box", "half_extents": [2, 0.25, 2] },
+      "rigid_body": { "mass": 100, "position": [0, 0, 0] },
+      "kinematic": { "schedule": [ { "until": 1.5, "velocity": [0, 0, 0] }, { "velocity": [0, 1, 0] } ] },
+      "collider": { "restitution": 0, "friction": 0.8 } },
+    { "name": "box", "shape": { "type": "box", "half_extents": [0.5, 0.5, 0.5] },
+      "rigid_body": { "mass": 1, "position": [0, 0.76, 0] }, "collider": { "restitution": 0, "friction": 0.8 } } ] })";
+}  // namespace
+
+// A platform at rest does not wake what sleeps on it; once it moves, its box reaches the
+// sleeping box's and wakes it, and the box rides up with it (the elevator test's criterion).
+TEST(Sleep, AKinematicPlatformWakesTheBoxOnItWhenItStartsToMove) {
+  const Registry registry = builtins();
+  Simulation<3> sim(parseScene(kLateElevator, "late_elevator.json"), registry);
+  double asleepAt14 = -1, wokenAfter = 0, worstRelative = 0;
+  while (!sim.finished()) {
+    const auto& diag = sim.step();
+    if (std::abs(sim.time() - 1.4) < 1e-9) asleepAt14 = diag.at("bodies_asleep");
+    if (sim.time() > 1.45) wokenAfter += diagnostic(diag, "bodies_woken");
+    if (sim.time() > 2.0)
+      worstRelative = std::max(worstRelative, (bodyNamed(sim, "box").v - bodyNamed(sim, "platform").v).norm());
+  }
+  EXPECT_EQ(asleepAt14, 1);
+  EXPECT_EQ(wokenAfter, 1);
+  EXPECT_LT(worstRelative, 1e-3);
+  EXPECT_NEAR(bodyNamed(sim, "box").x.y() - bodyNamed(sim, "platform").x.y(), 0.75, 2e-3);
+}
+
+// box_stack_scatter (Fig. 2.2) with sleeping: the dropped stack falls asleep, the boulder wakes
+// all six boxes at once (a group wakes whole) and scatters them; the scene's rules hold (no
+// overlap over 1 % of the smaller body, collisions and the second contact step never add
+// kinetic energy), and 1 and 2 threads agree bitwise.
+TEST(Sleep, ABoulderWakesTheSleepingStackWholeAndTheRulesHold) {
+  const Registry registry = builtins();
+  const SceneSpec scene = loadScene(kScenes + "box_stack_scatter.json", {{"solvers.contact.sleep", "true"}});
+  Simulation<3> one(scene, registry, 1), two(scene, registry, 2);
+  double mostAsleep = 0, mostWokenAtOnce = 0, worstOverlap = 0, worstGain = 0;
+  while (!one.finished()) {
+    two.step();
+    const auto& diag = one.step();
+    mostAsleep = std::max(mostAsleep, diag.at("bodies_asleep"));
+    mostWokenAtOnce = std::max(mostWokenAtOnce, diagnostic(diag, "bodies_woken"));
+    worstOverlap = std::max(worstOverlap, diag.at("max_penetration_ratio"));
+    worstGain = std::max({worstGain, diag.at("collision_energy_change"), diag.at("velocity_contact_energy_change")});
+  }
+  EXPECT_EQ(mostAsleep, 6);
+  EXPECT_EQ(mostWokenAtOnce, 6);
+  EXPECT_LE(worstOverlap, 0.01);
+  EXPECT_LE(worstGain, 1e-12);
+  EXPECT_LT(bodyNamed(one, "stack_5").x.y(), 3.0);  // scattered
+  EXPECT_EQ(stateHash(one.world()), stateHash(two.world()));
+}
+
+// The sleep state is the scene's only when it asks for sleeping: without it no Sleep component
+// exists (so every other scene's state and checkpoints are as before), with it every dynamic
+// collider body has one and kinematic and static bodies have none.
+TEST(Sleep, OnlyDynamicColliderBodiesGetASleepStateAndOnlyWhenAsked) {
+  const Registry registry = builtins();
+  Simulation<3> off(parseScene(kLateElevator, "late_elevator.json", {{"solvers.contact.sleep", "false"}}), registry);
+  EXPECT_EQ(off.world().count<Sleep<3>>(), 0u);
+  Simulation<3> on(parseScene(kLateElevator, "late_elevator.json"), registry);
+  EXPECT_EQ(on.world().count<Sleep<3>>(), 1u);
+  EXPECT_NE(on.world().get<Sleep<3>>(*on.world().find("box")), nullptr);
+  EXPECT_EQ(on.world().get<Sleep<3>>(*on.world().find("platform")), nullptr);
+}
