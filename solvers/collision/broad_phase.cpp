@@ -230,6 +230,8 @@ const std::vector<std::pair<int, int>>& BroadPhase<d>::collect(const std::vector
     (isUnbounded<d>(boxes[i]) ? impl.unbounded : impl.bounded).push_back(i);
   }
   pairs_.clear();
+  // Every box of infinite mass (a pile asleep on the ground): no pair can be reported.
+  if (!isInfinite.empty() && std::find(isInfinite.begin(), isInfinite.end(), 0) == isInfinite.end()) return pairs_;
   if (subset) impl.dynamicTreeTouching(boxes, isInfinite, *subset, pairs_);
   else if (method_ == BroadPhaseMethod::SweepAndPrune) impl.sweepAndPrune(boxes, isInfinite, pairs_);
   else impl.dynamicTree(boxes, isInfinite, pairs_);
