@@ -91,8 +91,12 @@ struct PyramidChoice {
 
 void pyramids(const Registry& registry, double seconds, const std::string& only, const std::vector<Override>& extra,
               const PyramidChoice& choice) {
-  std::printf("| scene | boxes | dt | steps | threads | us/step | speed-up | max drift | final KE | max penetration / size | 1T == 2T |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
+  // Sleeping (systems/sleep.h) is a scene setting: shown, since a sleeping pile costs next to nothing.
+  bool sleeping = false;
+  for (const Override& o : extra)
+    if (o.first == "solvers.contact.sleep") sleeping = o.second == "true";
+  std::printf("| scene | boxes | dt | steps | threads | sleeping | us/step | speed-up | max drift | final KE | max penetration / size | 1T == 2T |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const char* name : {"pyramid_10", "pyramid_20"}) {
     if (!only.empty() && only != name) continue;
     for (double dt : choice.dts) {
@@ -109,8 +113,8 @@ void pyramids(const Registry& registry, double seconds, const std::string& only,
         const TimedRun run = runTimed(scene, registry, threads);
         if (threads == choice.threads.front()) oneThread = run;
         const DynamicSummary d = summarize(run);
-        std::printf("| %s | %d | 1/%.0f | %ld | %d | %.1f | %.2f | %.2e | %.2e | %.2e | %s |\n", name, d.count, 1 / dt,
-                    run.steps, threads, 1e6 * run.wall / run.steps, oneThread.wall / run.wall, d.drift, d.kineticEnergy,
+        std::printf("| %s | %d | 1/%.0f | %ld | %d | %s | %.1f | %.2f | %.2e | %.2e | %.2e | %s |\n", name, d.count, 1 / dt,
+                    run.steps, threads, sleeping ? "on" : "off", 1e6 * run.wall / run.steps, oneThread.wall / run.wall, d.drift, d.kineticEnergy,
                     run.penetration, choice.threads.front() == 1 ? sameText(threads, run, oneThread) : "-");
         std::fflush(stdout);
       }
