@@ -197,6 +197,7 @@ class FallAsleep final : public RigidContactSystem<d> {
   std::vector<const solvers::collision::PreparedGeometry<d>*> reachOf_;  // the geometry reach_ is of
   std::vector<int> parent_;    // union-find over the step's pairs
   std::vector<char> blocked_;  // per island root: a member that may not sleep yet
+  std::vector<char> held_;     // per body, then per island root: at rest without being pushed
 };
 
 // The systems above sharing one workspace, in pipeline order.

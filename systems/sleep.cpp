@@ -99,6 +99,8 @@ void FallAsleep<d>::run(World<d>& world, StepContext& ctx) {
   parent_.resize(n);
   std::iota(parent_.begin(), parent_.end(), 0);
   blocked_.assign(n, 0);
+  held_.assign(n, 0);
+  const auto* forces = world.template findPool<RigidForces<d>>();
   // Per body: still for long enough? A dynamic body without a Sleep component never sleeps, nor
   // does its island.
   auto awakeDynamic = [&](int i) {
@@ -123,16 +125,31 @@ void FallAsleep<d>::run(World<d>& world, StepContext& ctx) {
     const double speed = rb.v.norm() + rb.omega().norm() * reach_[i];
     s->stillTime = speed <= settings.sleepSpeed ? s->stillTime + ctx.dt : 0.0;
     if (s->stillTime < settings.sleepTime) blocked_[i] = 1;
+    // A body no force acts on stays at rest by itself.
+    const RigidForces<d>* f = forces ? forces->get(ws.entityOf(i)) : nullptr;
+    if (!f || (f->force.squaredNorm() == 0 && f->torque.squaredNorm() == 0)) held_[i] = 1;
   }
   // Islands: the awake dynamic bodies the step's pairs join (a pair is a broad-phase one, so
   // bodies within the contact thickness of each other count as joined: that only delays sleep).
+  // A body paired with one that cannot move (static, kinematic or asleep) may be held by it.
   for (const ContactPairState& p : ws.pairs) {
-    if (!awakeDynamic(p.a) || !awakeDynamic(p.b)) continue;
+    const bool a = awakeDynamic(p.a), b = awakeDynamic(p.b);
+    if (a != b) held_[a ? p.a : p.b] = 1;
+    if (!a || !b) continue;
     const int ra = rootOf(parent_, p.a), rb = rootOf(parent_, p.b);
     if (ra != rb) parent_[std::max(ra, rb)] = std::min(ra, rb);
   }
+  // An island sleeps only if something holds it: a body paired with an immovable one, or none
+  // pushed by a force. Else it is slow but accelerating: a weak force (under sleep_speed per
+  // sleep_time) would otherwise be stopped for good before it got the body moving.
+  for (int i = 0; i < n; ++i) {
+    if (!awakeDynamic(i)) continue;
+    const int root = rootOf(parent_, i);
+    if (blocked_[i]) blocked_[root] = 1;
+    if (held_[i]) held_[root] = 1;
+  }
   for (int i = 0; i < n; ++i)
-    if (awakeDynamic(i) && blocked_[i]) blocked_[rootOf(parent_, i)] = 1;
+    if (awakeDynamic(i) && held_[i] == 0 && rootOf(parent_, i) == i) blocked_[i] = 1;
   // An island's group: its lowest body index (the root, as unions keep the smaller index).
   int fell = 0, asleep = 0;
   for (int i = 0; i < n; ++i) {

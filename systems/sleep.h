@@ -4,7 +4,9 @@
 // (components/sleep.h), and:
 //  * falls asleep with its island (fall_asleep, after Step V): when every dynamic body the step's
 //    pairs join it to has moved slower than sleep_speed (at its farthest point) for sleep_time,
-//    they all stop (v = 0, L = 0) and share a group;
+//    and something holds the island (one of its bodies is paired with a static, kinematic or
+//    sleeping body, or no force acts on any of them: a weak force would otherwise be stopped
+//    for good before it got a body moving), they all stop (v = 0, L = 0) and share a group;
 //  * while asleep it is held still: Steps I, IV and V skip it, and the contact stages treat it
 //    as a body of infinite mass at rest, so pairs between sleeping and static bodies are never
 //    formed and a settled pile costs a broad phase per step;

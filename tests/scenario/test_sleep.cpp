@@ -178,6 +178,29 @@ TEST(Sleep, ABoulderWakesTheSleepingStackWholeAndTheRulesHold) {
   EXPECT_EQ(stateHash(one.world()), stateHash(two.world()));
 }
 
+// A body that nothing holds and a weak force pushes (0.01 N on 1 kg: under 0.01 m/s for its
+// first second) is slow but accelerating: it must not fall asleep, or the force would never get
+// it moving. A body no force acts on, at rest in the same scene, does sleep.
+TEST(Sleep, ABodyAWeakForcePushesThroughEmptySpaceStaysAwake) {
+  const Registry registry = builtins();
+  Simulation<3> sim(parseScene(R"({ "dimension": 3, "time": { "dt": 0.016666666666666666, "end": 2.0 },
+    "gravity": [0, 0, 0], "solvers": { "contact": { "sleep": true } },
+    "entities": [
+      { "name": "pushed", "shape": { "type": "box", "half_extents": [0.5, 0.5, 0.5] },
+        "rigid_body": { "mass": 1, "position": [0, 0, 0] }, "external_force": { "force": [0.01, 0, 0] },
+        "collider": { "restitution": 0, "friction": 0.5 } },
+      { "name": "resting", "shape": { "type": "box", "half_extents": [0.5, 0.5, 0.5] },
+        "rigid_body": { "mass": 1, "position": [0, 5, 0] }, "collider": { "restitution": 0, "friction": 0.5 } } ] })",
+                               "weak_force.json"),
+                    registry);
+  double mostAsleep = 0;
+  while (!sim.finished()) mostAsleep = std::max(mostAsleep, sim.step().at("bodies_asleep"));
+  EXPECT_EQ(mostAsleep, 1);  // the resting box only
+  EXPECT_EQ(sim.world().get<Sleep<3>>(*sim.world().find("pushed"))->asleep, false);
+  EXPECT_NEAR(bodyNamed(sim, "pushed").v.x(), 0.02, 1e-12);  // a t = 0.01 m/s^2 * 2 s
+  EXPECT_NEAR(bodyNamed(sim, "pushed").x.x(), 0.02, 1e-12);  // a t^2 / 2
+}
+
 // The sleep state is the scene's only when it asks for sleeping: without it no Sleep component
 // exists (so every other scene's state and checkpoints are as before), with it every dynamic
 // collider body has one and kinematic and static bodies have none.
