@@ -6,7 +6,6 @@
 #include "components/forces.h"
 #include "components/rigid_body.h"
 #include "components/shape.h"
-#include "components/sleep.h"
 #include "ecs/registry.h"
 #include "scenarios/contact_components.h"
 #include "scenarios/fluid_components.h"
@@ -142,8 +141,6 @@ void registerDimension(Registry& r) {
   r.addComponentOf<d, ExternalForce<d>>("constant world-frame force and torque on a rigid body", parseExternalForce<d>);
   r.addComponentOf<d, RigidForces<d>>("(internal) force/torque accumulator of a dynamic rigid body", nullptr);
   registerContactComponents<d>(r);
-  r.addComponentOf<d, Sleep<d>>("(internal) whether a dynamic collider body is asleep (\"sleep\": true in solvers.contact)",
-                                nullptr);
   registerFluidComponents<d>(r);
 
   r.addSystem<d>({"clear_rigid_forces", "zero the force accumulators before each force evaluation",

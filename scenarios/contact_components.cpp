@@ -12,6 +12,7 @@
 #include "components/kinematic.h"
 #include "components/rigid_body.h"
 #include "components/shape.h"
+#include "components/sleep.h"
 #include "systems/contact_workspace.h"
 
 namespace monolith {
@@ -257,6 +258,25 @@ void parseKinematic(World<d>& world, Entity e, const Config& c) {
   world.add(e, k);
 }
 
+// "sleep": {"asleep": true} starts a body asleep (systems/sleep.h): a pile built at rest stays as
+// built until something reaches it. Only a dynamic collider body sleeps; the scene must turn
+// sleeping on (checked by the scene loader, which reads "solvers" after the entities).
+template <int d>
+void parseSleep(World<d>& world, Entity e, const Config& c) {
+  const RigidBody<d>* body = world.template get<RigidBody<d>>(e);
+  if (!body || body->isStatic || !world.template has<Collider<d>>(e))
+    c.fail("a dynamic rigid_body with a collider on the same entity (only those sleep)",
+           !body ? "no rigid_body" : body->isStatic ? "a static body" : "no collider");
+  if (world.template has<KinematicMotion<d>>(e))
+    c.fail("a body that is not kinematic (its script moves it)", "a kinematic body");
+  Sleep<d> s;
+  s.asleep = c.boolean("asleep", false);
+  if (s.asleep && (body->v.squaredNorm() > 0 || body->L.squaredNorm() > 0))
+    c.failAt("asleep", "false for a moving body (a sleeping body is at rest)", "true with a velocity");
+  s.group = e.index;  // fall_asleep's groups are entity indices too
+  world.add(e, s);
+}
+
 }  // namespace
 
 template <int d>
@@ -267,6 +287,10 @@ void registerContactComponents(Registry& r) {
   r.addComponentOf<d, KinematicMotion<d>>(
       "scripted motion of a rigid body: velocity/angular_velocity, or schedule [{until, velocity, angular_velocity}]",
       parseKinematic<d>);
+  r.addComponentOf<d, Sleep<d>>(
+      "sleep state of a dynamic collider body (with \"solvers\": {\"contact\": {\"sleep\": true}}): asleep (start "
+      "asleep, held still until something reaches it)",
+      parseSleep<d>);
 }
 
 template std::vector<double> pointList<2>(const Config&, const std::string&, int);

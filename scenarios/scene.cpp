@@ -7,8 +7,10 @@
 #include <set>
 #include <sstream>
 
+#include "components/fluid_obstacle.h"
 #include "components/forces.h"
 #include "components/rigid_body.h"
+#include "components/sleep.h"
 #include "ecs/plugin.h"
 #include "scenarios/plugin_search.h"
 #include "systems/sleep.h"
@@ -515,6 +517,18 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
         type.parse(world, e, config);
         config.finish();
       }
+    }
+    // A body's sleep state needs the scene's sleeping on; a fluid obstacle never sleeps (the
+    // fluid's forces on it change while it rests).
+    for (std::size_t i = 0; i < created.size(); ++i) {
+      if (!world.template get<Sleep<d>>(created[i])) continue;
+      const std::string path = "entities[" + std::to_string(i) + "].sleep";
+      if (!settings.contact.sleep)
+        throw SceneError(scene.file, path, "\"solvers\": {\"contact\": {\"sleep\": true}} in the scene (sleeping on)",
+                         "sleeping off");
+      if (world.template get<FluidObstacle>(created[i]))
+        throw SceneError(scene.file, path, "no sleep state on a fluid obstacle (the fluid's forces on it change while it rests)",
+                         "a fluid_obstacle");
     }
   } catch (...) {
     for (const Entity e : created) world.destroy(e);

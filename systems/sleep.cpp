@@ -150,14 +150,16 @@ void FallAsleep<d>::run(World<d>& world, StepContext& ctx) {
   }
   for (int i = 0; i < n; ++i)
     if (awakeDynamic(i) && held_[i] == 0 && rootOf(parent_, i) == i) blocked_[i] = 1;
-  // An island's group: its lowest body index (the root, as unions keep the smaller index).
+  // An island's group: the entity index of its lowest body (the root, as unions keep the smaller
+  // index); unique among the sleeping groups, as is a body's own entity index where the scene
+  // starts it asleep.
   int fell = 0, asleep = 0;
   for (int i = 0; i < n; ++i) {
     Sleep<d>* s = sleeps.get(ws.entityOf(i));
     if (!s) continue;
     if (!s->asleep && awakeDynamic(i) && !blocked_[rootOf(parent_, i)]) {
       s->asleep = true;
-      s->group = rootOf(parent_, i);
+      s->group = ws.entityOf(rootOf(parent_, i)).index;
       RigidBody<d>& rb = *ws.bodies[i].body;
       rb.v.setZero();
       rb.L.setZero();

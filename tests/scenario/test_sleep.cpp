@@ -201,6 +201,38 @@ TEST(Sleep, ABodyAWeakForcePushesThroughEmptySpaceStaysAwake) {
   EXPECT_NEAR(bodyNamed(sim, "pushed").x.x(), 0.02, 1e-12);  // a t^2 / 2
 }
 
+// "sleep": {"asleep": true} starts a body asleep: held where the scene puts it, in mid-air too,
+// until something reaches it; then it falls. The box beside it, awake, falls at once.
+TEST(Sleep, ABodyTheSceneStartsAsleepStaysUntilSomethingReachesIt) {
+  const Registry registry = builtins();
+  Simulation<3> sim(parseScene(R"({ "dimension": 3, "time": { "dt": 0.016666666666666666, "end": 2.0 },
+    "gravity": [0, -9.81, 0], "solvers": { "contact": { "sleep": true } },
+    "entities": [
+      { "name": "ground", "shape": { "type": "plane", "normal": [0, 1, 0] }, "rigid_body": { "static": true },
+        "collider": { "restitution": 0, "friction": 0.5 } },
+      { "name": "hanging", "shape": { "type": "box", "half_extents": [0.5, 0.5, 0.5] },
+        "rigid_body": { "mass": 1, "position": [0, 3, 0] }, "collider": { "restitution": 0, "friction": 0.5 },
+        "sleep": { "asleep": true } },
+      { "name": "falling", "shape": { "type": "box", "half_extents": [0.5, 0.5, 0.5] },
+        "rigid_body": { "mass": 1, "position": [5, 3, 0] }, "collider": { "restitution": 0, "friction": 0.5 } },
+      { "name": "ball", "shape": { "type": "sphere", "radius": 0.25 },
+        "rigid_body": { "mass": 1, "position": [-4.763, 3, 0], "velocity": [4, 4.905, 0] },
+        "collider": { "restitution": 0, "friction": 0.5 } } ] })",
+                               "start_asleep.json"),
+                    registry);
+  double wokenAt = -1, heightBefore = -1;
+  while (!sim.finished()) {
+    const auto& diag = sim.step();
+    if (wokenAt < 0 && diagnostic(diag, "bodies_woken") > 0) wokenAt = sim.time();
+    if (wokenAt < 0) heightBefore = bodyNamed(sim, "hanging").x.y();
+  }
+  EXPECT_EQ(heightBefore, 3.0);  // held exactly where the scene put it
+  EXPECT_GT(wokenAt, 0.9);       // the ball reaches it near t = 1 s
+  EXPECT_LT(wokenAt, 1.1);
+  EXPECT_NEAR(bodyNamed(sim, "hanging").x.y(), 0.5, 0.02);  // then it fell to the ground
+  EXPECT_NEAR(bodyNamed(sim, "falling").x.y(), 0.5, 0.02);
+}
+
 // The sleep state is the scene's only when it asks for sleeping: without it no Sleep component
 // exists (so every other scene's state and checkpoints are as before), with it every dynamic
 // collider body has one and kinematic and static bodies have none.
