@@ -49,15 +49,16 @@ const RigidBody<d>& bodyNamed(Simulation<d>& sim, const std::string& name) {
 
 }  // namespace
 
-// pyramid_10 on the short exact schedule stands exactly at rest (test_rigid_contact), so every
-// box is still from the first step: all 55 fall asleep together once sleep_time has passed, and
-// from then on no pair is formed and nothing moves. The boxes sleep where the run without
-// sleeping keeps them (to its drift of about 1e-14).
-TEST(Sleep, ASettledPyramidFallsAsleepWhereItStandsAndFormsNoPairs) {
+// pyramid_10 (and its 2-D twin) on the short exact schedule stands exactly at rest
+// (test_rigid_contact), so every box is still from the first step: all 55 fall asleep together
+// once sleep_time has passed, and from then on no pair is formed and nothing moves. The boxes
+// sleep where the run without sleeping keeps them (to its drift of about 1e-14).
+template <int d>
+void expectSettledPyramidSleepsInPlace(const std::string& sceneName) {
   const Registry registry = builtins();
   const Overrides base = with(kShortScheduleExact, "time.end", "3");
-  Simulation<3> awake(loadScene(kScenes + "pyramid_10.json", base), registry);
-  Simulation<3> sleeping(loadScene(kScenes + "pyramid_10.json", with(base, "solvers.contact.sleep", "true")), registry);
+  Simulation<d> awake(loadScene(kScenes + sceneName, base), registry);
+  Simulation<d> sleeping(loadScene(kScenes + sceneName, with(base, "solvers.contact.sleep", "true")), registry);
   long fellAt = -1;
   while (!sleeping.finished()) {
     awake.step();
@@ -72,12 +73,19 @@ TEST(Sleep, ASettledPyramidFallsAsleepWhereItStandsAndFormsNoPairs) {
   // 0.5 s at dt = 1/30: still for 15 steps after the first, asleep at the end of step 15 or 16.
   EXPECT_GE(fellAt, 15);
   EXPECT_LE(fellAt, 16);
-  const auto& a = awake.world().pool<RigidBody<3>>().components();
-  const auto& s = sleeping.world().pool<RigidBody<3>>().components();
+  const auto& a = awake.world().template pool<RigidBody<d>>().components();
+  const auto& s = sleeping.world().template pool<RigidBody<d>>().components();
   ASSERT_EQ(a.size(), s.size());
   double apart = 0;
   for (std::size_t i = 0; i < a.size(); ++i) apart = std::max(apart, (a[i].x - s[i].x).norm());
   EXPECT_LT(apart, 1e-12);
+}
+
+TEST(Sleep, ASettledPyramidFallsAsleepWhereItStandsAndFormsNoPairs) {
+  expectSettledPyramidSleepsInPlace<3>("pyramid_10.json");
+}
+TEST(Sleep, ASettledPyramidFallsAsleepWhereItStandsAndFormsNoPairsIn2D) {
+  expectSettledPyramidSleepsInPlace<2>("pyramid_2d_10.json");
 }
 
 namespace {
