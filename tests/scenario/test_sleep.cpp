@@ -241,6 +241,39 @@ TEST(Sleep, ABodyTheSceneStartsAsleepStaysUntilSomethingReachesIt) {
   EXPECT_NEAR(bodyNamed(sim, "falling").x.y(), 0.5, 0.02);
 }
 
+// Waking spreads through touching sleepers: three boxes started asleep side by side on the ground
+// (each its own group) wake together when a ball hits the first, since each woken box is paired
+// with the next; a fourth, 0.5 m apart, sleeps on.
+TEST(Sleep, WakingSpreadsToTheSleepersAWokenBodyTouches) {
+  const Registry registry = builtins();
+  std::string boxes;
+  for (const double x : {0.0, 1.0, 2.0, 3.5}) {
+    boxes += R"(, { "name": "box_)" + std::to_string(static_cast<int>(2 * x)) +
+             R"(", "shape": { "type": "box", "half_extents": [0.5, 0.5, 0.5] }, "rigid_body": { "mass": 1, "position": [)" +
+             std::to_string(x) + R"(, 0.5, 0] }, "collider": { "restitution": 0, "friction": 0.5 }, "sleep": { "asleep": true } })";
+  }
+  Simulation<3> sim(parseScene(R"({ "dimension": 3, "time": { "dt": 0.016666666666666666, "end": 1.0 },
+    "gravity": [0, -9.81, 0], "solvers": { "contact": { "sleep": true } },
+    "entities": [
+      { "name": "ground", "shape": { "type": "plane", "normal": [0, 1, 0] }, "rigid_body": { "static": true },
+        "collider": { "restitution": 0, "friction": 0.5 } },
+      { "name": "ball", "shape": { "type": "sphere", "radius": 0.25 },
+        "rigid_body": { "mass": 1, "position": [-2.013, 0.5, 0], "velocity": [4, 0, 0] },
+        "collider": { "restitution": 0, "friction": 0 } })" + boxes + "] }",
+                               "wall.json"),
+                    registry);
+  double woken = 0, firstWake = 0;
+  while (!sim.finished()) {
+    const double n = diagnostic(sim.step(), "bodies_woken");
+    if (firstWake == 0) firstWake = n;
+    woken += n;
+  }
+  EXPECT_EQ(firstWake, 3);  // all three in the step the ball arrives
+  EXPECT_EQ(woken, 3);
+  EXPECT_TRUE(sim.world().get<Sleep<3>>(*sim.world().find("box_7"))->asleep);
+  EXPECT_GT(bodyNamed(sim, "box_4").x.x(), 2.0);  // the row was pushed along
+}
+
 // The sleep state is the scene's only when it asks for sleeping: without it no Sleep component
 // exists (so every other scene's state and checkpoints are as before), with it every dynamic
 // collider body has one and kinematic and static bodies have none.
