@@ -24,6 +24,17 @@ void enableSleeping(World<d>& world) {
   for (const Entity e : eligible) world.add(e, Sleep<d>{});
 }
 
+namespace {
+// The farthest a point of the geometry lies from the body's centre of mass (a bound: the corner
+// of its body-frame bounding box), so |v| + |w| reach bounds every point's speed.
+template <int d>
+double farthestPoint(const col::PreparedGeometry<d>& g) {
+  const Eigen::AlignedBox<double, d> box = col::worldBounds(g, col::Pose<d>{});
+  return box.min().cwiseAbs().cwiseMax(box.max().cwiseAbs()).norm();
+}
+
+}  // namespace
+
 template <int d>
 int ContactWorkspace<d>::wakeTouchedSleepers(World<d>& world) {
   if (world.template count<Sleep<d>>() == 0) return 0;
@@ -32,8 +43,24 @@ int ContactWorkspace<d>::wakeTouchedSleepers(World<d>& world) {
   auto groupOf = [&](std::size_t i) { return sleeps.get(entities_[i])->group; };
   int woken = 0;
   std::vector<std::int64_t> groups;
+  // A force that changed since the body fell asleep (a plugin's, or one a program set): by more
+  // than 1e-3 of its weight plus the force it slept with, the torque likewise at its reach.
+  const double g = gravity.norm();
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (!bodies[i].asleep) continue;
+    Sleep<d>& s = *sleeps.get(entities_[i]);
+    const RigidForces<d>* f = forces ? forces->get(entities_[i]) : nullptr;
+    const Eigen::Matrix<double, d, 1> F = f ? f->force : Eigen::Matrix<double, d, 1>::Zero();
+    const AngularVec<d> T = f ? f->torque : AngularVec<d>::Zero();
+    if (!s.forceKnown) {
+      s.forceKnown = true, s.force = F, s.torque = T, s.reach = farthestPoint(*bodies[i].geometry);
+      continue;
+    }
+    const double scale = s.force.norm() + bodies[i].mass * g;
+    if ((F - s.force).norm() > 1e-3 * scale || (T - s.torque).norm() > 1e-3 * (s.torque.norm() + scale * s.reach))
+      groups.push_back(s.group);
+  }
   for (;;) {
-    groups.clear();
     // A pair of a sleeping body and an awake dynamic one (two bodies of infinite mass never
     // make a pair: the broad phase skips them).
     for (const ContactPairState& p : pairs) {
@@ -66,6 +93,7 @@ int ContactWorkspace<d>::wakeTouchedSleepers(World<d>& world) {
       }
       ++woken;
     }
+    groups.clear();
     // The woken bodies move from here on: pack them as such and find their pairs (with each
     // other, and with sleepers they touch, which the next pass wakes).
     pack(world, dt, kick);
@@ -74,14 +102,6 @@ int ContactWorkspace<d>::wakeTouchedSleepers(World<d>& world) {
 }
 
 namespace {
-// The farthest a point of the geometry lies from the body's centre of mass (a bound: the corner
-// of its body-frame bounding box), so |v| + |w| reach bounds every point's speed.
-template <int d>
-double farthestPoint(const col::PreparedGeometry<d>& g) {
-  const Eigen::AlignedBox<double, d> box = col::worldBounds(g, col::Pose<d>{});
-  return box.min().cwiseAbs().cwiseMax(box.max().cwiseAbs()).norm();
-}
-
 int rootOf(std::vector<int>& parent, int i) {
   while (parent[i] != i) i = parent[i] = parent[parent[i]];
   return i;
@@ -160,6 +180,11 @@ void FallAsleep<d>::run(World<d>& world, StepContext& ctx) {
     if (!s->asleep && awakeDynamic(i) && !blocked_[rootOf(parent_, i)]) {
       s->asleep = true;
       s->group = ws.entityOf(rootOf(parent_, i)).index;
+      const RigidForces<d>* f = forces ? forces->get(ws.entityOf(i)) : nullptr;
+      s->forceKnown = true;
+      s->force = f ? f->force : Eigen::Matrix<double, d, 1>::Zero();
+      s->torque = f ? f->torque : AngularVec<d>::Zero();
+      s->reach = reach_[i];
       RigidBody<d>& rb = *ws.bodies[i].body;
       rb.v.setZero();
       rb.L.setZero();

@@ -11,8 +11,10 @@
 //    as a body of infinite mass at rest, so pairs between sleeping and static bodies are never
 //    formed and a settled pile costs a broad phase per step;
 //  * wakes, with its whole group, at the start of Step II when a pair joins it to an awake
-//    dynamic body or a moving kinematic body's box reaches its box
-//    (ContactWorkspace::wakeTouchedSleepers), and takes the Step I kick it missed.
+//    dynamic body, a moving kinematic body's box reaches its box, or the force or torque on it
+//    has changed by more than 1e-3 of its weight plus the force it fell asleep with (a plugin's
+//    force, or one a program set) (ContactWorkspace::wakeTouchedSleepers), and takes the Step I
+//    kick it missed.
 // An awake body that meets a sleeping one in mid-step (sent there by an impulse after Step II's
 // broad phase) meets it as an immovable body and wakes it the step after.
 #include "ecs/world.h"

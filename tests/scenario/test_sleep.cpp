@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "components/forces.h"
 #include "components/rigid_body.h"
 #include "components/sleep.h"
 #include "scenarios/checkpoint.h"
@@ -272,6 +273,38 @@ TEST(Sleep, WakingSpreadsToTheSleepersAWokenBodyTouches) {
   EXPECT_EQ(woken, 3);
   EXPECT_TRUE(sim.world().get<Sleep<3>>(*sim.world().find("box_7"))->asleep);
   EXPECT_GT(bodyNamed(sim, "box_4").x.x(), 2.0);  // the row was pushed along
+}
+
+// A force that changes while a body sleeps (a program's or a plugin's) wakes it once the change
+// passes 1e-3 of its weight plus the force it slept with: 1e-4 N on a 1 kg box leaves it asleep,
+// 20 N (above friction's 4.9 N) wakes it in the next step and slides it.
+TEST(Sleep, AForceThatChangesWakesASleepingBody) {
+  const Registry registry = builtins();
+  Simulation<3> sim(parseScene(R"({ "dimension": 3, "time": { "dt": 0.016666666666666666, "end": 2.0 },
+    "gravity": [0, -9.81, 0], "solvers": { "contact": { "sleep": true } },
+    "entities": [
+      { "name": "ground", "shape": { "type": "plane", "normal": [0, 1, 0] }, "rigid_body": { "static": true },
+        "collider": { "restitution": 0, "friction": 0.5 } },
+      { "name": "box", "shape": { "type": "box", "half_extents": [0.5, 0.5, 0.5] },
+        "rigid_body": { "mass": 1, "position": [0, 0.5, 0] }, "external_force": { "force": [0, 0, 0] },
+        "collider": { "restitution": 0, "friction": 0.5 } } ] })",
+                               "pushed_later.json"),
+                    registry);
+  const Entity box = *sim.world().find("box");
+  auto asleep = [&] { return sim.world().get<Sleep<3>>(box)->asleep; };
+  while (sim.time() < 1.0 - 1e-9) sim.step();
+  ASSERT_TRUE(asleep());
+  const double x = bodyNamed(sim, "box").x.x();
+  sim.world().get<ExternalForce<3>>(box)->force.x() = 1e-4;
+  while (sim.time() < 1.2 - 1e-9) sim.step();
+  EXPECT_TRUE(asleep());
+  EXPECT_EQ(bodyNamed(sim, "box").x.x(), x);
+  sim.world().get<ExternalForce<3>>(box)->force.x() = 20;
+  EXPECT_EQ(diagnostic(sim.step(), "bodies_woken"), 1);
+  while (!sim.finished()) sim.step();
+  EXPECT_FALSE(asleep());
+  // About (20 - 4.905) / 2 * 0.8^2 = 4.8 m in the last 0.8 s.
+  EXPECT_GT(bodyNamed(sim, "box").x.x(), 4.0);
 }
 
 // The sleep state is the scene's only when it asks for sleeping: without it no Sleep component
