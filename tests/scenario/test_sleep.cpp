@@ -48,6 +48,15 @@ const RigidBody<d>& bodyNamed(Simulation<d>& sim, const std::string& name) {
   return *b;
 }
 
+// A 3-D scene at dt = 1/60 with gravity, sleeping on and a ground plane (friction 0.5), then
+// `entities` (each after a comma).
+std::string onGround(const std::string& end, const std::string& entities) {
+  return R"({ "dimension": 3, "time": { "dt": 0.016666666666666666, "end": )" + end +
+         R"( }, "gravity": [0, -9.81, 0], "solvers": { "contact": { "sleep": true } }, "entities": [
+    { "name": "ground", "shape": { "type": "plane", "normal": [0, 1, 0] }, "rigid_body": { "static": true },
+      "collider": { "restitution": 0, "friction": 0.5 } })" + entities + "] }";
+}
+
 }  // namespace
 
 // pyramid_10 (and its 2-D twin) on the short exact schedule stands exactly at rest
@@ -214,11 +223,7 @@ TEST(Sleep, ABodyAWeakForcePushesThroughEmptySpaceStaysAwake) {
 // until something reaches it; then it falls. The box beside it, awake, falls at once.
 TEST(Sleep, ABodyTheSceneStartsAsleepStaysUntilSomethingReachesIt) {
   const Registry registry = builtins();
-  Simulation<3> sim(parseScene(R"({ "dimension": 3, "time": { "dt": 0.016666666666666666, "end": 2.0 },
-    "gravity": [0, -9.81, 0], "solvers": { "contact": { "sleep": true } },
-    "entities": [
-      { "name": "ground", "shape": { "type": "plane", "normal": [0, 1, 0] }, "rigid_body": { "static": true },
-        "collider": { "restitution": 0, "friction": 0.5 } },
+  Simulation<3> sim(parseScene(onGround("2.0", R"(,
       { "name": "hanging", "shape": { "type": "box", "half_extents": [0.5, 0.5, 0.5] },
         "rigid_body": { "mass": 1, "position": [0, 3, 0] }, "collider": { "restitution": 0, "friction": 0.5 },
         "sleep": { "asleep": true } },
@@ -226,7 +231,7 @@ TEST(Sleep, ABodyTheSceneStartsAsleepStaysUntilSomethingReachesIt) {
         "rigid_body": { "mass": 1, "position": [5, 3, 0] }, "collider": { "restitution": 0, "friction": 0.5 } },
       { "name": "ball", "shape": { "type": "sphere", "radius": 0.25 },
         "rigid_body": { "mass": 1, "position": [-4.763, 3, 0], "velocity": [4, 4.905, 0] },
-        "collider": { "restitution": 0, "friction": 0.5 } } ] })",
+        "collider": { "restitution": 0, "friction": 0.5 } })"),
                                "start_asleep.json"),
                     registry);
   double wokenAt = -1, heightBefore = -1;
@@ -253,14 +258,10 @@ TEST(Sleep, WakingSpreadsToTheSleepersAWokenBodyTouches) {
              R"(", "shape": { "type": "box", "half_extents": [0.5, 0.5, 0.5] }, "rigid_body": { "mass": 1, "position": [)" +
              std::to_string(x) + R"(, 0.5, 0] }, "collider": { "restitution": 0, "friction": 0.5 }, "sleep": { "asleep": true } })";
   }
-  Simulation<3> sim(parseScene(R"({ "dimension": 3, "time": { "dt": 0.016666666666666666, "end": 1.0 },
-    "gravity": [0, -9.81, 0], "solvers": { "contact": { "sleep": true } },
-    "entities": [
-      { "name": "ground", "shape": { "type": "plane", "normal": [0, 1, 0] }, "rigid_body": { "static": true },
-        "collider": { "restitution": 0, "friction": 0.5 } },
+  Simulation<3> sim(parseScene(onGround("1.0", R"(,
       { "name": "ball", "shape": { "type": "sphere", "radius": 0.25 },
         "rigid_body": { "mass": 1, "position": [-2.013, 0.5, 0], "velocity": [4, 0, 0] },
-        "collider": { "restitution": 0, "friction": 0 } })" + boxes + "] }",
+        "collider": { "restitution": 0, "friction": 0 } })" + boxes),
                                "wall.json"),
                     registry);
   double woken = 0, firstWake = 0;
@@ -280,14 +281,10 @@ TEST(Sleep, WakingSpreadsToTheSleepersAWokenBodyTouches) {
 // 20 N (above friction's 4.9 N) wakes it in the next step and slides it.
 TEST(Sleep, AForceThatChangesWakesASleepingBody) {
   const Registry registry = builtins();
-  Simulation<3> sim(parseScene(R"({ "dimension": 3, "time": { "dt": 0.016666666666666666, "end": 2.0 },
-    "gravity": [0, -9.81, 0], "solvers": { "contact": { "sleep": true } },
-    "entities": [
-      { "name": "ground", "shape": { "type": "plane", "normal": [0, 1, 0] }, "rigid_body": { "static": true },
-        "collider": { "restitution": 0, "friction": 0.5 } },
+  Simulation<3> sim(parseScene(onGround("2.0", R"(,
       { "name": "box", "shape": { "type": "box", "half_extents": [0.5, 0.5, 0.5] },
         "rigid_body": { "mass": 1, "position": [0, 0.5, 0] }, "external_force": { "force": [0, 0, 0] },
-        "collider": { "restitution": 0, "friction": 0.5 } } ] })",
+        "collider": { "restitution": 0, "friction": 0.5 } })"),
                                "pushed_later.json"),
                     registry);
   const Entity box = *sim.world().find("box");
