@@ -7,8 +7,10 @@
 //    1- and 2-thread states are bitwise equal.
 //  * mixed_pile (boxes, spheres, capsules, cylinders, octahedra): us/step on 1 and 2 threads,
 //    deepest overlap, final kinetic energy, 1T == 2T.
+//  * goal: issue 3's speed goal, pyramid_20 on the short exact schedule with and without
+//    sleeping, at 1/30 and 1/60, and whether it stands at 1/30 under 800 us per step.
 //
-// usage: bench_rigid_contact [pyramid|pour|mixed|all, default all] [seconds]
+// usage: bench_rigid_contact [pyramid|pour|mixed|goal|all, default all] [seconds]
 //                            [pyramid scene, e.g. pyramid_20; or with pour: 250, 1000, 4000 or all]
 //                            [key=value scene overrides for the pyramids and pours, e.g.
 //                             solvers.contact.contact_iterations=4; frames=30 or frames=60: only that
@@ -172,6 +174,41 @@ void mixedPile(const Registry& registry) {
   }
 }
 
+// Issue 3's goal: pyramid_20 stands at dt = 1/30 (every box within 0.05 of its start, final KE
+// under 1e-3) at under 800 us per step (the issue's figure for a popular engine at 1/60). The
+// short exact schedule, with sleeping (systems/sleep.h) and without.
+void goal(const Registry& registry) {
+  const std::vector<Override> shortExact = {{"solvers.contact.contact_iterations", "1"},
+                                            {"solvers.contact.contact_level_iterations", "1"},
+                                            {"solvers.contact.shock_level_iterations", "1"},
+                                            {"solvers.contact.exact_manifold_finish", "true"}};
+  bool met[2] = {false, false};  // without and with sleeping
+  std::printf("| sleeping | dt | threads | us/step | max drift | final KE | stands | under 800 us |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
+  for (const char* sleep : {"false", "true"}) {
+    for (const double dt : {1.0 / 30, 1.0 / 60}) {
+      char dtText[64];
+      std::snprintf(dtText, sizeof dtText, "%.17g", dt);
+      std::vector<Override> overrides = shortExact;
+      overrides.push_back({"solvers.contact.sleep", sleep});
+      overrides.push_back({"time.dt", dtText});
+      const SceneSpec scene = loadScene(kScenes + "pyramid_20.json", overrides);
+      for (int threads : {1, 2}) {
+        const TimedRun run = runTimed(scene, registry, threads);
+        const DynamicSummary d = summarize(run);
+        const double us = 1e6 * run.wall / run.steps;
+        const bool stands = d.drift < 0.05 && d.kineticEnergy < 1e-3;
+        if (dt > 1.0 / 31 && stands && us < 800) met[std::strcmp(sleep, "true") == 0] = true;
+        std::printf("| %s | 1/%.0f | %d | %.1f | %.2e | %.2e | %s | %s |\n", std::strcmp(sleep, "true") == 0 ? "on" : "off",
+                    1 / dt, threads, us, d.drift, d.kineticEnergy, stands ? "yes" : "no", us < 800 ? "yes" : "no");
+        std::fflush(stdout);
+      }
+    }
+  }
+  std::printf("\nissue 3's goal (stands at 1/30 under 800 us per step): without sleeping %s, with sleeping %s\n",
+              met[0] ? "met" : "not met", met[1] ? "met" : "not met");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -198,5 +235,6 @@ int main(int argc, char** argv) {
   if (what == "pour" || what == "all")
     pour(registry, seconds > 0 ? seconds : 1.0, argc > 3 && what == "pour" ? argv[3] : "", extra, choice.threads);
   if (what == "mixed" || what == "all") mixedPile(registry);
+  if (what == "goal") goal(registry);
   return 0;
 }
