@@ -33,6 +33,12 @@ double farthestPoint(const col::PreparedGeometry<d>& g) {
   return box.min().cwiseAbs().cwiseMax(box.max().cwiseAbs()).norm();
 }
 
+// Union-find over the step's pairs (fall_asleep's islands), with path halving.
+int rootOf(std::vector<int>& parent, int i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+
 }  // namespace
 
 template <int d>
@@ -101,12 +107,6 @@ int ContactWorkspace<d>::wakeTouchedSleepers(World<d>& world) {
   }
 }
 
-namespace {
-int rootOf(std::vector<int>& parent, int i) {
-  while (parent[i] != i) i = parent[i] = parent[parent[i]];
-  return i;
-}
-}  // namespace
 
 template <int d>
 void FallAsleep<d>::run(World<d>& world, StepContext& ctx) {
