@@ -324,7 +324,7 @@ typename ContactWorkspace<d>::VecD ContactWorkspace<d>::clampFrameVelocity(const
 template <int d>
 void ContactWorkspace<d>::unpack(bool positions) {
   for (ContactBody<d>& b : bodies) {
-    if (b.isStatic || b.kinematic || b.asleep) continue;
+    if (b.immovable()) continue;
     b.body->v = b.v;
     b.body->L = b.L;
     if (positions) {
@@ -417,7 +417,7 @@ void ContactWorkspace<d>::findPairs() {
     box.min() -= pad;
     box.max() += pad;
     boxes_[i] = box;
-    infinite_[i] = (b.isStatic || b.kinematic || b.asleep) ? 1 : 0;
+    infinite_[i] = b.immovable() ? 1 : 0;
   }
   // Sweep and prune is the faster of the two below about 500 boxes, FCL's dynamic AABB tree
   // above (bench_narrow_phase); both return the same sorted pairs.
@@ -525,8 +525,8 @@ int ContactWorkspace<d>::computeLevels() {
     for (std::size_t k = r.begin(); k != r.end(); ++k) {
       const ContactBody<d>& A = bodies[pairs[k].a];
       const ContactBody<d>& B = bodies[pairs[k].b];
-      aOverB[k] = !(A.isStatic || A.kinematic || A.asleep) && touches(pairs[k].a, pairs[k].b);
-      bOverA[k] = !(B.isStatic || B.kinematic || B.asleep) && touches(pairs[k].b, pairs[k].a);
+      aOverB[k] = !A.immovable() && touches(pairs[k].a, pairs[k].b);
+      bOverA[k] = !B.immovable() && touches(pairs[k].b, pairs[k].a);
     }
   });
   for (std::size_t k = 0; k < pairs.size(); ++k) {
@@ -887,7 +887,7 @@ void ContactWorkspace<d>::addOrdered(solvers::parallel::OrderedTasks& order, con
   int writeCount = 0, readCount = 0;
   for (int i = 0; i < count; ++i) {
     const ContactBody<d>& b = bodies[touched[i]];
-    if (b.isStatic || b.kinematic || b.asleep) continue;
+    if (b.immovable()) continue;
     const int local = memberIndex_[touched[i]];
     if (frozen[local]) reads[readCount++] = local;
     else writes[writeCount++] = local;
@@ -916,7 +916,7 @@ typename ContactWorkspace<d>::IslandSchedule& ContactWorkspace<d>::startSchedule
 template <int d>
 bool ContactWorkspace<d>::infiniteIn(const IslandSchedule& s, int body) const {
   const ContactBody<d>& b = bodies[body];
-  return b.isStatic || b.kinematic || b.asleep || (memberIndex_[body] >= 0 && s.frozen[memberIndex_[body]]);
+  return b.immovable() || (memberIndex_[body] >= 0 && s.frozen[memberIndex_[body]]);
 }
 
 // What a collision check leaves for the skip test (notes 1.4): the bodies it moved carry its

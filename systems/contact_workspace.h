@@ -82,7 +82,9 @@ struct ContactBody {
   AngM inverseInertiaCandidate = AngM::Zero();
   long movedStamp = 0;
 
-  bool infinite() const { return isStatic || kinematic || asleep || frozen; }
+  // Never moved by an impulse in this step, whatever the stage: static, scripted or asleep.
+  bool immovable() const { return isStatic || kinematic || asleep; }
+  bool infinite() const { return immovable() || frozen; }
   // Held where it is for the whole step (the pose updates skip it).
   bool still() const { return isStatic || asleep; }
   double inverseMass() const { return infinite() ? 0.0 : 1.0 / mass; }

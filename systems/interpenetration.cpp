@@ -654,7 +654,7 @@ void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
   }
 
   for (auto& b : ws.bodies) {
-    if (b.isStatic || b.kinematic || b.asleep) continue;
+    if (b.immovable()) continue;
     b.v = b.vCollided + b.dv;
     b.L = b.LCollided + b.dL;
   }

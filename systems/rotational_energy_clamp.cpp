@@ -13,7 +13,7 @@ namespace {
 template <int d>
 bool turningChangesEnergy(const ContactBody<d>& b) {
   if constexpr (d == 3) {
-    if (b.isStatic || b.kinematic || b.asleep || b.turnFree) return false;
+    if (b.immovable() || b.turnFree) return false;
     const auto& I = b.body->inertiaBodyInverse;
     return !(I.isDiagonal(0) && I(0, 0) == I(1, 1) && I(1, 1) == I(2, 2));
   } else {
