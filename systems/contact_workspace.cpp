@@ -154,6 +154,28 @@ double slipLeft(const std::vector<con::PgsPoint<d>>& points, const con::PgsBodie
   return worst;
 }
 
+// Shock propagation (kLeanSlip): where the plain solve, from `before`, leaves a slip above
+// `slipBound`, solves again from `before` with each point's friction leaning on its share of
+// the stage's normal impulse (preloadOf(k), PgsPoint::frictionPreload), by projected
+// Gauss-Seidel (the closed forms have only the plain law). The points are prepared for sweeps in
+// full again: they may have had only the closed form's or the exact finish's preparation.
+template <int d, typename PreloadOf>
+void solveAgainLeaningOnStage(std::vector<con::PgsPoint<d>>& points, con::PgsBodies<d>& state,
+                              const con::PgsBodies<d>& before, double slipBound, double inverseMass,
+                              const con::AngMat<d>& Ia, const con::AngMat<d>& Ib, PreloadOf&& preloadOf,
+                              int iterations, double tolerance) {
+  if (!(slipLeft<d>(points, before) > slipBound)) return;
+  state = before;
+  state.setExactFinish(false);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    points[k].prepareForSolve(false, inverseMass, Ia, Ib);
+    points[k].normalImpulse = 0;
+    points[k].tangentImpulse.setZero();
+    points[k].frictionPreload = preloadOf(k);
+  }
+  con::pgsSolve<d>(points, state, iterations, tolerance);
+}
+
 // Adds a solved update's impulses (on body `a` of the pair when sign = 1, on `b` when -1; the
 // clamp's scale applied) to the pair's stage sums.
 template <int d>
@@ -670,20 +692,10 @@ typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
     if (state.exactFinish) rememberEndStates<d>(pair, points);
   }
   const double slipBound = std::max(tolerance + settings.approachTolerance, kLeanSlip * speedScale);
-  if (anySliding && slipLeft<d>(points, before) > slipBound) {
-    // Shock propagation, still sliding: solved again with the friction leaning on the stage's
-    // normal impulse (projected Gauss-Seidel; the closed forms have only the plain law).
-    // Prepared for sweeps in full: the points may have had only the closed form's or the exact
-    // finish's preparation.
-    state = before;
-    state.setExactFinish(false);
-    for (Point& p : points) {
-      p.prepareForSolve(false, A.inverseMass() + B.inverseMass(), Ia, Ib);
-      p.normalImpulse = 0;
-      p.tangentImpulse.setZero();
-      p.frictionPreload = allowance / double(points.size());
-    }
-    con::pgsSolve<d>(points, state, iterations, tolerance);
+  if (anySliding) {
+    const double share = allowance / double(points.size());
+    solveAgainLeaningOnStage<d>(points, state, before, slipBound, A.inverseMass() + B.inverseMass(), Ia, Ib,
+                                [&](std::size_t) { return share; }, iterations, tolerance);
   }
   // Net impulse on A and its angular impulse about A's centre.
   VecD J;
@@ -817,17 +829,9 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
   const con::PgsBodies<d> before = state;
   if (anyApproaching) con::pgsSolve<d>(points, state, iterations, tolerance);
   const double slipBound = std::max(tolerance + settings.approachTolerance, kLeanSlip * speedScale);
-  if (anySliding && slipLeft<d>(points, before) > slipBound) {
-    state = before;
-    state.setExactFinish(false);  // and the points prepared for sweeps in full
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      points[k].prepareForSolve(false, C.inverseMass(), Iinv, none);
-      points[k].normalImpulse = 0;
-      points[k].tangentImpulse.setZero();
-      points[k].frictionPreload = preloads[k];
-    }
-    con::pgsSolve<d>(points, state, iterations, tolerance);
-  }
+  if (anySliding)
+    solveAgainLeaningOnStage<d>(points, state, before, slipBound, C.inverseMass(), Iinv, none,
+                                [&](std::size_t k) { return preloads[k]; }, iterations, tolerance);
   VecD J;
   con::AngVec<d> tau;
   const int active = netImpulse<d>(points, J, tau);
