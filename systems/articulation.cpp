@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "components/collider.h"
 #include "components/kinematic.h"
 #include "components/sleep.h"
 #include "solvers/articulation/joint_constraints.h"
@@ -166,6 +167,18 @@ Stage PostStabilizeJoints::stage() const {
 
 void PostStabilizeJoints::run(World<3>& world, StepContext& ctx) {
   const ArticulationSolver s = articulationSettings(world);
+  if (place_ == Place::AfterPositions && world.count<Collider<3>>() > 0) {
+    // Interpenetration resolution moved bodies one contact at a time: close the joints again.
+    JointAssembly a(world);
+    const solvers::PreStabilizationReport r = solvers::closeJoints(
+        a.joints, a.bodies, s.pre == ArticulationSolver::Method::Global, s.preIterations, s.preTolerance);
+    for (std::size_t i = 1; i < a.bodies.size(); ++i) {
+      if (a.bodies[i].invMass == 0) continue;
+      a.rigid[i]->x = a.bodies[i].x;
+      a.rigid[i]->orientation = a.bodies[i].q;
+    }
+    ctx.diagnostics.max("joint_push_out_error", r.errorBefore);
+  }
   if (place_ == Place::AfterPositions && !memory_->entity.empty()) {
     for (std::size_t i = 0; i < memory_->entity.size(); ++i) {
       RigidBody<3>* b = world.get<RigidBody<3>>(memory_->entity[i]);

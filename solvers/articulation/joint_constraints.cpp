@@ -1,5 +1,7 @@
 #include "solvers/articulation/joint_constraints.h"
 
+#include "solvers/rigid_rotation.h"
+
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
@@ -330,6 +332,22 @@ PreStabilizationReport preStabilize(const std::vector<JointDefinition>& joints, 
   }
   report.errorAfter = worstError();
   return report;
+}
+
+PreStabilizationReport closeJoints(const std::vector<JointDefinition>& joints, std::vector<ConstraintBody>& bodies,
+                                   bool global, int maxIterations, double tolerance) {
+  std::vector<ConstraintBody> moves = bodies;
+  for (auto& b : moves) b.v.setZero(), b.w.setZero(), b.angularImpulse.setZero();
+  const PosePredictor displaced = [](int, const ConstraintBody& b, Eigen::Vector3d& x, Eigen::Quaterniond& q) {
+    x = b.x + b.v;
+    q = b.invMass > 0 ? Eigen::Quaterniond((rotationExponential(b.w) * b.q).normalized()) : b.q;
+  };
+  const PreStabilizationReport r = preStabilize(joints, moves, displaced, 1.0, global, maxIterations, tolerance);
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (bodies[i].invMass == 0) continue;
+    displaced(static_cast<int>(i), moves[i], bodies[i].x, bodies[i].q);
+  }
+  return r;
 }
 
 }  // namespace monolith::solvers

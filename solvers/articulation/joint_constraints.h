@@ -112,4 +112,11 @@ PreStabilizationReport preStabilize(const std::vector<JointDefinition>& joints, 
                                     const PosePredictor& predict, double dt, bool global, int maxIterations,
                                     double tolerance);
 
+// Moves the bodies so that the joints close at their current poses (not in the thesis; after
+// interpenetration resolution, which moves bodies one contact at a time and may pull joints
+// apart): pre-stabilization's Newton with displacements in place of velocities (dt = 1, poses
+// x + dx, exp(dw*) q), mass-weighted, so the centre of mass stays put. Velocities are untouched.
+PreStabilizationReport closeJoints(const std::vector<JointDefinition>& joints, std::vector<ConstraintBody>& bodies,
+                                   bool global, int maxIterations, double tolerance);
+
 }  // namespace monolith::solvers
