@@ -47,6 +47,11 @@ struct Joint {
   Eigen::Quaterniond parentFrame = Eigen::Quaterniond::Identity();  // joint frame orientation on the parent
   Eigen::Quaterniond childFrame = Eigen::Quaterniond::Identity();   // ... on the child
 
+  // Angle limits of a revolute joint (rad, lower < upper): a one-sided row about the hinge,
+  // active while the joint is at or past a limit and moving (or predicted) further out.
+  bool limited = false;
+  double lower = 0, upper = 0;
+
   // PD drive of a revolute joint's angle (impulse per step dt (kp (a* - a) + kd (a*' - a'))).
   PdTarget pd = PdTarget::None;
   double kp = 0, kd = 0;
@@ -68,6 +73,9 @@ struct Joint {
     visit("child_anchor", childAnchor);
     visit("parent_frame", parentFrame);
     visit("child_frame", childFrame);
+    visit("limited", limited);
+    visit("lower", lower);
+    visit("upper", upper);
     visit("pd", pd);
     visit("kp", kp);
     visit("kd", kd);

@@ -118,6 +118,16 @@ void parseJoint(World<3>& world, Entity e, const Config& c) {
       j.axisInWorld = true;  // frames aligned with the world at the initial poses
     }
   }
+  if (c.has("limits")) {
+    if (j.type != JointType::Revolute) c.failAt("limits", "angle limits on a revolute joint only", "a " + type + " joint");
+    const Eigen::VectorXd l = c.vector("limits", 2);
+    if (!(l(0) < l(1)) || l(0) < -3.14159265358979323846 || l(1) > 3.14159265358979323846)
+      c.failAt("limits", "[lower, upper] in radians with -pi <= lower < upper <= pi",
+               "[" + formatNumber(l(0)) + ", " + formatNumber(l(1)) + "]");
+    j.limited = true;
+    j.lower = l(0);
+    j.upper = l(1);
+  }
   if (c.has("pd")) {
     if (j.type != JointType::Revolute) c.failAt("pd", "PD control on a revolute joint only", "a " + type + " joint");
     const Config pd = c.child("pd");
@@ -164,7 +174,7 @@ void registerJointComponents(Registry& r) {
   r.addComponentOf<3, Joint>(
       "articulation joint: type (fixed, revolute, spherical, prismatic, universal), parent (entity or \"world\"), "
       "child (default: this entity), anchor + axis (world, at the initial poses) or parent_frame/child_frame "
-      "{position, orientation}; pd {kp, kd, target} on revolute joints",
+      "{position, orientation}; limits [lower, upper] and pd {kp, kd, target} on revolute joints",
       parseJoint);
   r.addComponentOf<3, ArticulationSolver>(
       "how the scene's joints are solved (one per scene): post_stabilization/pre_stabilization \"pairwise\" or "

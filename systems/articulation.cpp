@@ -67,6 +67,9 @@ struct JointAssembly {
       def.childAnchor = j.childAnchor;
       def.parentFrame = j.parentFrame;
       def.childFrame = j.childFrame;
+      def.limited = j.limited;
+      def.lower = j.lower;
+      def.upper = j.upper;
       joints.push_back(def);
       components.push_back(&j);
     }

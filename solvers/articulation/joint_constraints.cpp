@@ -90,10 +90,18 @@ JointRows jointRows(const JointDefinition& joint, const std::vector<ConstraintBo
       rows.linear = 3, rows.linearDirs = Fp;
       rows.angular = 3, rows.angularDirs = Fp;
       break;
-    case JointKind::Revolute:
+    case JointKind::Revolute: {
       rows.linear = 3, rows.linearDirs = Fp;
       rows.angular = 2, rows.angularDirs.leftCols<2>() = Fp.leftCols<2>();
+      if (joint.limited) {
+        const double angle = revoluteAngle(joint, P.q, C.q);
+        const double rate = Fp.col(2).dot(C.w - P.w);
+        const bool pastUpper = angle > joint.upper || (angle >= joint.upper - limitSlack && rate > 0);
+        const bool pastLower = angle < joint.lower || (angle <= joint.lower + limitSlack && rate < 0);
+        if (pastUpper || pastLower) rows.angular = 3, rows.angularDirs.col(2) = Fp.col(2);
+      }
       break;
+    }
     case JointKind::Spherical:
       rows.linear = 3, rows.linearDirs = Fp;
       break;
@@ -132,6 +140,8 @@ JointError jointError(const JointDefinition& joint, const Eigen::Vector3d& xPare
       const Eigen::Quaterniond untwisted = qC * Eigen::Quaterniond(Eigen::AngleAxisd(-twist, Eigen::Vector3d::UnitZ()));
       e.angular = 2 * positiveScalar(untwisted * qP.conjugate()).vec();
       e.angular -= axis * axis.dot(e.angular);
+      if (joint.limited && twist > joint.upper) e.angular += (twist - joint.upper) * axis;
+      if (joint.limited && twist < joint.lower) e.angular += (twist - joint.lower) * axis;
       break;
     }
     case JointKind::Universal: {

@@ -40,6 +40,8 @@ struct JointDefinition {
   int parent = 0, child = 0;  // indices into the body list
   Eigen::Vector3d parentAnchor = Eigen::Vector3d::Zero(), childAnchor = Eigen::Vector3d::Zero();
   Eigen::Quaterniond parentFrame = Eigen::Quaterniond::Identity(), childFrame = Eigen::Quaterniond::Identity();
+  bool limited = false;  // revolute: angle limits [lower, upper]
+  double lower = 0, upper = 0;
 };
 
 // A joint's rows at given poses.
@@ -55,14 +57,18 @@ struct JointRows {
 // Position error of a joint at given poses, as world vectors with the free components removed:
 // the child's anchor minus the parent's, and the rotation vector that turns the parent's joint
 // frame onto the child's (Sec. 4.5.1: the vector part of q_c q_p^-1, sign-fixed so the scalar
-// part is positive, without the free twist of a revolute joint). For a universal joint the
-// angular error is along the common normal of the two axes.
+// part is positive, without the free twist of a revolute joint, plus how far a limited one is
+// past its limit, along the hinge). For a universal joint the angular error is along the common
+// normal of the two axes.
 struct JointError {
   Eigen::Vector3d linear = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular = Eigen::Vector3d::Zero();
 };
 
+// A limited revolute joint gains a third angular row (the hinge axis) while its angle is past a
+// limit, or within limitSlack of it and turning further out with the bodies' velocities.
 JointRows jointRows(const JointDefinition& joint, const std::vector<ConstraintBody>& bodies);
+inline constexpr double limitSlack = 1e-9;
 JointError jointError(const JointDefinition& joint, const Eigen::Vector3d& xParent, const Eigen::Quaterniond& qParent,
                       const Eigen::Vector3d& xChild, const Eigen::Quaterniond& qChild);
 // Angle of a revolute joint: the child's frame turned about the parent frame's z axis, in (-pi, pi].

@@ -250,6 +250,27 @@ TEST(Articulation, PrismaticAndUniversalJointsKeepTheirConstraints) {
   EXPECT_GT(x.x(), 0.5);  // it slid down the rail (free slide alone would give 1.73 m)
 }
 
+TEST(Articulation, HingeLimitsStopTheSwing) {
+  const Registry registry = builtins();
+  // A rod hanging from a hinge, kicked to swing about 1 rad each way; limits at +-0.3 rad.
+  Simulation<3> sim(parseScene(R"({ "dimension": 3, "time": { "dt": 0.004166666666666667, "end": 2.0 },
+    "gravity": [0, -9.81, 0], "entities": [
+    { "name": "rod", "shape": { "type": "box", "half_extents": [0.02, 0.5, 0.02] },
+      "rigid_body": { "mass": 1, "position": [0, -0.5, 0], "velocity": [2, 0, 0], "angular_velocity": [0, 0, 4] },
+      "joint": { "type": "revolute", "parent": "world", "anchor": [0, 0, 0], "axis": [0, 0, 1], "limits": [-0.3, 0.3] } } ] })",
+                                "limits.json"),
+                     registry);
+  double largest = 0, smallest = 0, worst = 0;
+  while (!sim.finished()) {
+    worst = std::max(worst, sim.step().at("joint_error_max"));
+    const double a = pendulumAngle(sim);
+    largest = std::max(largest, a), smallest = std::min(smallest, a);
+  }
+  EXPECT_NEAR(largest, 0.3, 1e-6);   // reached the upper limit and stopped there
+  EXPECT_GT(smallest, -0.3 - 1e-6);  // swung back no further than the lower one
+  EXPECT_LT(worst, 1e-8);
+}
+
 TEST(Articulation, BadJointsAreRefusedAtTheirJsonPath) {
   const Registry registry = builtins();
   auto refuse = [&](const std::string& joint, const std::string& path, const std::string& extra = "") {
@@ -278,6 +299,10 @@ TEST(Articulation, BadJointsAreRefusedAtTheirJsonPath) {
               "child_frame": {} })",
          "entities[3].joint.parent_frame.orientation");
   refuse(R"({ "type": "fixed", "parent": "a", "child": "b", "parent_frame": {} })", "entities[3].joint.child_frame");
+  refuse(R"({ "type": "spherical", "parent": "a", "child": "b", "anchor": [0, 0, 0], "limits": [-1, 1] })",
+         "entities[3].joint.limits");
+  refuse(R"({ "type": "revolute", "parent": "a", "child": "b", "anchor": [0, 0, 0], "axis": [0, 0, 1], "limits": [1, -1] })",
+         "entities[3].joint.limits");
   refuse(R"({ "type": "spherical", "parent": "a", "child": "b", "anchor": [0, 0, 0], "pd": { "kp": 1, "target": 0 } })",
          "entities[3].joint.pd");
   refuse(R"({ "type": "revolute", "parent": "a", "child": "b", "anchor": [0, 0, 0], "axis": [0, 0, 1],
