@@ -173,7 +173,7 @@ void registerDimension(Registry& r) {
                   [] { return makeRigidContactSystems<d>(); }, ""});
   if constexpr (d == 3) {
     // After rigid_contact: each runs after the contact system of its stage.
-    r.addSystem<d>({"articulation",
+    r.addSystem<d>({"joint_stages",
                     "joint stages (Sec. 4.4-4.7, App. C): post-stabilization at Steps II, IV and V, "
                     "pre-stabilization at Step III, joint diagnostics",
                     [] { return makeJointSystems(); },
