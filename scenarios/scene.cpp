@@ -14,6 +14,7 @@
 #include "ecs/plugin.h"
 #include "scenarios/plugin_search.h"
 #include "systems/sleep.h"
+#include "scenarios/joint_components.h"
 
 namespace monolith {
 
@@ -518,6 +519,7 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
         config.finish();
       }
     }
+    if constexpr (d == 3) resolveJoints(world, scene.file, created);
     // A body's sleep state needs the scene's sleeping on; a fluid obstacle never sleeps (the
     // fluid's forces on it change while it rests).
     for (std::size_t i = 0; i < created.size(); ++i) {

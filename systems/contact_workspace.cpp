@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 #include <utility>
 
@@ -10,6 +11,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "components/joint.h"
 #include "solvers/collision/grounded_box.h"
 #include "solvers/contact/energy_clamp.h"
 #include "solvers/contact/impulse.h"
@@ -257,6 +259,24 @@ void ContactWorkspace<d>::ensureGeometry(World<d>& world) {
     }
     geometries_.push_back(std::make_unique<col::PreparedGeometry<d>>(g));
   }
+  jointedPairs_.clear();
+  if constexpr (d == 3) {
+    if (const auto* joints = world.template findPool<Joint>()) {
+      std::map<std::uint32_t, int> index;
+      for (std::size_t i = 0; i < entities_.size(); ++i) index[entities_[i].index] = static_cast<int>(i);
+      auto bodyOf = [&](const std::string& name) {
+        const auto e = world.find(name);
+        const auto it = e ? index.find(e->index) : index.end();
+        return it == index.end() ? -1 : it->second;
+      };
+      for (const Joint& j : joints->components()) {
+        const int a = bodyOf(j.parent), b = bodyOf(j.child);
+        if (a >= 0 && b >= 0) jointedPairs_.emplace_back(std::min(a, b), std::max(a, b));
+      }
+      std::sort(jointedPairs_.begin(), jointedPairs_.end());
+      jointedPairs_.erase(std::unique(jointedPairs_.begin(), jointedPairs_.end()), jointedPairs_.end());
+    }
+  }
 }
 
 template <int d>
@@ -446,6 +466,7 @@ void ContactWorkspace<d>::findPairs() {
   if (!broadPhase_)
     broadPhase_ = std::make_unique<col::BroadPhase<d>>(n > 500 ? col::BroadPhaseMethod::FclDynamicTree
                                                                : col::BroadPhaseMethod::SweepAndPrune);
+  broadPhase_->excludePairs(jointedPairs_);
   const auto& found = broadPhase_->findPairs(boxes_, infinite_);
   // A fresh state per pair, except how its last manifold solve ended (both lists are sorted).
   std::vector<ContactPairState>& fresh = freshPairs_;

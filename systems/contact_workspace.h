@@ -339,6 +339,8 @@ class ContactWorkspace {
 
   void ensureGeometry(World<d>& world);
   std::vector<Entity> entities_;
+  // Body index pairs joined by an articulation joint: never paired (sorted, first < second).
+  std::vector<std::pair<int, int>> jointedPairs_;
   std::vector<std::unique_ptr<solvers::collision::PreparedGeometry<d>>> geometries_;
   // Per body: where its collision geometry's centre lies in its body frame (non-zero only for a
   // static box reaching down through the ground, solvers/collision/grounded_box.h).

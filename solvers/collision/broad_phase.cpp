@@ -243,6 +243,12 @@ const std::vector<std::pair<int, int>>& BroadPhase<d>::collect(const std::vector
     }
   std::sort(pairs_.begin(), pairs_.end());
   pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
+  if (!excluded_.empty())
+    pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
+                                [&](const std::pair<int, int>& p) {
+                                  return std::binary_search(excluded_.begin(), excluded_.end(), p);
+                                }),
+                 pairs_.end());
   return pairs_;
 }
 

@@ -33,6 +33,9 @@ class BroadPhase {
                                                             const std::vector<char>& isInfinite,
                                                             const std::vector<char>& subset);
   BroadPhaseMethod method() const { return method_; }
+  // Pairs never reported (sorted, first < second): bodies joined by an articulation joint,
+  // which are shaped not to touch where they meet but may swing into each other.
+  void excludePairs(const std::vector<std::pair<int, int>>& sortedPairs) { excluded_ = sortedPairs; }
 
  private:
   // Both queries: the pairs of all boxes, or (tree only) those with a box of `subset`.
@@ -42,6 +45,7 @@ class BroadPhase {
   struct Impl;
   Impl* impl_;
   std::vector<std::pair<int, int>> pairs_;
+  std::vector<std::pair<int, int>> excluded_;
 };
 
 }  // namespace monolith::solvers::collision

@@ -1,0 +1,146 @@
+#pragma once
+// Joint: one articulation joint between a parent and a child rigid body (3-D), in maximal
+// coordinates (thesis Sec. 4.4-4.7, App. C; Weinstein, Teran and Fedkiw 2006). The parent may
+// be "world". Each body carries a joint frame (a point and an orientation in the body's frame);
+// the joint type says which relative motions of the child's frame against the parent's are
+// allowed:
+//   fixed      none
+//   revolute   rotation about the frames' z axis (a hinge); optional PD drive of the angle
+//   spherical  any rotation about the common point
+//   prismatic  translation along the parent frame's z axis
+//   universal  rotation about the parent frame's x axis and the child frame's y axis
+// Bodies are named, not held as entity handles: the names survive checkpoints as they are.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace monolith {
+
+enum class JointType : int { Fixed = 0, Revolute, Spherical, Prismatic, Universal };
+
+inline const char* jointTypeName(JointType t) {
+  switch (t) {
+    case JointType::Fixed: return "fixed";
+    case JointType::Revolute: return "revolute";
+    case JointType::Spherical: return "spherical";
+    case JointType::Prismatic: return "prismatic";
+    case JointType::Universal: return "universal";
+  }
+  return "?";
+}
+
+// Target of a revolute joint's PD drive (Step III.2): constant, a sinusoid
+// offset + amplitude sin(2 pi frequency t + phase), or keyframes (t_k, angle_k) joined linearly
+// and held outside their span.
+enum class PdTarget : int { None = 0, Constant, Sinusoid, Keyframes };
+
+struct Joint {
+  static constexpr const char* kName = "joint";
+
+  JointType type = JointType::Spherical;
+  std::string parent = "world";  // entity name, or "world"
+  std::string child;             // entity name
+  Eigen::Vector3d parentAnchor = Eigen::Vector3d::Zero();  // in the parent's body frame (world frame for "world")
+  Eigen::Vector3d childAnchor = Eigen::Vector3d::Zero();   // in the child's body frame
+  Eigen::Quaterniond parentFrame = Eigen::Quaterniond::Identity();  // joint frame orientation on the parent
+  Eigen::Quaterniond childFrame = Eigen::Quaterniond::Identity();   // ... on the child
+
+  // Angle limits of a revolute joint (rad, lower < upper): a one-sided row about the hinge,
+  // active while the joint is at or past a limit and moving (or predicted) further out.
+  bool limited = false;
+  double lower = 0, upper = 0;
+
+  // PD drive of a revolute joint's angle (impulse per step dt (kp (a* - a) + kd (a*' - a'))).
+  PdTarget pd = PdTarget::None;
+  double kp = 0, kd = 0;
+  double target = 0;  // Constant: the angle; Sinusoid: the offset
+  double amplitude = 0, frequency = 0, phase = 0;
+  std::vector<double> keyTimes, keyAngles;
+
+  // Scene input given in the world frame at the initial poses ("anchor", "axis"), turned into
+  // the body-frame fields above when the scene is loaded; not state.
+  bool anchorInWorld = false, axisInWorld = false;
+  Eigen::Vector3d worldAnchor = Eigen::Vector3d::Zero(), worldAxis = Eigen::Vector3d::UnitZ();
+
+  template <class V>
+  void visitFields(V& visit) {
+    visit("type", type);
+    visit("parent", parent);
+    visit("child", child);
+    visit("parent_anchor", parentAnchor);
+    visit("child_anchor", childAnchor);
+    visit("parent_frame", parentFrame);
+    visit("child_frame", childFrame);
+    visit("limited", limited);
+    visit("lower", lower);
+    visit("upper", upper);
+    visit("pd", pd);
+    visit("kp", kp);
+    visit("kd", kd);
+    visit("target", target);
+    visit("amplitude", amplitude);
+    visit("frequency", frequency);
+    visit("phase", phase);
+    visit("key_times", keyTimes);
+    visit("key_angles", keyAngles);
+  }
+
+  // Target angle and angular velocity at time t.
+  void targetAt(double t, double& angle, double& rate) const;
+};
+
+// How the scene's joints are solved: the one "articulation" component of a scene (on any
+// entity); without it the defaults below hold.
+struct ArticulationSolver {
+  static constexpr const char* kName = "articulation";
+  enum class Method : int { Pairwise = 0, Global = 1 };
+  Method post = Method::Pairwise;  // post-stabilization: Gauss-Seidel over joints, or App. C.1's CG
+  Method pre = Method::Pairwise;   // pre-stabilization: Newton per joint, or App. C.2's global Newton + CG
+  bool preStabilization = true;
+  int postIterations = 50;         // Gauss-Seidel sweeps, or CG iterations x joints for global
+  double postTolerance = 1e-10;    // largest joint row velocity left (m/s, rad/s)
+  int preIterations = 20;          // Newton sweeps (pairwise) or outer Newton iterations (global)
+  double preTolerance = 1e-10;     // largest predicted joint position error left (m, rad)
+
+  template <class V>
+  void visitFields(V& visit) {
+    visit("post", post);
+    visit("pre", pre);
+    visit("pre_stabilization", preStabilization);
+    visit("post_iterations", postIterations);
+    visit("post_tolerance", postTolerance);
+    visit("pre_iterations", preIterations);
+    visit("pre_tolerance", preTolerance);
+  }
+};
+
+inline void Joint::targetAt(double t, double& angle, double& rate) const {
+  angle = 0;
+  rate = 0;
+  switch (pd) {
+    case PdTarget::None: return;
+    case PdTarget::Constant: angle = target; return;
+    case PdTarget::Sinusoid: {
+      const double w = 2 * 3.14159265358979323846 * frequency;
+      angle = target + amplitude * std::sin(w * t + phase);
+      rate = amplitude * w * std::cos(w * t + phase);
+      return;
+    }
+    case PdTarget::Keyframes: {
+      const std::size_t n = keyTimes.size();
+      if (n == 0) return;
+      if (t <= keyTimes.front()) { angle = keyAngles.front(); return; }
+      if (t >= keyTimes.back()) { angle = keyAngles.back(); return; }
+      std::size_t k = 1;
+      while (keyTimes[k] < t) ++k;
+      const double span = keyTimes[k] - keyTimes[k - 1];
+      rate = (keyAngles[k] - keyAngles[k - 1]) / span;
+      angle = keyAngles[k - 1] + rate * (t - keyTimes[k - 1]);
+      return;
+    }
+  }
+}
+
+}  // namespace monolith

@@ -1,0 +1,251 @@
+#include "scenarios/joint_components.h"
+
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "components/joint.h"
+#include "components/kinematic.h"
+#include "components/rigid_body.h"
+#include "ecs/config.h"
+
+namespace monolith {
+
+namespace {
+
+std::string formatNumber(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
+Eigen::Quaterniond quaternionAt(const Config& c, const std::string& key) {
+  const Eigen::VectorXd q = c.vector(key, 4);
+  if (!(q.norm() > 1e-12)) c.failAt(key, "a non-zero quaternion [w, x, y, z]", "a zero quaternion");
+  return Eigen::Quaterniond(q(0), q(1), q(2), q(3)).normalized();
+}
+
+void parseFrame(const Config& c, Eigen::Vector3d& position, Eigen::Quaterniond& orientation) {
+  position = c.vector("position", Eigen::VectorXd::Zero(3));
+  if (c.has("orientation")) orientation = quaternionAt(c, "orientation");
+}
+
+void parsePd(const Config& c, Joint& j) {
+  j.kp = c.number("kp", Bound::NonNegative);
+  j.kd = c.number("kd", 0.0, Bound::NonNegative);
+  const Json& target = c.raw()["target"];
+  if (target.is_number()) {
+    j.pd = PdTarget::Constant;
+    j.target = c.number("target");
+    return;
+  }
+  if (!target.is_object()) c.failAt("target", "an angle (rad), {\"sinusoid\": {...}} or {\"keyframes\": [[t, angle], ...]}", describeJson(target));
+  const Config t = c.child("target");
+  if (t.has("sinusoid")) {
+    const Config s = t.child("sinusoid");
+    j.pd = PdTarget::Sinusoid;
+    j.target = s.number("offset", 0.0);
+    j.amplitude = s.number("amplitude");
+    j.frequency = s.number("frequency", Bound::Positive);
+    j.phase = s.number("phase", 0.0);
+    s.finish();
+  } else {
+    t.fail("{\"sinusoid\": {offset, amplitude, frequency, phase}} or {\"keyframes\": [[t, angle], ...]}",
+           describeJson(target));
+  }
+  t.finish();
+}
+
+void parseKeyframes(const Config& t, Joint& j) {
+  const Json& raw = t.raw()["keyframes"];
+  const std::string path = t.pathOf("keyframes");
+  if (!raw.is_array() || raw.empty())
+    throw SceneError(t.file(), path, "a non-empty list of [time, angle] pairs", describeJson(raw));
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const Json& k = raw[i];
+    if (!k.is_array() || k.size() != 2 || !k[0].is_number() || !k[1].is_number())
+      throw SceneError(t.file(), path + "[" + std::to_string(i) + "]", "a [time, angle] pair of numbers", describeJson(k));
+    const double time = k[0].get<double>();
+    if (!j.keyTimes.empty() && !(time > j.keyTimes.back()))
+      throw SceneError(t.file(), path + "[" + std::to_string(i) + "]", "times increasing from one keyframe to the next",
+                       formatNumber(time) + " after " + formatNumber(j.keyTimes.back()));
+    j.keyTimes.push_back(time);
+    j.keyAngles.push_back(k[1].get<double>());
+  }
+  j.pd = PdTarget::Keyframes;
+}
+
+void parseJoint(World<3>& world, Entity e, const Config& c) {
+  Joint j;
+  const std::string type = c.oneOf("type", {"fixed", "revolute", "spherical", "prismatic", "universal"}, "");
+  if (type.empty()) c.failAt("type", "one of fixed, revolute, spherical, prismatic, universal", "none");
+  j.type = type == "fixed"       ? JointType::Fixed
+           : type == "revolute"  ? JointType::Revolute
+           : type == "spherical" ? JointType::Spherical
+           : type == "prismatic" ? JointType::Prismatic
+                                 : JointType::Universal;
+  j.parent = c.string("parent");
+  j.child = c.string("child", world.name(e));
+  if (j.child.empty()) c.failAt("child", "the name of the child body (or a named entity with a rigid_body)", "none");
+  if (j.child == "world") c.failAt("child", "a body; only the parent may be \"world\"", "\"world\"");
+  if (j.child == j.parent) c.failAt("parent", "a body other than the child", "\"" + j.parent + "\" again");
+
+  const bool frames = c.has("parent_frame") || c.has("child_frame");
+  if (frames && (c.has("anchor") || c.has("axis")))
+    c.failAt(c.has("anchor") ? "anchor" : "axis",
+             "either a world \"anchor\" (and \"axis\") or \"parent_frame\" and \"child_frame\", not both", "both");
+  if (frames) {
+    if (!c.has("parent_frame") || !c.has("child_frame"))
+      c.failAt(c.has("parent_frame") ? "child_frame" : "parent_frame", "both parent_frame and child_frame", "only one");
+    const Config pf = c.child("parent_frame"), cf = c.child("child_frame");
+    parseFrame(pf, j.parentAnchor, j.parentFrame);
+    parseFrame(cf, j.childAnchor, j.childFrame);
+    pf.finish();
+    cf.finish();
+  } else {
+    if (!c.has("anchor"))
+      c.failAt("anchor", "the joint's world point at the initial poses, or parent_frame and child_frame", "none");
+    j.anchorInWorld = true;
+    j.worldAnchor = c.vector("anchor", 3);
+    if (c.has("axis")) {
+      j.axisInWorld = true;
+      j.worldAxis = c.vector("axis", 3);
+      if (!(j.worldAxis.norm() > 1e-12)) c.failAt("axis", "a non-zero direction", "a zero vector");
+      j.worldAxis.normalize();
+    } else if (j.type == JointType::Revolute || j.type == JointType::Prismatic || j.type == JointType::Universal) {
+      c.failAt("axis", std::string("the ") + type + " joint's axis (a world direction)", "none");
+    } else {
+      j.axisInWorld = true;  // frames aligned with the world at the initial poses
+    }
+  }
+  if (c.has("limits")) {
+    if (j.type != JointType::Revolute) c.failAt("limits", "angle limits on a revolute joint only", "a " + type + " joint");
+    const Eigen::VectorXd l = c.vector("limits", 2);
+    if (!(l(0) < l(1)) || l(0) < -3.14159265358979323846 || l(1) > 3.14159265358979323846)
+      c.failAt("limits", "[lower, upper] in radians with -pi <= lower < upper <= pi",
+               "[" + formatNumber(l(0)) + ", " + formatNumber(l(1)) + "]");
+    j.limited = true;
+    j.lower = l(0);
+    j.upper = l(1);
+  }
+  if (c.has("pd")) {
+    if (j.type != JointType::Revolute) c.failAt("pd", "PD control on a revolute joint only", "a " + type + " joint");
+    const Config pd = c.child("pd");
+    if (pd.raw().contains("target") && pd.raw()["target"].is_object() && pd.raw()["target"].contains("keyframes")) {
+      pd.markUsed("target");
+      j.kp = pd.number("kp", Bound::NonNegative);
+      j.kd = pd.number("kd", 0.0, Bound::NonNegative);
+      const Config t = pd.child("target");
+      parseKeyframes(t, j);
+      t.finish();
+    } else {
+      parsePd(pd, j);
+    }
+    pd.finish();
+  }
+  world.add(e, j);
+}
+
+void parseArticulation(World<3>& world, Entity e, const Config& c) {
+  ArticulationSolver s;
+  auto method = [&](const char* key) {
+    return c.oneOf(key, {"pairwise", "global"}, "pairwise") == "global" ? ArticulationSolver::Method::Global
+                                                                        : ArticulationSolver::Method::Pairwise;
+  };
+  s.post = method("post_stabilization");
+  s.pre = method("pre_stabilization");
+  s.preStabilization = c.boolean("pre_stabilize", true);
+  s.postIterations = static_cast<int>(c.integer("post_iterations", s.postIterations, 1, 1000000));
+  s.postTolerance = c.number("post_tolerance", s.postTolerance, Bound::Positive);
+  s.preIterations = static_cast<int>(c.integer("pre_iterations", s.preIterations, 1, 1000000));
+  s.preTolerance = c.number("pre_tolerance", s.preTolerance, Bound::Positive);
+  world.add(e, s);
+}
+
+// Union-find over bodies, the immovable ones (static, kinematic, world) all one node.
+struct Groups {
+  std::vector<int> parent;
+  int find(int i) { return parent[i] == i ? i : parent[i] = find(parent[i]); }
+};
+
+}  // namespace
+
+void registerJointComponents(Registry& r) {
+  r.addComponentOf<3, Joint>(
+      "articulation joint: type (fixed, revolute, spherical, prismatic, universal), parent (entity or \"world\"), "
+      "child (default: this entity), anchor + axis (world, at the initial poses) or parent_frame/child_frame "
+      "{position, orientation}; limits [lower, upper] and pd {kp, kd, target} on revolute joints",
+      parseJoint);
+  r.addComponentOf<3, ArticulationSolver>(
+      "how the scene's joints are solved (one per scene): post_stabilization/pre_stabilization \"pairwise\" or "
+      "\"global\", pre_stabilize, post_iterations, post_tolerance, pre_iterations, pre_tolerance",
+      parseArticulation);
+}
+
+void resolveJoints(World<3>& world, const std::string& file, const std::vector<Entity>& created) {
+  std::map<std::uint32_t, int> bodyIndex;  // entity index -> union-find node (0: immovable)
+  Groups groups{{0}};
+  bool settingsSeen = false;
+  for (std::size_t i = 0; i < created.size(); ++i) {
+    const std::string at = "entities[" + std::to_string(i) + "]";
+    if (world.get<ArticulationSolver>(created[i])) {
+      if (settingsSeen)
+        throw SceneError(file, at + ".articulation", "one \"articulation\" component in the scene", "a second one");
+      settingsSeen = true;
+    }
+    Joint* j = world.get<Joint>(created[i]);
+    if (!j) continue;
+    const std::string path = at + ".joint";
+    auto body = [&](const std::string& name, const char* key) -> RigidBody<3>* {
+      if (name == "world") return nullptr;
+      const auto e = world.find(name);
+      RigidBody<3>* b = e ? world.get<RigidBody<3>>(*e) : nullptr;
+      if (!b)
+        throw SceneError(file, path + "." + key, "the name of an entity with a rigid_body, or \"world\"",
+                         "\"" + name + "\"" + (e ? " (no rigid_body)" : " (no such entity)"));
+      return b;
+    };
+    RigidBody<3>* parent = body(j->parent, "parent");
+    RigidBody<3>* child = body(j->child, "child");
+    auto immovable = [&](const std::string& name, const RigidBody<3>* b) {
+      return !b || b->isStatic || world.get<KinematicMotion<3>>(*world.find(name));
+    };
+    if (immovable(j->parent, parent) && immovable(j->child, child))
+      throw SceneError(file, path, "a joint with at least one dynamic body",
+                       "\"" + j->parent + "\" and \"" + j->child + "\", neither of which can move");
+
+    const Eigen::Vector3d xp = parent ? parent->x : Eigen::Vector3d::Zero();
+    const Eigen::Quaterniond qp = parent ? parent->orientation : Eigen::Quaterniond::Identity();
+    if (j->anchorInWorld) {
+      j->parentAnchor = qp.conjugate() * (j->worldAnchor - xp);
+      j->childAnchor = child->orientation.conjugate() * (j->worldAnchor - child->x);
+      j->anchorInWorld = false;
+    }
+    if (j->axisInWorld) {
+      const Eigen::Quaterniond world = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), j->worldAxis);
+      j->parentFrame = (qp.conjugate() * world).normalized();
+      j->childFrame = (child->orientation.conjugate() * world).normalized();
+      j->axisInWorld = false;
+    }
+
+    // Loops of fixed joints (through the ground too) lock a body twice: refused.
+    auto node = [&](const std::string& name, bool fixedToGround) {
+      if (fixedToGround) return 0;
+      const std::uint32_t index = world.find(name)->index;
+      auto [it, inserted] = bodyIndex.emplace(index, static_cast<int>(groups.parent.size()));
+      if (inserted) groups.parent.push_back(it->second);
+      return it->second;
+    };
+    if (j->type == JointType::Fixed) {
+      const int a = groups.find(node(j->parent, immovable(j->parent, parent)));
+      const int b = groups.find(node(j->child, immovable(j->child, child)));
+      if (a == b)
+        throw SceneError(file, path,
+                         "a joint that closes no loop of fixed joints (such a loop over-constrains its bodies)",
+                         "a fixed joint between \"" + j->parent + "\" and \"" + j->child + "\", already fixed together");
+      groups.parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+}
+
+}  // namespace monolith

@@ -1,0 +1,363 @@
+#include "solvers/articulation/joint_constraints.h"
+
+#include "solvers/rigid_rotation.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+
+namespace monolith::solvers {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Eigen::Quaterniond positiveScalar(Eigen::Quaterniond q) {
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  return q;
+}
+
+// Velocity changes of the parent and child from a row impulse.
+struct Response {
+  Eigen::Vector3d vParent, wParent, vChild, wChild, torqueParent, torqueChild;
+};
+
+Response responseTo(const JointRows& rows, const Vector6d& lambda, const std::vector<ConstraintBody>& bodies) {
+  Eigen::Vector3d J = Eigen::Vector3d::Zero(), T = Eigen::Vector3d::Zero();
+  for (int i = 0; i < rows.linear; ++i) J += lambda(i) * rows.linearDirs.col(i);
+  for (int i = 0; i < rows.angular; ++i) T += lambda(rows.linear + i) * rows.angularDirs.col(i);
+  const ConstraintBody& P = bodies[rows.parent];
+  const ConstraintBody& C = bodies[rows.child];
+  Response r;
+  r.torqueChild = rows.armChild.cross(J) + T;
+  r.torqueParent = -(rows.armParent.cross(J) + T);
+  r.vChild = C.invMass * J;
+  r.wChild = C.invInertia * r.torqueChild;
+  r.vParent = -P.invMass * J;
+  r.wParent = P.invInertia * r.torqueParent;
+  return r;
+}
+
+Vector6d rowsOfMotion(const JointRows& rows, const Eigen::Vector3d& vP, const Eigen::Vector3d& wP,
+                      const Eigen::Vector3d& vC, const Eigen::Vector3d& wC) {
+  const Eigen::Vector3d lin = vC + wC.cross(rows.armChild) - vP - wP.cross(rows.armParent);
+  return rowsOf(rows, lin, wC - wP);
+}
+
+double maxAbs(const Vector6d& r, int n) { return largestEntry(r, n); }
+
+using Ldlt6 = Eigen::LDLT<Eigen::MatrixXd>;
+
+Ldlt6 factor(const JointRows& rows, const std::vector<ConstraintBody>& bodies) {
+  const int k = rows.rows();
+  return Ldlt6(effectiveMass(rows, bodies).topLeftCorner(k, k));
+}
+
+Vector6d solveRows(const Ldlt6& K, const Vector6d& rhs, int k) {
+  Vector6d out = Vector6d::Zero();
+  if (k > 0) out.head(k) = K.solve(rhs.head(k).eval());
+  return out;
+}
+
+}  // namespace
+
+double largestEntry(const Vector6d& v, int n) {
+  double m = 0;
+  for (int i = 0; i < n; ++i) m = std::max(m, std::abs(v(i)));
+  return m;
+}
+
+Vector6d rowsOf(const JointRows& rows, const Eigen::Vector3d& linear, const Eigen::Vector3d& angular) {
+  Vector6d out = Vector6d::Zero();
+  for (int i = 0; i < rows.linear; ++i) out(i) = rows.linearDirs.col(i).dot(linear);
+  for (int i = 0; i < rows.angular; ++i) out(rows.linear + i) = rows.angularDirs.col(i).dot(angular);
+  return out;
+}
+
+JointRows jointRows(const JointDefinition& joint, const std::vector<ConstraintBody>& bodies) {
+  const ConstraintBody& P = bodies[joint.parent];
+  const ConstraintBody& C = bodies[joint.child];
+  JointRows rows;
+  rows.parent = joint.parent;
+  rows.child = joint.child;
+  const Eigen::Vector3d anchor = C.x + C.q * joint.childAnchor;
+  rows.armParent = anchor - P.x;
+  rows.armChild = anchor - C.x;
+  const Eigen::Matrix3d Fp = (P.q * joint.parentFrame).toRotationMatrix();
+  const Eigen::Matrix3d Fc = (C.q * joint.childFrame).toRotationMatrix();
+  switch (joint.type) {
+    case JointKind::Fixed:
+      rows.linear = 3, rows.linearDirs = Fp;
+      rows.angular = 3, rows.angularDirs = Fp;
+      break;
+    case JointKind::Revolute: {
+      rows.linear = 3, rows.linearDirs = Fp;
+      rows.angular = 2, rows.angularDirs.leftCols<2>() = Fp.leftCols<2>();
+      if (joint.limited) {
+        const double angle = revoluteAngle(joint, P.q, C.q);
+        const double rate = Fp.col(2).dot(C.w - P.w);
+        const bool pastUpper = angle > joint.upper || (angle >= joint.upper - limitSlack && rate > 0);
+        const bool pastLower = angle < joint.lower || (angle <= joint.lower + limitSlack && rate < 0);
+        if (pastUpper || pastLower) rows.angular = 3, rows.angularDirs.col(2) = Fp.col(2);
+      }
+      break;
+    }
+    case JointKind::Spherical:
+      rows.linear = 3, rows.linearDirs = Fp;
+      break;
+    case JointKind::Prismatic:
+      rows.linear = 2, rows.linearDirs.leftCols<2>() = Fp.leftCols<2>();
+      rows.angular = 3, rows.angularDirs = Fp;
+      break;
+    case JointKind::Universal: {
+      rows.linear = 3, rows.linearDirs = Fp;
+      const Eigen::Vector3d n = Fp.col(0).cross(Fc.col(1));
+      // The two axes parallel: the joint is at its singular pose; constrain the parent's normal.
+      rows.angular = 1;
+      rows.angularDirs.col(0) = n.norm() > 1e-6 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d(Fp.col(2));
+      break;
+    }
+  }
+  return rows;
+}
+
+JointError jointError(const JointDefinition& joint, const Eigen::Vector3d& xParent, const Eigen::Quaterniond& qParent,
+                      const Eigen::Vector3d& xChild, const Eigen::Quaterniond& qChild) {
+  JointError e;
+  const Eigen::Quaterniond qP = qParent * joint.parentFrame, qC = qChild * joint.childFrame;
+  const Eigen::Vector3d axis = qP * Eigen::Vector3d::UnitZ();
+  e.linear = (xChild + qChild * joint.childAnchor) - (xParent + qParent * joint.parentAnchor);
+  if (joint.type == JointKind::Prismatic) e.linear -= axis * axis.dot(e.linear);
+  switch (joint.type) {
+    case JointKind::Fixed:
+    case JointKind::Prismatic:
+      e.angular = 2 * positiveScalar(qC * qP.conjugate()).vec();
+      break;
+    case JointKind::Revolute: {
+      // Remove the free twist about the hinge first, so that what remains is the error alone
+      // (the vector part of q_c q_p^-1 would else mix the twist into the perpendicular rows).
+      const double twist = revoluteAngle(joint, qParent, qChild);
+      const Eigen::Quaterniond untwisted = qC * Eigen::Quaterniond(Eigen::AngleAxisd(-twist, Eigen::Vector3d::UnitZ()));
+      e.angular = 2 * positiveScalar(untwisted * qP.conjugate()).vec();
+      e.angular -= axis * axis.dot(e.angular);
+      if (joint.limited && twist > joint.upper) e.angular += (twist - joint.upper) * axis;
+      if (joint.limited && twist < joint.lower) e.angular += (twist - joint.lower) * axis;
+      break;
+    }
+    case JointKind::Universal: {
+      const Eigen::Vector3d a = qP * Eigen::Vector3d::UnitX(), b = qC * Eigen::Vector3d::UnitY();
+      const Eigen::Vector3d n = a.cross(b);
+      const double s = n.norm();
+      if (s > 1e-6) e.angular = std::atan2(-a.dot(b), s) * n / s;
+      break;
+    }
+    case JointKind::Spherical:
+      break;
+  }
+  return e;
+}
+
+double revoluteAngle(const JointDefinition& joint, const Eigen::Quaterniond& qParent, const Eigen::Quaterniond& qChild) {
+  const Eigen::Quaterniond rel = (qParent * joint.parentFrame).conjugate() * (qChild * joint.childFrame);
+  double a = 2 * std::atan2(rel.z(), rel.w());
+  if (a > kPi) a -= 2 * kPi;
+  if (a <= -kPi) a += 2 * kPi;
+  return a;
+}
+
+Eigen::Vector3d jointAxis(const JointDefinition& joint, const Eigen::Quaterniond& qParent) {
+  return (qParent * joint.parentFrame) * Eigen::Vector3d::UnitZ();
+}
+
+Vector6d rowVelocities(const JointRows& rows, const std::vector<ConstraintBody>& bodies) {
+  const ConstraintBody& P = bodies[rows.parent];
+  const ConstraintBody& C = bodies[rows.child];
+  return rowsOfMotion(rows, P.v, P.w, C.v, C.w);
+}
+
+void applyRowImpulse(const JointRows& rows, const Vector6d& lambda, std::vector<ConstraintBody>& bodies) {
+  const Response r = responseTo(rows, lambda, bodies);
+  ConstraintBody& P = bodies[rows.parent];
+  ConstraintBody& C = bodies[rows.child];
+  C.v += r.vChild;
+  C.w += r.wChild;
+  P.v += r.vParent;
+  P.w += r.wParent;
+  if (C.invMass > 0) C.angularImpulse += r.torqueChild;
+  if (P.invMass > 0) P.angularImpulse += r.torqueParent;
+}
+
+Eigen::Matrix<double, 6, 6> effectiveMass(const JointRows& rows, const std::vector<ConstraintBody>& bodies) {
+  Eigen::Matrix<double, 6, 6> K = Eigen::Matrix<double, 6, 6>::Zero();
+  for (int j = 0; j < rows.rows(); ++j) {
+    const Response r = responseTo(rows, Vector6d::Unit(j), bodies);
+    K.col(j) = rowsOfMotion(rows, r.vParent, r.wParent, r.vChild, r.wChild);
+  }
+  return K;
+}
+
+ProjectionReport projectPairwise(const std::vector<JointRows>& joints, const std::vector<Vector6d>& targets,
+                                 std::vector<ConstraintBody>& bodies, int maxSweeps, double tolerance) {
+  std::vector<Ldlt6> K;
+  K.reserve(joints.size());
+  for (const auto& j : joints) K.push_back(factor(j, bodies));
+  ProjectionReport report;
+  for (int sweep = 0; sweep < maxSweeps; ++sweep) {
+    double worst = 0;
+    for (std::size_t j = 0; j < joints.size(); ++j) {
+      const int k = joints[j].rows();
+      const Vector6d r = targets[j] - rowVelocities(joints[j], bodies);
+      worst = std::max(worst, maxAbs(r, k));
+      applyRowImpulse(joints[j], solveRows(K[j], r, k), bodies);
+    }
+    report.iterations = sweep + 1;
+    if (worst <= tolerance) break;
+  }
+  for (std::size_t j = 0; j < joints.size(); ++j)
+    report.residual = std::max(report.residual, maxAbs(targets[j] - rowVelocities(joints[j], bodies), joints[j].rows()));
+  return report;
+}
+
+ProjectionReport projectGlobal(const std::vector<JointRows>& joints, const std::vector<Vector6d>& targets,
+                               std::vector<ConstraintBody>& bodies, int maxIterations, double tolerance) {
+  const std::size_t J = joints.size();
+  std::vector<int> offset(J + 1, 0);
+  for (std::size_t j = 0; j < J; ++j) offset[j + 1] = offset[j] + joints[j].rows();
+  const int n = offset[J];
+  auto segment = [&](const Eigen::VectorXd& x, std::size_t j) {
+    Vector6d s = Vector6d::Zero();
+    s.head(joints[j].rows()) = x.segment(offset[j], joints[j].rows());
+    return s;
+  };
+  // G^T M^-1 G x: the bodies' velocity changes from all row impulses, then every joint's rows.
+  std::vector<Eigen::Vector3d> dv(bodies.size()), dw(bodies.size());
+  auto apply = [&](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+    std::fill(dv.begin(), dv.end(), Eigen::Vector3d::Zero());
+    std::fill(dw.begin(), dw.end(), Eigen::Vector3d::Zero());
+    for (std::size_t j = 0; j < J; ++j) {
+      const Response r = responseTo(joints[j], segment(x, j), bodies);
+      dv[joints[j].parent] += r.vParent, dw[joints[j].parent] += r.wParent;
+      dv[joints[j].child] += r.vChild, dw[joints[j].child] += r.wChild;
+    }
+    for (std::size_t j = 0; j < J; ++j) {
+      const JointRows& rows = joints[j];
+      out.segment(offset[j], rows.rows()) =
+          rowsOfMotion(rows, dv[rows.parent], dw[rows.parent], dv[rows.child], dw[rows.child]).head(rows.rows());
+    }
+  };
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n), r(n), p(n), Ap(n);
+  for (std::size_t j = 0; j < J; ++j)
+    r.segment(offset[j], joints[j].rows()) = (targets[j] - rowVelocities(joints[j], bodies)).head(joints[j].rows());
+  p = r;
+  double rr = r.squaredNorm();
+  ProjectionReport report;
+  for (int it = 0; it < maxIterations && n > 0; ++it) {
+    if (r.cwiseAbs().maxCoeff() <= tolerance) break;
+    apply(p, Ap);
+    const double pAp = p.dot(Ap);
+    if (!(pAp > 0)) break;  // the rest lies in G's nullspace (redundant rows of a loop)
+    const double alpha = rr / pAp;
+    x += alpha * p;
+    r -= alpha * Ap;
+    const double rrNew = r.squaredNorm();
+    p = r + (rrNew / rr) * p;
+    rr = rrNew;
+    report.iterations = it + 1;
+  }
+  for (std::size_t j = 0; j < J; ++j) applyRowImpulse(joints[j], segment(x, j), bodies);
+  for (std::size_t j = 0; j < J; ++j)
+    report.residual = std::max(report.residual, maxAbs(targets[j] - rowVelocities(joints[j], bodies), joints[j].rows()));
+  return report;
+}
+
+PreStabilizationReport preStabilize(const std::vector<JointDefinition>& joints, std::vector<ConstraintBody>& bodies,
+                                    const PosePredictor& predict, double dt, bool global, int maxIterations,
+                                    double tolerance) {
+  PreStabilizationReport report;
+  const std::size_t J = joints.size();
+  // The bodies at the poses Step IV would give them (velocities and inertias as now): the
+  // Newton Jacobian takes its arms and directions there, since an impulse now moves the
+  // predicted anchor by dt (dv + dw x r) with the arm r of the predicted pose.
+  std::vector<ConstraintBody> ahead = bodies;
+  auto predictBody = [&](int i) {
+    ahead[i] = bodies[i];
+    predict(i, bodies[i], ahead[i].x, ahead[i].q);
+  };
+  auto errorRows = [&](std::size_t j, const JointRows& rows) {
+    const JointDefinition& d = joints[j];
+    const JointError e = jointError(d, ahead[d.parent].x, ahead[d.parent].q, ahead[d.child].x, ahead[d.child].q);
+    return rowsOf(rows, e.linear, e.angular);
+  };
+  auto predictAll = [&] {
+    for (std::size_t i = 0; i < bodies.size(); ++i) predictBody(static_cast<int>(i));
+  };
+  auto worstError = [&] {
+    predictAll();
+    double worst = 0;
+    for (std::size_t j = 0; j < J; ++j) {
+      const JointRows rows = jointRows(joints[j], ahead);
+      worst = std::max(worst, maxAbs(errorRows(j, rows), rows.rows()));
+    }
+    return worst;
+  };
+
+  report.errorBefore = worstError();
+  if (report.errorBefore <= tolerance) {
+    report.errorAfter = report.errorBefore;
+    return report;
+  }
+  if (!global) {
+    for (int it = 0; it < maxIterations; ++it) {
+      double worst = 0;
+      for (std::size_t j = 0; j < J; ++j) {
+        predictBody(joints[j].parent);
+        predictBody(joints[j].child);
+        const JointRows rows = jointRows(joints[j], ahead);
+        const int k = rows.rows();
+        const Vector6d e = errorRows(j, rows);
+        worst = std::max(worst, maxAbs(e, k));
+        applyRowImpulse(rows, solveRows(factor(rows, bodies), -e / dt, k), bodies);
+      }
+      report.iterations = it + 1;
+      if (worst <= tolerance) break;
+    }
+  } else {
+    std::vector<JointRows> rows(J);
+    std::vector<Vector6d> targets(J);
+    for (int it = 0; it < maxIterations; ++it) {
+      predictAll();
+      double worst = 0;
+      int totalRows = 0;
+      for (std::size_t j = 0; j < J; ++j) {
+        rows[j] = jointRows(joints[j], ahead);
+        totalRows += rows[j].rows();
+        const Vector6d e = errorRows(j, rows[j]);
+        worst = std::max(worst, maxAbs(e, rows[j].rows()));
+        targets[j] = rowVelocities(rows[j], bodies) - e / dt;
+      }
+      if (worst <= tolerance) break;
+      projectGlobal(rows, targets, bodies, std::max(100, 4 * totalRows), 1e-3 * tolerance / dt);
+      report.iterations = it + 1;
+    }
+  }
+  report.errorAfter = worstError();
+  return report;
+}
+
+PreStabilizationReport closeJoints(const std::vector<JointDefinition>& joints, std::vector<ConstraintBody>& bodies,
+                                   bool global, int maxIterations, double tolerance) {
+  std::vector<ConstraintBody> moves = bodies;
+  for (auto& b : moves) b.v.setZero(), b.w.setZero(), b.angularImpulse.setZero();
+  const PosePredictor displaced = [](int, const ConstraintBody& b, Eigen::Vector3d& x, Eigen::Quaterniond& q) {
+    x = b.x + b.v;
+    q = b.invMass > 0 ? Eigen::Quaterniond((rotationExponential(b.w) * b.q).normalized()) : b.q;
+  };
+  const PreStabilizationReport r = preStabilize(joints, moves, displaced, 1.0, global, maxIterations, tolerance);
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (bodies[i].invMass == 0) continue;
+    displaced(static_cast<int>(i), moves[i], bodies[i].x, bodies[i].q);
+  }
+  return r;
+}
+
+}  // namespace monolith::solvers

@@ -1,0 +1,293 @@
+#include "systems/articulation.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "components/collider.h"
+#include "components/kinematic.h"
+#include "components/sleep.h"
+#include "solvers/articulation/joint_constraints.h"
+#include "solvers/rigid_rotation.h"
+
+namespace monolith {
+
+namespace {
+
+// The jointed bodies and joints of the world as the solvers see them. Body 0 is the world;
+// bodies follow in the order the joints name them (joint pool order: deterministic).
+struct JointAssembly {
+  std::vector<solvers::ConstraintBody> bodies;
+  std::vector<RigidBody<3>*> rigid;  // null for the world
+  std::vector<Entity> entity;
+  std::vector<bool> kinematic;
+  std::vector<solvers::JointDefinition> joints;
+  std::vector<const Joint*> components;
+
+  explicit JointAssembly(World<3>& world) {
+    bodies.emplace_back();
+    rigid.push_back(nullptr);
+    entity.push_back(Entity{});
+    kinematic.push_back(false);
+    std::unordered_map<std::uint32_t, int> index;
+    const auto* sleeps = world.findPool<Sleep<3>>();
+    auto bodyOf = [&](const std::string& name) -> int {
+      if (name == "world") return 0;
+      const auto e = world.find(name);
+      RigidBody<3>* b = e ? world.get<RigidBody<3>>(*e) : nullptr;
+      if (!b) throw std::logic_error("joint names '" + name + "', which is not a rigid body");
+      const auto [it, inserted] = index.emplace(e->index, static_cast<int>(bodies.size()));
+      if (!inserted) return it->second;
+      solvers::ConstraintBody c;
+      c.x = b->x;
+      c.q = b->orientation;
+      const bool moving = world.get<KinematicMotion<3>>(*e) != nullptr;
+      const bool immovable = b->isStatic || moving || isAsleep<3>(sleeps, *e);
+      if (!immovable) {
+        c.invMass = 1 / b->mass;
+        c.invInertia = b->worldInverseInertia();
+      }
+      if (!b->isStatic && !isAsleep<3>(sleeps, *e)) {
+        c.v = b->v;
+        c.w = b->omega();
+      }
+      bodies.push_back(c);
+      rigid.push_back(b);
+      entity.push_back(*e);
+      kinematic.push_back(moving);
+      return it->second;
+    };
+    const auto& pool = world.pool<Joint>();
+    for (const Joint& j : pool.components()) {
+      solvers::JointDefinition def;
+      def.type = static_cast<solvers::JointKind>(j.type);
+      def.parent = bodyOf(j.parent);
+      def.child = bodyOf(j.child);
+      def.parentAnchor = j.parentAnchor;
+      def.childAnchor = j.childAnchor;
+      def.parentFrame = j.parentFrame;
+      def.childFrame = j.childFrame;
+      def.limited = j.limited;
+      def.lower = j.lower;
+      def.upper = j.upper;
+      joints.push_back(def);
+      components.push_back(&j);
+    }
+  }
+
+  std::vector<solvers::JointRows> rows() const {
+    std::vector<solvers::JointRows> out;
+    out.reserve(joints.size());
+    for (const auto& j : joints) out.push_back(solvers::jointRows(j, bodies));
+    return out;
+  }
+
+  // The new velocities of the dynamic bodies; angular momentum takes the torque impulses
+  // exactly (L is the state, w is derived).
+  void writeBack() const {
+    for (std::size_t i = 1; i < bodies.size(); ++i) {
+      if (bodies[i].invMass == 0) continue;
+      rigid[i]->v = bodies[i].v;
+      rigid[i]->L += bodies[i].angularImpulse;
+    }
+  }
+};
+
+solvers::BodyInertia bodyInertia(const RigidBody<3>& b) {
+  solvers::BodyInertia I;
+  I.I0 = b.inertiaBody;
+  I.I0inv = b.inertiaBodyInverse;
+  I.principalMoments = b.principalMoments;
+  I.principalAxes = b.principalAxes;
+  return I;
+}
+
+}  // namespace
+
+ArticulationSolver articulationSettings(const World<3>& world) {
+  const auto* pool = world.findPool<ArticulationSolver>();
+  return pool && pool->size() > 0 ? pool->components()[0] : ArticulationSolver{};
+}
+
+std::vector<std::string> JointSystem::reads() const {
+  return {Joint::kName, ArticulationSolver::kName, KinematicMotion<3>::kName, Sleep<3>::kName};
+}
+std::vector<std::string> JointSystem::writes() const { return {RigidBody<3>::kName}; }
+
+namespace {
+
+// PD drive of the revolute joints with a target (Step III.2): an angular impulse about the
+// hinge, dt (kp (a* - a) + kd (a*' - a')), on the child and its opposite on the parent.
+void applyPd(JointAssembly& a, double t, double dt) {
+  constexpr double kPi = 3.14159265358979323846;
+  for (std::size_t k = 0; k < a.joints.size(); ++k) {
+    const Joint& joint = *a.components[k];
+    if (joint.pd == PdTarget::None) continue;
+    const auto& def = a.joints[k];
+    auto& P = a.bodies[def.parent];
+    auto& C = a.bodies[def.child];
+    const Eigen::Vector3d axis = solvers::jointAxis(def, P.q);
+    const double angle = solvers::revoluteAngle(def, P.q, C.q);
+    const double rate = axis.dot(C.w - P.w);
+    double target = 0, targetRate = 0;
+    joint.targetAt(t, target, targetRate);
+    double error = target - angle;
+    if (error > kPi) error -= 2 * kPi;
+    if (error < -kPi) error += 2 * kPi;
+    const Eigen::Vector3d impulse = dt * (joint.kp * error + joint.kd * (targetRate - rate)) * axis;
+    if (C.invMass > 0) C.angularImpulse += impulse, C.w += C.invInertia * impulse;
+    if (P.invMass > 0) P.angularImpulse -= impulse, P.w -= P.invInertia * impulse;
+  }
+}
+
+bool anyPd(const World<3>& w) {
+  const auto* pool = w.findPool<Joint>();
+  if (!pool) return false;
+  for (const Joint& j : pool->components())
+    if (j.pd != PdTarget::None) return true;
+  return false;
+}
+
+}  // namespace
+
+std::string PostStabilizeJoints::name() const {
+  switch (place_) {
+    case Place::AfterCollisions: return "post_stabilize_collisions";
+    case Place::AfterPositions: return "post_stabilize_positions";
+    case Place::AfterVelocities: return "post_stabilize_velocities";
+  }
+  return "?";
+}
+
+Stage PostStabilizeJoints::stage() const {
+  switch (place_) {
+    case Place::AfterCollisions: return Stage::Collisions;
+    case Place::AfterPositions: return Stage::AdvancePositions;
+    case Place::AfterVelocities: return Stage::AdvanceVelocity;
+  }
+  return Stage::Count;
+}
+
+void PostStabilizeJoints::run(World<3>& world, StepContext& ctx) {
+  const ArticulationSolver s = articulationSettings(world);
+  if (place_ == Place::AfterPositions && world.count<Collider<3>>() > 0) {
+    // Interpenetration resolution moved bodies one contact at a time: close the joints again.
+    JointAssembly a(world);
+    const solvers::PreStabilizationReport r = solvers::closeJoints(
+        a.joints, a.bodies, s.pre == ArticulationSolver::Method::Global, s.preIterations, s.preTolerance);
+    for (std::size_t i = 1; i < a.bodies.size(); ++i) {
+      if (a.bodies[i].invMass == 0) continue;
+      a.rigid[i]->x = a.bodies[i].x;
+      a.rigid[i]->orientation = a.bodies[i].q;
+    }
+    ctx.diagnostics.max("joint_push_out_error", r.errorBefore);
+  }
+  if (place_ == Place::AfterPositions && !memory_->entity.empty()) {
+    for (std::size_t i = 0; i < memory_->entity.size(); ++i) {
+      RigidBody<3>* b = world.get<RigidBody<3>>(memory_->entity[i]);
+      b->v = memory_->v[i];
+      b->L = memory_->L[i];
+    }
+  }
+  JointAssembly a(world);
+  if (place_ == Place::AfterVelocities) applyPd(a, ctx.time + 0.5 * ctx.dt, ctx.dt);
+  const auto rows = a.rows();
+  const std::vector<solvers::Vector6d> zero(rows.size(), solvers::Vector6d::Zero());
+  const solvers::ProjectionReport r =
+      s.post == ArticulationSolver::Method::Global
+          ? solvers::projectGlobal(rows, zero, a.bodies, s.postIterations * static_cast<int>(std::max<std::size_t>(rows.size(), 1)),
+                                   s.postTolerance)
+          : solvers::projectPairwise(rows, zero, a.bodies, s.postIterations, s.postTolerance);
+  a.writeBack();
+  ctx.diagnostics.max("joint_post_iterations", r.iterations);
+  if (place_ == Place::AfterCollisions) {
+    memory_->entity.clear(), memory_->v.clear(), memory_->L.clear();
+    for (std::size_t i = 1; i < a.bodies.size(); ++i) {
+      if (a.bodies[i].invMass == 0) continue;
+      memory_->entity.push_back(a.entity[i]);
+      memory_->v.push_back(a.rigid[i]->v);
+      memory_->L.push_back(a.rigid[i]->L);
+    }
+  }
+}
+
+bool JointPdControl::needed(const World<3>& w) const { return anyPd(w); }
+
+void JointPdControl::run(World<3>& world, StepContext& ctx) {
+  JointAssembly a(world);
+  applyPd(a, ctx.time + 0.5 * ctx.dt, ctx.dt);
+  a.writeBack();
+}
+
+std::vector<std::unique_ptr<System<3>>> makeJointSystems() {
+  auto memory = std::make_shared<JointVelocityMemory>();
+  using Place = PostStabilizeJoints::Place;
+  std::vector<std::unique_ptr<System<3>>> v;
+  v.push_back(std::make_unique<PostStabilizeJoints>(Place::AfterCollisions, memory));
+  v.push_back(std::make_unique<PreStabilizeJoints>());
+  v.push_back(std::make_unique<PostStabilizeJoints>(Place::AfterPositions, memory));
+  v.push_back(std::make_unique<PostStabilizeJoints>(Place::AfterVelocities, memory));
+  v.push_back(std::make_unique<JointDiagnostics>());
+  return v;
+}
+
+bool PreStabilizeJoints::needed(const World<3>& w) const {
+  return JointSystem::needed(w) && articulationSettings(w).preStabilization;
+}
+
+void PreStabilizeJoints::run(World<3>& world, StepContext& ctx) {
+  const ArticulationSolver s = articulationSettings(world);
+  JointAssembly a(world);
+  const double dt = ctx.dt;
+  const RigidRotationSettings rule = world.settings().rigidRotation;
+  std::vector<solvers::BodyInertia> inertia(a.bodies.size());
+  for (std::size_t i = 1; i < a.bodies.size(); ++i)
+    if (a.bodies[i].invMass > 0) inertia[i] = bodyInertia(*a.rigid[i]);
+  // Exactly what Step IV will do with these velocities (advance_positions.cpp,
+  // kinematic_motion.cpp), so that the joints close on the poses the step ends at.
+  const solvers::PosePredictor predict = [&](int i, const solvers::ConstraintBody& b, Eigen::Vector3d& x,
+                                             Eigen::Quaterniond& q) {
+    x = b.x;
+    q = b.q;
+    if (i == 0 || (a.rigid[i]->isStatic)) return;
+    x = b.x + dt * b.v;
+    if (a.kinematic[i]) {
+      const double angle = dt * b.w.norm();
+      if (angle > 0) q = (Eigen::Quaterniond(Eigen::AngleAxisd(angle, b.w.normalized())) * b.q).normalized();
+      return;
+    }
+    if (b.invMass == 0) {  // asleep: held still
+      x = b.x;
+      return;
+    }
+    const Eigen::Vector3d L = a.rigid[i]->L + b.angularImpulse;
+    const double energyBefore = solvers::rotationalKineticEnergy(inertia[i], b.q, L);
+    q = solvers::advanceOrientation(static_cast<solvers::RotationOrder>(rule.order), dt, inertia[i], b.q, L);
+    if (rule.energyFix) solvers::correctOrientationForKineticEnergy(q, inertia[i], L, energyBefore);
+  };
+  const solvers::PreStabilizationReport r =
+      solvers::preStabilize(a.joints, a.bodies, predict, dt, s.pre == ArticulationSolver::Method::Global,
+                            s.preIterations, s.preTolerance);
+  a.writeBack();
+  ctx.diagnostics.max("joint_pre_iterations", r.iterations);
+  ctx.diagnostics.max("joint_pre_error_left", r.errorAfter);
+}
+
+void JointDiagnostics::run(World<3>& world, StepContext& ctx) {
+  JointAssembly a(world);
+  double position = 0, angle = 0, velocity = 0;
+  for (const auto& def : a.joints) {
+    const auto& P = a.bodies[def.parent];
+    const auto& C = a.bodies[def.child];
+    const solvers::JointError e = solvers::jointError(def, P.x, P.q, C.x, C.q);
+    position = std::max(position, e.linear.norm());
+    angle = std::max(angle, e.angular.norm());
+    const solvers::JointRows rows = solvers::jointRows(def, a.bodies);
+    velocity = std::max(velocity, solvers::largestEntry(solvers::rowVelocities(rows, a.bodies), rows.rows()));
+  }
+  ctx.diagnostics.set("joint_error_max", position);
+  ctx.diagnostics.set("joint_angle_error_max", angle);
+  ctx.diagnostics.set("joint_velocity_error_max", velocity);
+}
+
+}  // namespace monolith

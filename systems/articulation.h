@@ -1,0 +1,81 @@
+#pragma once
+// Articulated rigid bodies (thesis Sec. 4.4-4.7, App. C): the joint stages of the Newmark step.
+//   post_stabilize_collisions  Step II.2   project the velocities after collisions onto the joints
+//   joint_pd_control           Step III.2  PD drive of revolute joints, as impulses
+//   pre_stabilize_joints       Step III.3  impulses so that Step IV's positions satisfy the joints
+//   post_stabilize_positions   Step IV.3   project the velocities at the new positions
+//   post_stabilize_velocities  Step V.4    project the final velocities
+//   joint_diagnostics          joint_error_max, joint_angle_error_max, joint_velocity_error_max
+// A scene without joints schedules none of them. The numerics are in solvers/articulation.
+#include "components/joint.h"
+#include "components/rigid_body.h"
+#include "ecs/system.h"
+
+#include <cstdint>
+#include <memory>
+
+namespace monolith {
+
+class JointSystem : public System<3> {
+ public:
+  std::vector<std::string> reads() const override;
+  std::vector<std::string> writes() const override;
+  bool needed(const World<3>& w) const override { return w.count<Joint>() > 0; }
+};
+
+// The jointed bodies' velocities after Step II (v-hat^{n+1/2} = v-hat^n + dt/2 F^n/m), kept
+// within one step: pre-stabilization's and PD's impulses of Step III only serve the positions
+// (Sec. 4.6: Step IV.3 post-stabilizes v-hat^n), so Step IV restores these before projecting.
+struct JointVelocityMemory {
+  std::vector<Entity> entity;
+  std::vector<Eigen::Vector3d> v, L;
+};
+
+// Post-stabilization at one of its three places. After collisions it also remembers the
+// velocities; after the positions it first restores them; after the velocities it first applies
+// the PD drives again (Sec. 4.7 step 4: post-stabilization, PD, contact, post-stabilization).
+class PostStabilizeJoints final : public JointSystem {
+ public:
+  enum class Place { AfterCollisions, AfterPositions, AfterVelocities };
+  PostStabilizeJoints(Place place, std::shared_ptr<JointVelocityMemory> memory)
+      : place_(place), memory_(std::move(memory)) {}
+  std::string name() const override;
+  Stage stage() const override;
+  void run(World<3>& world, StepContext& ctx) override;
+
+ private:
+  Place place_;
+  std::shared_ptr<JointVelocityMemory> memory_;
+};
+
+class JointPdControl final : public JointSystem {
+ public:
+  std::string name() const override { return "joint_pd_control"; }
+  Stage stage() const override { return Stage::Contact; }
+  bool needed(const World<3>& w) const override;
+  void run(World<3>& world, StepContext& ctx) override;
+};
+
+class PreStabilizeJoints final : public JointSystem {
+ public:
+  std::string name() const override { return "pre_stabilize_joints"; }
+  Stage stage() const override { return Stage::Contact; }
+  bool needed(const World<3>& w) const override;
+  void run(World<3>& world, StepContext& ctx) override;
+};
+
+class JointDiagnostics final : public JointSystem {
+ public:
+  std::string name() const override { return "joint_diagnostics"; }
+  Stage stage() const override { return Stage::Diagnostics; }
+  std::vector<std::string> writes() const override { return {}; }
+  void run(World<3>& world, StepContext& ctx) override;
+};
+
+// All the joint systems, sharing one velocity memory.
+std::vector<std::unique_ptr<System<3>>> makeJointSystems();
+
+// The scene's solver settings (its "articulation" component, else the defaults).
+ArticulationSolver articulationSettings(const World<3>& world);
+
+}  // namespace monolith

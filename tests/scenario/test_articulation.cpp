@@ -1,0 +1,320 @@
+// Articulated rigid bodies (thesis Sec. 4.4-4.7, App. C): the pendulum's period against the
+// closed form, energy that never rises, joints that stay closed on a falling chain and on a
+// loop dropped on the ground, global and pairwise post-stabilization converging to the same
+// velocities, a PD-driven arm with the overshoot its gains predict, 1 and 2 threads bitwise,
+// checkpoints, validation with JSON paths, and scenes without joints left alone.
+#include <gtest/gtest.h>
+
+#include "support/scenes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "components/joint.h"
+#include "components/rigid_body.h"
+#include "ecs/binary_io.h"
+#include "scenarios/checkpoint.h"
+#include "scenarios/simulation.h"
+
+using namespace monolith;
+using test::builtins;
+using test::kScenes;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kG = 9.81;
+
+const RigidBody<3>& body(Simulation<3>& sim, const std::string& name) {
+  return *sim.world().get<RigidBody<3>>(*sim.world().find(name));
+}
+
+double totalEnergy(Simulation<3>& sim) {
+  double e = 0;
+  for (const auto& b : sim.world().pool<RigidBody<3>>().components())
+    if (!b.isStatic) e += b.translationalKineticEnergy() + b.rotationalKineticEnergy() + b.mass * kG * b.x.y();
+  return e;
+}
+
+// The scene file's text with the "articulation" component given appended to its entities.
+std::string withArticulation(const std::string& file, const std::string& settings) {
+  std::ifstream in(kScenes + file);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string s = text.str();
+  const std::size_t end = s.rfind(']');
+  return s.substr(0, end) + ", {\"name\": \"solver\", \"articulation\": " + settings + "}\n" + s.substr(end);
+}
+
+std::vector<double> stateOf(Simulation<3>& sim) {
+  std::vector<double> s;
+  for (const auto& b : sim.world().pool<RigidBody<3>>().components()) {
+    for (int i = 0; i < 3; ++i) s.insert(s.end(), {b.x(i), b.v(i), b.L(i)});
+    s.insert(s.end(), {b.orientation.w(), b.orientation.x(), b.orientation.y(), b.orientation.z()});
+  }
+  return s;
+}
+
+// Angle of the rod from hanging straight down (about +z).
+double pendulumAngle(Simulation<3>& sim) {
+  const Eigen::Vector3d x = body(sim, "rod").x;
+  return std::atan2(x.x(), -x.y());
+}
+
+}  // namespace
+
+TEST(Articulation, PendulumPeriodMatchesTheClosedForm) {
+  const Registry registry = builtins();
+  Simulation<3> sim(loadScene(kScenes + "pendulum.json"), registry);
+  // I_pivot of the rod (box 0.02 x 1 x 0.02, 1 kg, centre 0.5 m down) and bob (ball r 0.1, 2 kg, 1 m down).
+  const double I = (1.0 / 12 * (1.0 + 0.0004) + 0.25) + (0.4 * 2 * 0.01 + 2.0);
+  const double m = 3, d = (0.5 * 1 + 1.0 * 2) / 3;
+  const double expected = 2 * kPi * std::sqrt(I / (m * kG * d));
+  std::vector<double> crossings;  // downward zero crossings of the angle
+  double previous = pendulumAngle(sim), tPrevious = 0;
+  while (!sim.finished()) {
+    const auto& diag = sim.step();
+    ASSERT_LT(diag.at("joint_error_max"), 1e-8);
+    const double a = pendulumAngle(sim);
+    if (previous > 0 && a <= 0) crossings.push_back(tPrevious + (sim.time() - tPrevious) * previous / (previous - a));
+    previous = a, tPrevious = sim.time();
+  }
+  ASSERT_GE(crossings.size(), 4u);
+  const double period = (crossings.back() - crossings.front()) / (crossings.size() - 1);
+  std::cout << "[measured] pendulum period " << period << " s, closed form " << expected << " s\n";
+  EXPECT_NEAR(period / expected, 1.0, 0.005) << "period " << period << " s, closed form " << expected << " s";
+}
+
+TEST(Articulation, PendulumAtLargeStepsNeverGainsEnergy) {
+  const Registry registry = builtins();
+  Simulation<3> sim(loadScene(kScenes + "pendulum.json", {{"time.dt", "0.03333333333333333"}}), registry);
+  const double start = totalEnergy(sim);
+  // The swing's energy above the lowest position: m g d (1 - cos 5 deg).
+  const double swing = 3 * kG * (2.5 / 3) * (1 - std::cos(5 * kPi / 180));
+  double worstRise = -1e300;
+  while (!sim.finished()) {
+    const auto& diag = sim.step();
+    worstRise = std::max(worstRise, diag.at("total_energy") - start);
+  }
+  std::cout << "[measured] pendulum dt=1/30 largest energy rise " << worstRise << " J (swing " << swing << " J)\n";
+  EXPECT_LT(worstRise, 1e-3 * swing) << "largest rise " << worstRise << " J on a swing of " << swing << " J";
+  EXPECT_LT(worstRise, 1e-3 * std::abs(start));
+}
+
+TEST(Articulation, HangingChainStaysJoinedWithoutGainingEnergyOnAnyThreadCount) {
+  const Registry registry = builtins();
+  const SceneSpec scene = loadScene(kScenes + "chain_hanging.json");
+  Simulation<3> one(scene, registry, 1), two(scene, registry, 2);
+  const double start = totalEnergy(one);
+  const double scale = 20 * 0.1 * kG * 2.0;  // the chain's weight times its length
+  double worstError = 0, worstRise = -1e300;
+  while (!one.finished()) {
+    const auto& diag = one.step();
+    two.step();
+    worstError = std::max(worstError, diag.at("joint_error_max"));
+    worstRise = std::max(worstRise, diag.at("total_energy") - start);
+  }
+  std::cout << "[measured] chain joint_error_max " << worstError << " m, energy rise " << worstRise << " J, end energy "
+            << totalEnergy(one) - start << " J\n";
+  EXPECT_LT(worstError, 1e-4 * 0.1);
+  EXPECT_LT(worstRise, 1e-3 * scale);
+  EXPECT_EQ(stateHash(one.world()), stateHash(two.world()));
+  // It fell: the last link is well below the pivot.
+  EXPECT_LT(body(one, "link19").x.y(), -1.0);
+}
+
+TEST(Articulation, LoopDroppedOnTheGroundStaysClosed) {
+  const Registry registry = builtins();
+  Simulation<3> sim(loadScene(kScenes + "loop_six.json"), registry);
+  double worst = 0;
+  while (!sim.finished()) worst = std::max(worst, sim.step().at("joint_error_max"));
+  std::cout << "[measured] loop_six joint_error_max " << worst << " m\n";
+  EXPECT_LT(worst, 1e-3);
+  for (int k = 0; k < 6; ++k) {  // at rest on the ground
+    const auto& b = body(sim, "bar" + std::to_string(k));
+    EXPECT_NEAR(b.x.y(), 0.02, 2e-3);
+    EXPECT_LT(b.v.norm(), 1e-2);
+  }
+}
+
+TEST(Articulation, GlobalAndPairwisePostStabilizationAgreeAtConvergence) {
+  const Registry registry = builtins();
+  const std::string tight = R"("post_iterations": 100000, "post_tolerance": 1e-14, "pre_iterations": 200, "pre_tolerance": 1e-13)";
+  Simulation<3> pairwise(parseScene(withArticulation("loop_six.json", R"({"post_stabilization": "pairwise", )" + tight + "}"),
+                                    "loop_six.json"),
+                         registry);
+  Simulation<3> global(parseScene(withArticulation("loop_six.json", R"({"post_stabilization": "global", )" + tight + "}"),
+                                  "loop_six.json"),
+                       registry);
+  // Spin the loop's bars so that the projections have work to do.
+  for (auto* sim : {&pairwise, &global}) {
+    int k = 0;
+    for (auto& b : sim->world().pool<RigidBody<3>>().components()) {
+      if (b.isStatic) continue;
+      b.setOmega(Eigen::Vector3d(std::sin(1.0 + k), std::cos(2.0 * k), 0.5 * k - 1.0));
+      b.v += Eigen::Vector3d(0.1 * k, 0.2, -0.05 * k);
+      ++k;
+    }
+  }
+  for (int n = 0; n < 10; ++n) {  // in the air: no contact yet
+    pairwise.step();
+    global.step();
+  }
+  const auto a = stateOf(pairwise), b = stateOf(global);
+  double worst = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
+  std::cout << "[measured] loop_six global vs pairwise largest state difference " << worst << "\n";
+  EXPECT_LT(worst, 1e-8);
+}
+
+TEST(Articulation, PdArmSettlesWithTheOvershootItsGainsPredict) {
+  const Registry registry = builtins();
+  Simulation<3> sim(loadScene(kScenes + "pd_arm.json"), registry);
+  const double target = 0.5, zeta = 0.3;
+  const double predicted = std::exp(-kPi * zeta / std::sqrt(1 - zeta * zeta));
+  double peak = 0, settledAt = 0;
+  while (!sim.finished()) {
+    sim.step();
+    const Eigen::Vector3d tip = body(sim, "fore").x;
+    const double angle = std::atan2(tip.y(), tip.x());  // the straight arm's angle
+    peak = std::max(peak, angle);
+    if (std::abs(angle - target) > 0.02 * target) settledAt = sim.time();
+  }
+  const double overshoot = (peak - target) / target;
+  std::cout << "[measured] pd_arm overshoot " << overshoot << " (predicted " << predicted << "), settled (2 %) at "
+            << settledAt << " s\n";
+  EXPECT_NEAR(overshoot, predicted, 0.03) << "overshoot " << overshoot << ", predicted " << predicted;
+  // Settling (2 %) of a damped oscillator: about 4 / (zeta w_n) = 2.1 s.
+  EXPECT_LT(settledAt, 3.0);
+}
+
+TEST(Articulation, CheckpointOfAJointedSceneResumesBitwise) {
+  const Registry registry = builtins();
+  const SceneSpec scene = loadScene(kScenes + "pd_arm.json", {{"time.end", "0.2"}});
+  Simulation<3> straight(scene, registry);
+  for (int n = 0; n < 100; ++n) straight.step();
+  BinaryWriter out;
+  serializeWorld(straight.world(), out);
+  Simulation<3> resumed(scene, registry);
+  BinaryReader in(out.bytes().data(), out.bytes().size(), "checkpoint");
+  deserializeWorld(resumed.world(), in, registry);
+  resumed.restoreClock(straight.stepsDone(), straight.time());
+  resumed.reschedule();
+  while (!straight.finished()) straight.step();
+  while (!resumed.finished()) resumed.step();
+  EXPECT_EQ(stateHash(straight.world()), stateHash(resumed.world()));
+}
+
+TEST(Articulation, ScenesWithoutJointsScheduleNoJointSystem) {
+  const Registry registry = builtins();
+  Simulation<3> sim(loadScene(kScenes + "newtons_cradle.json"), registry);
+  for (const char* name : {"post_stabilize_collisions", "pre_stabilize_joints", "post_stabilize_positions",
+                           "post_stabilize_velocities", "joint_pd_control", "joint_diagnostics"})
+    EXPECT_EQ(sim.scheduler().indexOf(name), -1) << name;
+  EXPECT_EQ(sim.step().count("joint_error_max"), 0u);
+  Simulation<3> jointed(loadScene(kScenes + "pendulum.json"), registry);
+  EXPECT_GE(jointed.scheduler().indexOf("pre_stabilize_joints"), 0);
+  EXPECT_EQ(jointed.scheduler().indexOf("joint_pd_control"), -1);  // no PD drive in the scene
+}
+
+TEST(Articulation, PrismaticAndUniversalJointsKeepTheirConstraints) {
+  const Registry registry = builtins();
+  // A slider on a tilted rail (prismatic along (1, -1, 0)/sqrt 2) under gravity: it slides with
+  // g / sqrt 2 along the rail; a box hanging from it on a universal joint swings but stays joined.
+  Simulation<3> sim(parseScene(R"({ "dimension": 3, "time": { "dt": 0.004166666666666667, "end": 1.0 },
+    "gravity": [0, -9.81, 0], "entities": [
+    { "name": "slider", "shape": { "type": "box", "half_extents": [0.1, 0.1, 0.1] },
+      "rigid_body": { "mass": 1 },
+      "joint": { "type": "prismatic", "parent": "world", "anchor": [0, 0, 0], "axis": [0.7071067811865476, -0.7071067811865476, 0] } },
+    { "name": "hanging", "shape": { "type": "box", "half_extents": [0.05, 0.2, 0.05] },
+      "rigid_body": { "mass": 0.5, "position": [0.1, -0.3, 0], "angular_velocity": [0, 3, 0] },
+      "joint": { "type": "universal", "parent": "slider", "anchor": [0, -0.1, 0], "axis": [0, 1, 0] } } ] })",
+                                "slider.json"),
+                     registry);
+  double worst = 0, worstAngle = 0;
+  while (!sim.finished()) {
+    const auto& d = sim.step();
+    worst = std::max(worst, d.at("joint_error_max"));
+    worstAngle = std::max(worstAngle, d.at("joint_angle_error_max"));
+  }
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_LT(worstAngle, 1e-6);
+  const Eigen::Vector3d x = body(sim, "slider").x;
+  EXPECT_NEAR(x.x(), -x.y(), 1e-6);  // on the rail
+  EXPECT_NEAR(body(sim, "slider").orientation.angularDistance(Eigen::Quaterniond::Identity()), 0, 1e-6);
+  EXPECT_GT(x.x(), 0.5);  // it slid down the rail (free slide alone would give 1.73 m)
+}
+
+TEST(Articulation, HingeLimitsStopTheSwing) {
+  const Registry registry = builtins();
+  // A rod hanging from a hinge, kicked to swing about 1 rad each way; limits at +-0.3 rad.
+  Simulation<3> sim(parseScene(R"({ "dimension": 3, "time": { "dt": 0.004166666666666667, "end": 2.0 },
+    "gravity": [0, -9.81, 0], "entities": [
+    { "name": "rod", "shape": { "type": "box", "half_extents": [0.02, 0.5, 0.02] },
+      "rigid_body": { "mass": 1, "position": [0, -0.5, 0], "velocity": [2, 0, 0], "angular_velocity": [0, 0, 4] },
+      "joint": { "type": "revolute", "parent": "world", "anchor": [0, 0, 0], "axis": [0, 0, 1], "limits": [-0.3, 0.3] } } ] })",
+                                "limits.json"),
+                     registry);
+  double largest = 0, smallest = 0, worst = 0;
+  while (!sim.finished()) {
+    worst = std::max(worst, sim.step().at("joint_error_max"));
+    const double a = pendulumAngle(sim);
+    largest = std::max(largest, a), smallest = std::min(smallest, a);
+  }
+  EXPECT_NEAR(largest, 0.3, 1e-6);   // reached the upper limit and stopped there
+  EXPECT_GT(smallest, -0.3 - 1e-6);  // swung back no further than the lower one
+  EXPECT_LT(worst, 1e-8);
+}
+
+TEST(Articulation, BadJointsAreRefusedAtTheirJsonPath) {
+  const Registry registry = builtins();
+  auto refuse = [&](const std::string& joint, const std::string& path, const std::string& extra = "") {
+    const std::string text = R"({ "dimension": 3, "time": { "dt": 0.01, "end": 0.1 }, "entities": [
+      { "name": "floor", "rigid_body": { "static": true } },
+      { "name": "a", "shape": { "type": "sphere", "radius": 0.1 }, "rigid_body": { "mass": 1 } },
+      { "name": "b", "shape": { "type": "sphere", "radius": 0.1 }, "rigid_body": { "mass": 1, "position": [1, 0, 0] } },
+      { "name": "j", "joint": )" + joint + "}" + extra + "] }";
+    try {
+      World<3> world;
+      populateWorld(parseScene(text, "bad.json"), registry, world);
+      ADD_FAILURE() << "accepted: " << joint;
+    } catch (const SceneError& e) {
+      EXPECT_EQ(e.path(), path) << e.what();
+      EXPECT_EQ(e.file(), "bad.json");
+    }
+  };
+  refuse(R"({ "type": "spherical", "parent": "a", "child": "nobody", "anchor": [0, 0, 0] })", "entities[3].joint.child");
+  refuse(R"({ "type": "spherical", "parent": "ghost", "child": "a", "anchor": [0, 0, 0] })", "entities[3].joint.parent");
+  refuse(R"({ "type": "fixed", "parent": "world", "child": "floor", "anchor": [0, 0, 0] })", "entities[3].joint");
+  refuse(R"({ "type": "hinge", "parent": "a", "child": "b", "anchor": [0, 0, 0] })", "entities[3].joint.type");
+  refuse(R"({ "type": "revolute", "parent": "a", "child": "b", "anchor": [0, 0, 0] })", "entities[3].joint.axis");
+  refuse(R"({ "type": "revolute", "parent": "a", "child": "b", "anchor": [0, 0, 0], "axis": [0, 0, 0] })",
+         "entities[3].joint.axis");
+  refuse(R"({ "type": "fixed", "parent": "a", "child": "b", "parent_frame": { "orientation": [0, 0, 0, 0] },
+              "child_frame": {} })",
+         "entities[3].joint.parent_frame.orientation");
+  refuse(R"({ "type": "fixed", "parent": "a", "child": "b", "parent_frame": {} })", "entities[3].joint.child_frame");
+  refuse(R"({ "type": "spherical", "parent": "a", "child": "b", "anchor": [0, 0, 0], "limits": [-1, 1] })",
+         "entities[3].joint.limits");
+  refuse(R"({ "type": "revolute", "parent": "a", "child": "b", "anchor": [0, 0, 0], "axis": [0, 0, 1], "limits": [1, -1] })",
+         "entities[3].joint.limits");
+  refuse(R"({ "type": "spherical", "parent": "a", "child": "b", "anchor": [0, 0, 0], "pd": { "kp": 1, "target": 0 } })",
+         "entities[3].joint.pd");
+  refuse(R"({ "type": "revolute", "parent": "a", "child": "b", "anchor": [0, 0, 0], "axis": [0, 0, 1],
+              "pd": { "kp": 1, "target": { "keyframes": [[0, 0], [0, 1]] } } })",
+         "entities[3].joint.pd.target.keyframes[1]");
+  // A second fixed joint between the same bodies closes a loop of fixed joints.
+  refuse(R"({ "type": "fixed", "parent": "a", "child": "b", "anchor": [0.5, 0, 0] })", "entities[4].joint", R"(,
+      { "name": "k", "joint": { "type": "fixed", "parent": "b", "child": "a", "anchor": [0.5, 0, 0] } })");
+  // Both bodies fixed to the static floor, then to each other: a loop through the ground.
+  refuse(R"({ "type": "fixed", "parent": "floor", "child": "a", "anchor": [0, 0, 0] })", "entities[5].joint", R"(,
+      { "name": "k", "joint": { "type": "fixed", "parent": "world", "child": "b", "anchor": [1, 0, 0] } },
+      { "name": "l", "joint": { "type": "fixed", "parent": "a", "child": "b", "anchor": [0.5, 0, 0] } })");
+  refuse(R"({ "type": "spherical", "parent": "a", "child": "b", "anchor": [0.5, 0, 0] })", "entities[5].articulation", R"(,
+      { "name": "s1", "articulation": {} }, { "name": "s2", "articulation": {} })");
+}
