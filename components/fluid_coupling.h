@@ -31,8 +31,8 @@ struct FluidCoupling {
 
 struct FsiSolver {
   static constexpr const char* kName = "fsi_solver";
-  enum class Preconditioner : int { None = 0, BlockJacobi = 1, BlockExact = 2 };
-  Preconditioner preconditioner = Preconditioner::BlockExact;
+  enum class Preconditioner : int { None = 0, BlockJacobi = 1, BlockExact = 2, Schur = 3 };
+  Preconditioner preconditioner = Preconditioner::Schur;
   bool halfStep = true;  // Sec. 5.4 steps 1-3: a coupled solve over dt/2 gives the velocity that moves the body
   template <class V>
   void visitFields(V& visit) {

@@ -174,9 +174,10 @@ template <int d>
 void parseFsiSolver(World<d>& world, Entity e, const Config& c) {
   if (!world.template has<MacGrid<d>>(e)) c.fail("fsi_solver on the entity with the \"mac_grid\"", "no mac_grid");
   FsiSolver s;
-  const std::string p = c.oneOf("preconditioner", {"none", "block_jacobi", "block_exact"}, "block_exact");
+  const std::string p = c.oneOf("preconditioner", {"none", "block_jacobi", "block_exact", "schur"}, "schur");
   s.preconditioner = p == "none"           ? FsiSolver::Preconditioner::None
                      : p == "block_jacobi" ? FsiSolver::Preconditioner::BlockJacobi
+                     : p == "schur"        ? FsiSolver::Preconditioner::Schur
                                            : FsiSolver::Preconditioner::BlockExact;
   s.halfStep = c.boolean("half_step", true);
   c.finish();
@@ -205,7 +206,7 @@ void registerFluidComponents(Registry& r) {
           ObstacleGeometry<d>::supportedNames() + ") or level_set",
       parseFluidCoupling<d>);
   r.addComponentOf<d, FsiSolver>(
-      "on the mac_grid entity: the fluid-structure solve's preconditioner (none, block_jacobi, block_exact) and "
+      "on the mac_grid entity: the fluid-structure solve's preconditioner (none, block_jacobi, block_exact, schur) and "
       "half_step (Sec. 5.4 steps 1-3)",
       parseFsiSolver<d>);
 }

@@ -28,6 +28,7 @@ solvers::FsiPreconditionerKind kindOf(FsiSolver::Preconditioner p) {
     case FsiSolver::Preconditioner::None: return solvers::FsiPreconditionerKind::None;
     case FsiSolver::Preconditioner::BlockJacobi: return solvers::FsiPreconditionerKind::BlockJacobi;
     case FsiSolver::Preconditioner::BlockExact: return solvers::FsiPreconditionerKind::BlockExact;
+    case FsiSolver::Preconditioner::Schur: return solvers::FsiPreconditionerKind::Schur;
   }
   return solvers::FsiPreconditionerKind::BlockExact;
 }
@@ -74,7 +75,8 @@ solvers::FsiReport coupledSolve(const World<d>& world, RigidCouplingSetup<d>& se
                                                     : solvers::CoupledPreconditionerKind::BlockDiagonal);
   solvers::CgSettings cg{settings.maxIterations, settings.tolerance, 0};
   solvers::FsiReport report =
-      solvers::fsiProjection(*ops, c, u, cg, &fluid, kindOf(fsiSolverOf(world).preconditioner));
+      solvers::fsiProjection(*ops, c, u, cg, &fluid, kindOf(fsiSolverOf(world).preconditioner),
+                             poissonKind(settings.preconditioner));
   opsOut = std::move(ops);
   return report;
 }

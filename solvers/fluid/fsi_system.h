@@ -27,6 +27,21 @@
 //    a factorisation of the structure-sized matrix M + b^-1 J^T J (3 or 6 per rigid body).
 //    The lambda block is dense within each body (J M^-1 J^T couples all of its faces), which is
 //    what the Jacobi variant misses.
+//  * Schur: lambda eliminated exactly, the rest approximated. With F = (p_hat, u_hat),
+//      A = [[A_FF, A_Fl], [A_lF, C]],  C = W (beta^-1 + J M^-1 J^T) W^T,
+//    the symmetric block factorisation
+//      P^-1 = [[I, 0], [-C^-1 A_lF, I]] diag(S~^-1, C^-1) [[I, -A_Fl C^-1], [0, I]]
+//    with S~ approximating the Schur complement A_FF - A_Fl C^-1 A_lF. On the pressure block that
+//    Schur complement is the Poisson matrix of the same fluid with the coupling faces closed
+//    (the fluid cannot flow into a rigid body; the one-way obstacle's matrix) plus a term of rank
+//    3 (6) per body, its rigid motions: S~^-1 is the Poisson preconditioner of that closed
+//    domain (built once per solve), and CG takes care of the low-rank rest. On the viscous block
+//    likewise the rows' ends on coupling faces drop out; that block gets its Jacobi. What remains
+//    neglected is the pressure-viscous coupling G^T b G_mu^T, as in the fluid's own (5.31)
+//    preconditioner: iterations grow with the viscous number dt nu / dx^2 only.
+//    P^-1 is SPD whenever S~^-1 is.
+//    The block variants neglect exactly the pressure-lambda coupling that this one keeps, and it
+//    is what their iteration counts grow with (docs/benchmarks_fsi.md).
 #include "solvers/fluid/coupled_preconditioner.h"
 #include "solvers/fluid/krylov.h"
 #include "solvers/fluid/operators.h"
@@ -40,7 +55,7 @@
 
 namespace monolith::solvers {
 
-enum class FsiPreconditionerKind { None, BlockJacobi, BlockExact };
+enum class FsiPreconditionerKind { None, BlockJacobi, BlockExact, Schur };
 std::string toString(FsiPreconditionerKind kind);
 
 template <int d>
@@ -71,14 +86,23 @@ template <int d>
 class FsiPreconditioner {
  public:
   // `fluid` may be null for None.
+  // `pressureKind`: the Poisson preconditioner of the closed domain (Schur only).
   FsiPreconditioner(const FsiOperator<d>& system, const FluidOperators<d>& ops, const StructureCoupling& coupling,
-                    const CoupledPreconditioner<d>* fluid, FsiPreconditionerKind kind);
+                    const CoupledPreconditioner<d>* fluid, FsiPreconditionerKind kind,
+                    PoissonPreconditionerKind pressureKind = PoissonPreconditionerKind::MIC0);
+  ~FsiPreconditioner();
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
   LinearOperator asOperator() const;
 
  private:
+  void applyConstraintInverse(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;  // C^-1 (Woodbury)
   FsiPreconditionerKind kind_;
+  const FluidOperators<d>* ops_;
+  const StructureCoupling* coupling_;
   const CoupledPreconditioner<d>* fluid_;
+  std::unique_ptr<FluidOperators<d>> closed_;              // Schur: coupling faces closed
+  std::unique_ptr<PoissonPreconditioner<d>> closedPoisson_;
+  Eigen::VectorXd viscousInverse_;  // Schur: Jacobi of the closed domain's viscous block
   int nf_ = 0, nc_ = 0;
   double b_ = 0;  // beta^-1 on a (whole) coupling face
   Eigen::VectorXd constraintInverse_;
@@ -101,7 +125,8 @@ struct FsiReport {
 template <int d>
 FsiReport fsiProjection(const FluidOperators<d>& ops, StructureCoupling& coupling, Eigen::VectorXd& faceVelocities,
                         const CgSettings& settings, const CoupledPreconditioner<d>* fluidPreconditioner,
-                        FsiPreconditionerKind kind);
+                        FsiPreconditionerKind kind,
+                        PoissonPreconditionerKind pressureKind = PoissonPreconditionerKind::MIC0);
 
 // Assembled K B^-1 K^T + P (tests, inspection).
 template <int d>

@@ -203,7 +203,8 @@ TEST(FsiSystem, NoViscosityGivesTheMassSymmetricProjection3D) { expectMassSymmet
 // every preconditioner (which changes the iterates, not the answer).
 TEST(FsiSystem, SolveNeverAddsKineticEnergy) {
   for (double mass : {1e-9, 1.0, 1e9})
-    for (auto kind : {FsiPreconditionerKind::None, FsiPreconditionerKind::BlockJacobi, FsiPreconditionerKind::BlockExact}) {
+    for (auto kind : {FsiPreconditionerKind::None, FsiPreconditionerKind::BlockJacobi, FsiPreconditionerKind::BlockExact,
+                      FsiPreconditionerKind::Schur}) {
       Rig<2> rig = makeRig<2>(16, 0.3, mass);
       const auto& ops = *rig.ops;
       std::mt19937 rng(5);
@@ -225,7 +226,8 @@ TEST(FsiSystem, SolveNeverAddsKineticEnergy) {
 // Preconditioning changes the iterations, not the solution.
 TEST(FsiSystem, PreconditionersAgreeOnTheSolution) {
   Eigen::VectorXd reference;
-  for (auto kind : {FsiPreconditionerKind::None, FsiPreconditionerKind::BlockJacobi, FsiPreconditionerKind::BlockExact}) {
+  for (auto kind : {FsiPreconditionerKind::None, FsiPreconditionerKind::BlockJacobi, FsiPreconditionerKind::BlockExact,
+                    FsiPreconditionerKind::Schur}) {
     Rig<2> rig = makeRig<2>(16, 0.3, 2.0);
     const auto& ops = *rig.ops;
     Eigen::VectorXd faces = Eigen::VectorXd::Zero(ops.domain.layout.totalFaces());
@@ -238,3 +240,25 @@ TEST(FsiSystem, PreconditionersAgreeOnTheSolution) {
     EXPECT_LT((rig.coupling.velocity - reference).cwiseAbs().maxCoeff(), 1e-8) << toString(kind);
   }
 }
+
+// CG needs a symmetric positive definite preconditioner: the Schur variant's block factorisation
+// is one (x^T P y = y^T P x, x^T P x > 0), in 2-D and 3-D.
+template <int d>
+void expectSchurPreconditionerSpd() {
+  Rig<d> rig = makeRig<d>(d == 2 ? 12 : 6, 0.2, 0.8);
+  FsiOperator<d> A(*rig.ops, rig.coupling);
+  FsiPreconditioner<d> P(A, *rig.ops, rig.coupling, nullptr, FsiPreconditionerKind::Schur, PoissonPreconditionerKind::MIC0);
+  std::mt19937 rng(17);
+  std::normal_distribution<double> g;
+  Eigen::VectorXd x(A.size()), y(A.size()), Px, Py;
+  for (int trial = 0; trial < 10; ++trial) {
+    for (auto& v : x) v = g(rng);
+    for (auto& v : y) v = g(rng);
+    P.apply(x, Px);
+    P.apply(y, Py);
+    EXPECT_NEAR(x.dot(Py), y.dot(Px), 1e-10 * (std::abs(x.dot(Py)) + 1));
+    EXPECT_GT(x.dot(Px), 0.0);
+  }
+}
+TEST(FsiSystem, SchurPreconditionerIsSymmetricPositiveDefinite2D) { expectSchurPreconditionerSpd<2>(); }
+TEST(FsiSystem, SchurPreconditionerIsSymmetricPositiveDefinite3D) { expectSchurPreconditionerSpd<3>(); }
