@@ -166,3 +166,34 @@ TEST(FsiScene, BadCouplingIsRefusedWithItsPath) {
     }
   }
 }
+
+// 3-D: a sphere two-way coupled in a closed box (6 DOFs per body): it sinks, its force columns
+// carry the buoyancy and drag, no solve adds kinetic energy, and it does not start spinning.
+TEST(FsiSphere3D, HeavySphereSinksWithoutEnergyGain) {
+  const Registry registry = builtins();
+  const std::string text = R"({"dimension": 3, "gravity": [0, 0, -9.8], "time": {"dt": 0.005, "steps": 12},
+    "solvers": {"fluid": {"advection": "semi_lagrangian"}},
+    "entities": [
+      {"name": "fluid", "mac_grid": {"cells": [10, 10, 14], "domain_min": [0, 0, 0], "domain_max": [1, 1, 1.4],
+                                     "boundaries": {"z_max": {"type": "outflow"}}},
+       "fluid_material": {"density": 1, "viscosity": 0.05}},
+      {"name": "ball", "shape": {"type": "sphere", "radius": 0.25},
+       "rigid_body": {"mass": 0.2, "position": [0.5, 0.5, 0.8]}, "fluid_coupling": {}}]})";
+  Simulation<3> sim(parseScene(text, "sphere_3d.json"), registry, 2);
+  double maxEnergyChange = -1e300;
+  std::map<std::string, double> m;
+  while (!sim.finished()) {
+    m = sim.step();
+    maxEnergyChange = std::max({maxEnergyChange, m.at("fsi_energy_change"), m.at("fsi_half_step_energy_change")});
+  }
+  const auto& body = *sim.world().get<RigidBody<3>>(*sim.world().find("ball"));
+  const double t = sim.time(), volume = 4.0 / 3.0 * M_PI * 0.25 * 0.25 * 0.25;
+  EXPECT_LT(body.v.z(), 0.0);
+  // Slower than free fall: buoyancy (the displaced fluid weighs 0.065 of its 0.2 kg) and drag.
+  EXPECT_GT(body.v.z(), -9.8 * t * (1 - 0.5 * volume / 0.2));
+  EXPECT_GT(m.at("fsi_ball_force_z"), 0.0);
+  EXPECT_LT(std::abs(body.v.x()) + std::abs(body.v.y()), 1e-6 * std::abs(body.v.z()) + 1e-12);
+  EXPECT_LT(body.omega().norm(), 1e-6);
+  EXPECT_LE(maxEnergyChange, 1e-12);
+  EXPECT_GT(m.at("fsi_coupling_faces"), 50.0);
+}
