@@ -17,6 +17,7 @@
 #include "systems/fluid_advection.h"
 #include "systems/fluid_obstacles.h"
 #include "systems/fluid_projection.h"
+#include "systems/fluid_structure_coupling.h"
 #include "systems/kinematic_motion.h"
 #include "systems/rigid_contact.h"
 #include "systems/rigid_forces.h"
@@ -188,6 +189,10 @@ void registerDimension(Registry& r) {
                   [] { return single<RasterizeObstacles<d>>(); }, ""});
   r.addSystem<d>({"obstacle_forces", "first-order force of the fluid on each fluid_obstacle (pressure + wall shear)",
                   [] { return single<ObstacleForces<d>>(); }, ""});
+  r.addSystem<d>({"fsi_half_step", "FSI steps 1-4 (Sec. 5.4): coupled fluid-structure solve over dt/2 at x^n for the velocity that moves fluid_coupling bodies",
+                  [] { return single<FsiHalfStep<d>>(); }, ""});
+  r.addSystem<d>({"project_fluid_structure", "monolithic SPD fluid-structure solve (5.30) with fluid_coupling rigid bodies (Sec. 5.4-5.8)",
+                  [] { return single<FluidStructureProjection<d>>(); }, ""});
   r.addSystem<d>({"rigid_diagnostics", "energies and momenta of the rigid bodies",
                   [] { return single<RigidDiagnostics<d>>(); }, ""});
 }

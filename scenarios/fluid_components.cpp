@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "components/fluid_coupling.h"
 #include "components/fluid_obstacle.h"
 #include "components/kinematic.h"
 #include "components/level_set.h"
@@ -148,6 +149,41 @@ void parseFluidObstacle(World<d>& world, Entity e, const Config& c) {
   world.add(e, FluidObstacle{});
 }
 
+// Two-way coupling: a dynamic rigid_body with a shape the rasterization knows (or a level_set).
+template <int d>
+void parseFluidCoupling(World<d>& world, Entity e, const Config& c) {
+  const Shape<d>* shape = world.template get<Shape<d>>(e);
+  const bool levelSet = world.template has<LevelSet<d>>(e);
+  if (!shape && !levelSet) c.fail("fluid_coupling on an entity with a \"level_set\" or a \"shape\"", "neither");
+  const RigidBody<d>* body = world.template get<RigidBody<d>>(e);
+  if (!body) c.fail("fluid_coupling on an entity with a dynamic \"rigid_body\"", "no rigid_body");
+  if (body->isStatic || world.template has<KinematicMotion<d>>(e))
+    c.fail("fluid_coupling on a dynamic rigid_body (static and kinematic bodies are one-way: \"fluid_obstacle\")",
+           body->isStatic ? "a static rigid_body" : "a kinematic rigid_body");
+  if (world.template has<FluidObstacle>(e))
+    c.fail("either fluid_obstacle (one-way) or fluid_coupling (two-way) on one entity", "both");
+  if (!levelSet && !ObstacleGeometry<d>::supports(shape->type))
+    c.fail("fluid_coupling on a " + ObstacleGeometry<d>::supportedNames() + " shape, or on an entity with a \"level_set\"",
+           "another shape type");
+  c.finish();
+  world.add(e, FluidCoupling<d>{});
+}
+
+// How the monolithic fluid-structure system is solved (on the mac_grid's entity).
+template <int d>
+void parseFsiSolver(World<d>& world, Entity e, const Config& c) {
+  if (!world.template has<MacGrid<d>>(e)) c.fail("fsi_solver on the entity with the \"mac_grid\"", "no mac_grid");
+  FsiSolver s;
+  const std::string p = c.oneOf("preconditioner", {"none", "block_jacobi", "block_exact", "schur"}, "schur");
+  s.preconditioner = p == "none"           ? FsiSolver::Preconditioner::None
+                     : p == "block_jacobi" ? FsiSolver::Preconditioner::BlockJacobi
+                     : p == "schur"        ? FsiSolver::Preconditioner::Schur
+                                           : FsiSolver::Preconditioner::BlockExact;
+  s.halfStep = c.boolean("half_step", true);
+  c.finish();
+  world.add(e, s);
+}
+
 }  // namespace
 
 template <int d>
@@ -165,6 +201,14 @@ void registerFluidComponents(Registry& r) {
       "obstacle in the fluid: the entity's level_set, else its shape (" + ObstacleGeometry<d>::supportedNames() +
           "), at its static or kinematic rigid_body pose",
       parseFluidObstacle<d>);
+  r.addComponentOf<d, FluidCoupling<d>>(
+      "two-way coupling of a dynamic rigid body with the fluid in one SPD solve (thesis Sec. 5.4-5.8): its shape (" +
+          ObstacleGeometry<d>::supportedNames() + ") or level_set",
+      parseFluidCoupling<d>);
+  r.addComponentOf<d, FsiSolver>(
+      "on the mac_grid entity: the fluid-structure solve's preconditioner (none, block_jacobi, block_exact, schur) and "
+      "half_step (Sec. 5.4 steps 1-3)",
+      parseFsiSolver<d>);
 }
 
 template void registerFluidComponents<2>(Registry&);

@@ -7,6 +7,7 @@
 // energy and momentum, and the velocity change per time (the steady-state measure).
 #include <memory>
 
+#include "components/fluid_coupling.h"
 #include "components/mac_grid.h"
 #include "ecs/system.h"
 
@@ -21,7 +22,10 @@ class FluidProjection final : public System<d> {
   Stage stage() const override { return Stage::AdvanceVelocity; }
   std::vector<std::string> reads() const override { return {FluidMaterial::kName}; }
   std::vector<std::string> writes() const override { return {MacGrid<d>::kName, "diagnostics"}; }
-  bool needed(const World<d>& w) const override { return w.template count<MacGrid<d>>() > 0; }
+  // With two-way coupled bodies project_fluid_structure solves the fluid with them instead.
+  bool needed(const World<d>& w) const override {
+    return w.template count<MacGrid<d>>() > 0 && w.template count<FluidCoupling<d>>() == 0;
+  }
   void run(World<d>& world, StepContext& ctx) override;
 
  private:

@@ -96,6 +96,10 @@ struct FluidDomain {
   // outside every obstacle. The rest of such a face moves with the obstacle: faceVelocity holds
   // that normal velocity.
   std::vector<double> openFraction;
+  // Optional (structure_coupling.h, markStructure); empty: no finite-mass structure. Else 1 per
+  // face that is a coupling face: a free velocity unknown constrained to move with a structure.
+  // The viscous operator drops the pairs between two such faces (no fluid shear between them).
+  std::vector<uint8_t> structureFace;
 
   // Classification of a face from its two cells and the sides (outside a Wall/Inflow side counts
   // as solid, outside an Outflow side as Dirichlet): solid on either side -> Prescribed, else a

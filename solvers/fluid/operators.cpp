@@ -150,6 +150,10 @@ void buildViscousRows(FluidOperators<d>& ops) {
         PairEnd e1 = pairEnd<d>(domain, ops.dofs, a, b, f1);
         if (e0.kind == PairEnd::Drop || e1.kind == PairEnd::Drop) continue;
         if (e0.kind != PairEnd::Unknown && e1.kind != PairEnd::Unknown) continue;
+        if (!domain.structureFace.empty() && e0.kind == PairEnd::Unknown && e1.kind == PairEnd::Unknown &&
+            domain.structureFace[ops.dofs.velocityToFace[e0.velocity]] &&
+            domain.structureFace[ops.dofs.velocityToFace[e1.velocity]])
+          continue;  // both ends move with structures (structure_coupling.h)
         double c = (e0.ghost || e1.ghost) ? std::sqrt(2.0) * w : w;
         if (!domain.wallDistance.empty()) {
           // A pair ending on an obstacle face: the wall sits theta cells from the free face

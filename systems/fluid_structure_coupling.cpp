@@ -1,0 +1,372 @@
+// Two-way rigid-body/fluid coupling: the FSI step of Sec. 5.4 (see fluid_structure_coupling.h).
+#include "systems/fluid_structure_coupling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "components/level_set.h"
+#include "components/shape.h"
+#include "systems/fluid_domain.h"
+#include "systems/obstacle_geometry.h"
+
+namespace monolith {
+
+namespace {
+
+constexpr int kAngular(int d) { return d == 2 ? 1 : 3; }
+
+template <int d>
+FsiSolver fsiSolverOf(const World<d>& world) {
+  const auto* pool = world.template findPool<FsiSolver>();
+  return pool && pool->size() > 0 ? pool->components()[0] : FsiSolver{};
+}
+
+solvers::FsiPreconditionerKind kindOf(FsiSolver::Preconditioner p) {
+  switch (p) {
+    case FsiSolver::Preconditioner::None: return solvers::FsiPreconditionerKind::None;
+    case FsiSolver::Preconditioner::BlockJacobi: return solvers::FsiPreconditionerKind::BlockJacobi;
+    case FsiSolver::Preconditioner::BlockExact: return solvers::FsiPreconditionerKind::BlockExact;
+    case FsiSolver::Preconditioner::Schur: return solvers::FsiPreconditionerKind::Schur;
+  }
+  return solvers::FsiPreconditionerKind::BlockExact;
+}
+
+solvers::PoissonPreconditionerKind poissonKind(FluidSolverSettings::Preconditioner p) {
+  using P = FluidSolverSettings::Preconditioner;
+  using K = solvers::PoissonPreconditionerKind;
+  switch (p) {
+    case P::None: return K::None;
+    case P::Jacobi: return K::Jacobi;
+    case P::IC0: return K::IC0;
+    case P::MIC0: return K::MIC0;
+    case P::Multigrid: return K::Multigrid;
+  }
+  return K::MIC0;
+}
+
+// Writes the structure velocity of body b (dofs from b * (d + angular)) into the body.
+template <int d>
+void writeBody(RigidBody<d>& body, const Eigen::VectorXd& v, int b) {
+  const int n = d + kAngular(d), off = b * n;
+  body.v = v.segment(off, d);
+  AngularVec<d> w;
+  for (int i = 0; i < kAngular(d); ++i) w[i] = v[off + d + i];
+  body.setOmega(w);
+}
+
+// One coupled solve over `dt` of the grid's face velocities `u` (in/out) with setup.coupling.velocity
+// as v* (in) and v^{n+1} (out).
+template <int d>
+solvers::FsiReport coupledSolve(const World<d>& world, RigidCouplingSetup<d>& setup, double rho, double mu, double dt,
+                                Eigen::VectorXd& u, std::unique_ptr<solvers::FluidOperators<d>>& opsOut) {
+  const FluidSolverSettings& settings = world.settings().fluid;
+  auto ops = std::make_unique<solvers::FluidOperators<d>>(
+      solvers::buildFluidOperators(setup.domain, solvers::FluidParameters{rho, mu, dt}));
+  auto& c = setup.coupling;
+  c.constrainedVelocities.resize(c.constrainedFaces.size());
+  for (std::size_t k = 0; k < c.constrainedFaces.size(); ++k)
+    c.constrainedVelocities[k] = ops->dofs.faceToVelocity[c.constrainedFaces[k]];
+  const solvers::PoissonPreconditioner<d> pressure(*ops, poissonKind(settings.preconditioner));
+  const solvers::CoupledPreconditioner<d> fluid(*ops, pressure,
+                                                settings.coupledCutCorrection
+                                                    ? solvers::CoupledPreconditionerKind::CutCorrected
+                                                    : solvers::CoupledPreconditionerKind::BlockDiagonal);
+  solvers::CgSettings cg{settings.maxIterations, settings.tolerance, 0};
+  solvers::FsiReport report =
+      solvers::fsiProjection(*ops, c, u, cg, &fluid, kindOf(fsiSolverOf(world).preconditioner),
+                             poissonKind(settings.preconditioner));
+  opsOut = std::move(ops);
+  return report;
+}
+
+// A coupling face inside a structure (a viscous neighbour of a fluid face, no fluid cell beside
+// it): its dual cell holds no fluid, so gravity must not act on the fluid mass the discretization
+// gives it; that mass would add its weight to the body's (a first-order error in the terminal
+// velocities, several per cent on the coarse grids).
+template <int d>
+bool insideStructure(const solvers::FluidDomain<d>& domain, int f) {
+  if (domain.structureFace.empty() || !domain.structureFace[f]) return false;
+  for (int which = 0; which < 2; ++which) {
+    int cell = -1;
+    if (domain.faceCell(f, which, cell) && domain.cells[cell] == solvers::CellKind::Fluid) return false;
+  }
+  return true;
+}
+
+template <int d>
+double fluidDensity(const World<d>& world, Entity grid) {
+  const FluidMaterial* m = world.template get<FluidMaterial>(grid);
+  return m ? m->density : 1.0;
+}
+template <int d>
+double fluidViscosity(const World<d>& world, Entity grid) {
+  const FluidMaterial* m = world.template get<FluidMaterial>(grid);
+  return m ? m->viscosity : 0.0;
+}
+
+}  // namespace
+
+template <int d>
+RigidCouplingSetup<d> buildRigidCoupling(const World<d>& world, const MacGrid<d>& grid, bool viscous) {
+  using Vec = Eigen::Matrix<double, d, 1>;
+  RigidCouplingSetup<d> setup;
+  setup.domain = fluidDomainOf(grid);
+  const auto& layout = setup.domain.layout;
+  const auto* pool = world.template findPool<FluidCoupling<d>>();
+  std::vector<ObstacleGeometry<d>> geometry;
+  for (Entity e : pool ? pool->entities() : std::vector<Entity>{}) {
+    const RigidBody<d>* body = world.template get<RigidBody<d>>(e);
+    if (!body) continue;
+    setup.bodies.push_back(e);
+    geometry.emplace_back(world.template get<Shape<d>>(e), world.template get<LevelSet<d>>(e), *body);
+  }
+  const int nb = static_cast<int>(setup.bodies.size());
+  // Structure cells: centre inside a body (the first listed wins where bodies overlap).
+  setup.cellBody.assign(layout.cellCount(), -1);
+  std::vector<std::uint8_t> mask(layout.cellCount(), 0);
+  for (int c = 0; c < layout.cellCount(); ++c) {
+    const Vec x = layout.cellCenter(layout.cellCoord(c));
+    for (int b = 0; b < nb; ++b)
+      if (geometry[b].contains(x)) {
+        setup.cellBody[c] = b;
+        mask[c] = 1;
+        break;
+      }
+  }
+  auto& coupling = setup.coupling;
+  coupling.constrainedFaces = solvers::markStructure(setup.domain, mask, viscous);
+  const int nc = static_cast<int>(coupling.constrainedFaces.size());
+  const int ndof = d + kAngular(d);
+
+  // J = N J_hat R: one sample per (face, adjacent body) at the face centre; a face between two
+  // bodies averages them (alpha = 1/2), else J_hat is the identity (Sec. 5.4.3).
+  std::vector<Eigen::Triplet<double>> jhat, r;
+  int samples = 0;
+  for (int k = 0; k < nc; ++k) {
+    const int f = coupling.constrainedFaces[k];
+    int adjacent[2] = {-1, -1}, count = 0;
+    for (int which = 0; which < 2; ++which) {
+      int cell = -1;
+      if (!setup.domain.faceCell(f, which, cell) || setup.cellBody[cell] < 0) continue;
+      if (count == 1 && adjacent[0] == setup.cellBody[cell]) continue;
+      adjacent[count++] = setup.cellBody[cell];
+    }
+    const auto [axis, fc] = layout.faceCoord(f);
+    const Vec x = layout.faceCenter(axis, fc);
+    for (int i = 0; i < count; ++i) {
+      const RigidBody<d>& body = geometry[adjacent[i]].body();
+      for (int a = 0; a < d; ++a) jhat.emplace_back(k * d + a, samples * d + a, 1.0 / count);
+      solvers::rigidSampleRows<d>(samples, adjacent[i] * ndof, Vec(x - body.x), r);
+      ++samples;
+    }
+  }
+  solvers::SparseMatrixR Jhat(nc * d, samples * d), R(samples * d, nb * ndof);
+  Jhat.setFromTriplets(jhat.begin(), jhat.end());
+  R.setFromTriplets(r.begin(), r.end());
+  coupling.J = solvers::faceNormalRows(layout, coupling.constrainedFaces) * Jhat * R;
+
+  std::vector<Eigen::Triplet<double>> m, minv;
+  coupling.velocity.resize(nb * ndof);
+  for (int b = 0; b < nb; ++b) {
+    const RigidBody<d>& body = geometry[b].body();
+    const int off = b * ndof;
+    for (int a = 0; a < d; ++a) {
+      m.emplace_back(off + a, off + a, body.mass);
+      minv.emplace_back(off + a, off + a, 1.0 / body.mass);
+    }
+    const InertiaMat<d> I = body.worldInertia(), Iinv = body.worldInverseInertia();
+    for (int i = 0; i < kAngular(d); ++i)
+      for (int j = 0; j < kAngular(d); ++j) {
+        m.emplace_back(off + d + i, off + d + j, I(i, j));
+        minv.emplace_back(off + d + i, off + d + j, Iinv(i, j));
+      }
+    coupling.velocity.segment(off, d) = body.v;
+    const AngularVec<d> w = body.omega();
+    for (int i = 0; i < kAngular(d); ++i) coupling.velocity[off + d + i] = w[i];
+  }
+  coupling.mass.resize(nb * ndof, nb * ndof);
+  coupling.mass.setFromTriplets(m.begin(), m.end());
+  coupling.massInverse.resize(nb * ndof, nb * ndof);
+  coupling.massInverse.setFromTriplets(minv.begin(), minv.end());
+  return setup;
+}
+
+template <int d>
+void FsiHalfStep<d>::run(World<d>& world, StepContext& ctx) {
+  auto& couplings = world.template pool<FluidCoupling<d>>();
+  for (std::size_t i = 0; i < couplings.size(); ++i) {
+    FluidCoupling<d>& c = couplings.components()[i];
+    const RigidBody<d>* body = world.template get<RigidBody<d>>(couplings.entities()[i]);
+    if (!body) continue;
+    c.startVelocity = c.halfVelocity = body->v;
+    c.startL = c.halfL = body->L;
+    c.startPosition = body->x;
+    c.startOrientation = body->orientation;
+    c.started = true;
+  }
+  const bool stokes = world.settings().fluid.advection == FluidSolverSettings::Advection::None;
+  if (stokes || !fsiSolverOf(world).halfStep) return;
+
+  auto& grids = world.template pool<MacGrid<d>>();
+  MacGrid<d>& grid = grids.components()[0];
+  const Entity fluidEntity = grids.entities()[0];
+  const double rho = fluidDensity(world, fluidEntity), mu = fluidViscosity(world, fluidEntity);
+  RigidCouplingSetup<d> setup = buildRigidCoupling(world, grid, mu > 0);
+  // u^ = u^n + dt/2 g on the free faces (step 2).
+  Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(grid.u.data(), grid.u.size());
+  const Eigen::Matrix<double, d, 1> g = world.settings().gravity;
+  for (int f = 0; f < setup.domain.layout.totalFaces(); ++f)
+    if (setup.domain.faces[f] == solvers::FaceKind::Free && !insideStructure(setup.domain, f))
+      u[f] += 0.5 * ctx.dt * g[setup.domain.layout.faceCoord(f).first];
+  std::unique_ptr<solvers::FluidOperators<d>> ops;
+  const solvers::FsiReport report = coupledSolve(world, setup, rho, mu, 0.5 * ctx.dt, u, ops);
+  for (std::size_t b = 0; b < setup.bodies.size(); ++b) {
+    RigidBody<d>& body = *world.template get<RigidBody<d>>(setup.bodies[b]);
+    writeBody(body, setup.coupling.velocity, static_cast<int>(b));
+    FluidCoupling<d>& c = *world.template get<FluidCoupling<d>>(setup.bodies[b]);
+    c.halfVelocity = body.v;
+    c.halfL = body.L;
+  }
+  ctx.diagnostics.set("fsi_half_step_iterations", report.solve.iterations);
+  ctx.diagnostics.set("fsi_half_step_energy_change", report.kineticEnergyAfter - report.kineticEnergyBefore);
+}
+
+template <int d>
+void FluidStructureProjection<d>::run(World<d>& world, StepContext& ctx) {
+  const bool stokes = world.settings().fluid.advection == FluidSolverSettings::Advection::None;
+  auto& couplings = world.template pool<FluidCoupling<d>>();
+  // v* = v^n + dt/2 (a^n + a^{n+1}) (step 5): the start velocity plus what the rigid stages added
+  // after the half-step solve.
+  for (std::size_t i = 0; i < couplings.size(); ++i) {
+    FluidCoupling<d>& c = couplings.components()[i];
+    RigidBody<d>* body = world.template get<RigidBody<d>>(couplings.entities()[i]);
+    if (!body || !c.started) continue;
+    if (stokes) {
+      body->x = c.startPosition;
+      body->orientation = c.startOrientation;
+    }
+    body->v = c.startVelocity + (body->v - c.halfVelocity);
+    body->L = c.startL + (body->L - c.halfL);
+    c.started = false;
+  }
+
+  auto& grids = world.template pool<MacGrid<d>>();
+  MacGrid<d>& grid = grids.components()[0];
+  const Entity fluidEntity = grids.entities()[0];
+  const double rho = fluidDensity(world, fluidEntity), mu = fluidViscosity(world, fluidEntity);
+  RigidCouplingSetup<d> setup = buildRigidCoupling(world, grid, mu > 0);
+  Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(grid.u.data(), grid.u.size());
+  // fluid_gravity added dt g on every face of the grid; take it off the faces inside the bodies.
+  const Eigen::Matrix<double, d, 1> g = world.settings().gravity;
+  if (world.template count<MacGrid<d>>() > 0 && g.squaredNorm() > 0)
+    for (int f = 0; f < setup.domain.layout.totalFaces(); ++f)
+      if (insideStructure(setup.domain, f)) u[f] -= ctx.dt * g[setup.domain.layout.faceCoord(f).first];
+  std::unique_ptr<solvers::FluidOperators<d>> ops;
+  const solvers::FsiReport report = coupledSolve(world, setup, rho, mu, ctx.dt, u, ops);
+  const auto& layout = setup.domain.layout;
+  const int ndof = d + kAngular(d);
+  for (std::size_t b = 0; b < setup.bodies.size(); ++b)
+    writeBody(*world.template get<RigidBody<d>>(setup.bodies[b]), setup.coupling.velocity, static_cast<int>(b));
+  // Faces inside the bodies that are no unknowns carry the body's velocity (what advection and
+  // the next step's u^n see there, as for an obstacle's faces).
+  for (int f = 0; f < layout.totalFaces(); ++f) {
+    if (setup.domain.faces[f] != solvers::FaceKind::Inactive) continue;
+    int body = -1;
+    for (int which = 0; which < 2 && body < 0; ++which) {
+      int cell = -1;
+      if (setup.domain.faceCell(f, which, cell)) body = setup.cellBody[cell];
+    }
+    if (body < 0) continue;
+    const auto [axis, fc] = layout.faceCoord(f);
+    const Eigen::Matrix<double, d, 1> r = layout.faceCenter(axis, fc) - world.template get<RigidBody<d>>(setup.bodies[body])->x;
+    const Eigen::VectorXd& v = setup.coupling.velocity;
+    double w = v[body * ndof + axis];
+    if constexpr (d == 2) {
+      w += (axis == 0 ? -r.y() : r.x()) * v[body * ndof + 2];
+    } else {
+      Eigen::Vector3d omega = v.segment<3>(body * ndof + 3);
+      w += omega.cross(Eigen::Vector3d(r))[axis];
+    }
+    u[f] = w;
+  }
+  Eigen::Map<Eigen::VectorXd>(grid.u.data(), grid.u.size()) = u;
+  for (std::size_t i = 0; i < grid.p.size(); ++i) grid.p[i] = report.pressure[static_cast<Eigen::Index>(i)];
+
+  // Diagnostics of t^{n+1}: the fluid's (as project_fluid reports them) and the bodies'.
+  auto& out = ctx.diagnostics;
+  const Eigen::VectorXd divergence = solvers::constraintDivergence(*ops, u);
+  double kinetic = 0, change = 0;
+  Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
+  const double faceMass = rho * layout.cellVolume();
+  for (int f = 0; f < layout.totalFaces(); ++f) {
+    if (setup.domain.faces[f] == solvers::FaceKind::Inactive || setup.domain.structureFace[f]) continue;
+    kinetic += 0.5 * faceMass * u[f] * u[f];
+    momentum[layout.faceCoord(f).first] += faceMass * u[f];
+    change = std::max(change, std::abs(u[f] - grid.uPrevious[f]));
+  }
+  grid.uPrevious = grid.u;
+  out.add("kinetic_energy", kinetic);
+  out.add("total_energy", kinetic);
+  out.add("linear_momentum_x", momentum.x());
+  out.add("linear_momentum_y", momentum.y());
+  out.add("linear_momentum_z", momentum.z());
+  out.set("fluid_kinetic_energy", kinetic);
+  out.set("fluid_solver_iterations", report.solve.iterations);
+  out.set("fluid_solver_relative_residual", report.solve.relativeResidual());
+  out.set("fluid_divergence_max", (divergence.size() > 0 ? divergence.cwiseAbs().maxCoeff() : 0.0) / layout.cellVolume());
+  out.set("fluid_velocity_change", change / ctx.dt);
+  out.set("fluid_cfl", u.cwiseAbs().maxCoeff() * ctx.dt / layout.dx);
+  out.set("fsi_solver_iterations", report.solve.iterations);
+  out.set("fsi_energy_change", report.kineticEnergyAfter - report.kineticEnergyBefore);
+  out.set("fsi_coupling_faces", setup.coupling.constraintCount());
+  static const char* axes[3] = {"_x", "_y", "_z"};
+  for (std::size_t b = 0; b < setup.bodies.size(); ++b) {
+    const std::string prefix = "fsi_" + world.name(setup.bodies[b]);
+    const int off = static_cast<int>(b) * ndof;
+    const Eigen::VectorXd& v = setup.coupling.velocity;
+    // The fluid's impulse on the body is -J^T W^T lambda (eq. 5.11).
+    const Eigen::VectorXd force = -report.structureImpulse.segment(off, ndof) / ctx.dt;
+    for (int a = 0; a < d; ++a) {
+      out.set(prefix + "_velocity" + axes[a], v[off + a]);
+      out.set(prefix + "_force" + axes[a], force[a]);
+    }
+    if constexpr (d == 2) {
+      out.set(prefix + "_angular_velocity_z", v[off + 2]);
+      out.set(prefix + "_torque_z", force[2]);
+    } else {
+      for (int a = 0; a < 3; ++a) {
+        out.set(prefix + "_angular_velocity" + axes[a], v[off + 3 + a]);
+        out.set(prefix + "_torque" + axes[a], force[3 + a]);
+      }
+    }
+  }
+}
+
+template <int d>
+double FluidStructureProjection<d>::unitCflDt(const World<d>& world) const {
+  const auto* grids = world.template findPool<MacGrid<d>>();
+  const auto* couplings = world.template findPool<FluidCoupling<d>>();
+  if (!grids || grids->size() == 0 || !couplings) return std::numeric_limits<double>::infinity();
+  const double dx = grids->components()[0].dx;
+  double speed = 0;
+  for (Entity e : couplings->entities()) {
+    const RigidBody<d>* body = world.template get<RigidBody<d>>(e);
+    const Shape<d>* shape = world.template get<Shape<d>>(e);
+    if (!body) continue;
+    double reach = 0;
+    if (shape) reach = ObstacleGeometry<d>(shape, world.template get<LevelSet<d>>(e), *body).boundingRadius();
+    speed = std::max(speed, body->v.norm() + body->omega().norm() * reach);
+  }
+  return speed > 0 ? dx / speed : std::numeric_limits<double>::infinity();
+}
+
+template RigidCouplingSetup<2> buildRigidCoupling<2>(const World<2>&, const MacGrid<2>&, bool);
+template RigidCouplingSetup<3> buildRigidCoupling<3>(const World<3>&, const MacGrid<3>&, bool);
+template class FsiHalfStep<2>;
+template class FsiHalfStep<3>;
+template class FluidStructureProjection<2>;
+template class FluidStructureProjection<3>;
+
+}  // namespace monolith

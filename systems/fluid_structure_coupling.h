@@ -1,0 +1,75 @@
+#pragma once
+// Two-way coupling of dynamic rigid bodies (fluid_coupling) with the scene's MAC grid fluid in one
+// SPD solve (thesis Sec. 5.4-5.8, eq. 5.30; solvers/fluid/fsi_system.h). The FSI time step of
+// Sec. 5.4 maps onto the pipeline as:
+//   1. v^* = v^n + dt/2 a(x^n)        advance_rigid_velocity_half (Step I of the rigid pipeline)
+//   2-3. fsi_half_step (Stage I, after it): u^ = u^n + dt/2 g and the coupled solve over dt/2 at
+//        x^n; its structure velocity v^{n+1/2} replaces the body's velocity, its fluid is discarded
+//   4. x^{n+1} = x^n + dt v^{n+1/2}    advance_rigid_positions (Step IV)
+//   5. v^* = v^n + dt/2 (a(x^n) + a(x^{n+1}))   advance_rigid_velocity (Step V) + what fsi_half_step kept
+//   6. u^* = u^n - dt (u.grad)u + dt g          advect_fluid, fluid_gravity
+//   7. project_fluid_structure (Step V): the coupled solve at x^{n+1} gives u^{n+1}, v^{n+1}.
+// Without the half step (fsi_solver "half_step": false) step 4 moves the body with the rigid
+// pipeline's v^n + dt/2 a. In Stokes flow (advection "none") the structure is not advected
+// (Sec. 5.7): its pose stays at x^n.
+//
+// The structure cells are the cells whose centres lie inside a coupled body (staircase, Sec.
+// 5.4.1); the coupling faces and J = N J_hat R are built afresh at every solve from the bodies'
+// poses (solvers/fluid/structure_coupling.h). Reports per coupled body (entity name N):
+// fsi_N_velocity_x/_y(/_z), fsi_N_angular_velocity(_z or _x/_y/_z), and the fluid's force and
+// torque on it from the coupling impulses, fsi_N_force_x/... = -(J^T W^T lambda)/dt; and per
+// step fsi_solver_iterations, fsi_half_step_iterations, fsi_energy_change (kinetic energy after
+// minus before the full solve, <= 0 up to rounding, Sec. 5.8), fsi_half_step_energy_change.
+#include "components/fluid_coupling.h"
+#include "components/mac_grid.h"
+#include "ecs/system.h"
+#include "solvers/fluid/fsi_system.h"
+
+namespace monolith {
+
+// The structure part of one coupled solve, built at the bodies' current poses.
+template <int d>
+struct RigidCouplingSetup {
+  solvers::FluidDomain<d> domain;       // the grid's domain with the structure cells marked
+  solvers::StructureCoupling coupling;  // W, J, M, M^-1, v (3 or 6 dofs per body, in `bodies` order)
+  std::vector<Entity> bodies;
+  std::vector<int> cellBody;            // per cell: index into bodies, -1 outside every body
+};
+
+// Builds the setup for `grid` from every entity with fluid_coupling, rigid_body and shape. The
+// structure velocity is read from the bodies (v, w = I^-1 L). `viscous`: the fluid has viscosity.
+template <int d>
+RigidCouplingSetup<d> buildRigidCoupling(const World<d>& world, const MacGrid<d>& grid, bool viscous);
+
+template <int d>
+class FsiHalfStep final : public System<d> {
+ public:
+  std::string name() const override { return "fsi_half_step"; }
+  Stage stage() const override { return Stage::AdvanceVelocityHalf; }
+  std::vector<std::string> reads() const override { return {MacGrid<d>::kName, FluidMaterial::kName}; }
+  std::vector<std::string> writes() const override {
+    return {RigidBody<d>::kName, FluidCoupling<d>::kName, "diagnostics"};
+  }
+  bool needed(const World<d>& w) const override {
+    return w.template count<MacGrid<d>>() > 0 && w.template count<FluidCoupling<d>>() > 0;
+  }
+  void run(World<d>& world, StepContext& ctx) override;
+};
+
+template <int d>
+class FluidStructureProjection final : public System<d> {
+ public:
+  std::string name() const override { return "project_fluid_structure"; }
+  Stage stage() const override { return Stage::AdvanceVelocity; }
+  std::vector<std::string> reads() const override { return {FluidMaterial::kName}; }
+  std::vector<std::string> writes() const override {
+    return {MacGrid<d>::kName, RigidBody<d>::kName, FluidCoupling<d>::kName, "diagnostics"};
+  }
+  bool needed(const World<d>& w) const override {
+    return w.template count<MacGrid<d>>() > 0 && w.template count<FluidCoupling<d>>() > 0;
+  }
+  void run(World<d>& world, StepContext& ctx) override;
+  double unitCflDt(const World<d>& world) const override;  // dx / fastest coupled body point
+};
+
+}  // namespace monolith
