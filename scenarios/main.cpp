@@ -19,7 +19,7 @@ namespace {
 const char* kUsage =
     "usage:\n"
     "  monolith run SCENE [--out DIR] [--threads N] [--set key=value]... [--checkpoint-every K]\n"
-    "                     [--plugin NAME|PATH]... [--no-frames] [--quiet]\n"
+    "                     [--plugin NAME|PATH]... [--no-frames] [--quiet] [--check]\n"
     "  monolith resume CHECKPOINT [--out DIR] [--threads N] [--set time.KEY=value]... [--checkpoint-every K]\n"
     "                            [--plugin NAME|PATH]... [--quiet]\n"
     "  monolith validate SCENE [--set key=value]... [--plugin NAME|PATH]...\n"
@@ -27,13 +27,14 @@ const char* kUsage =
     "  monolith systems [--plugin NAME|PATH]...   list component and system types\n"
     "  monolith version\n"
     "exit codes: 0 ok, 1 runtime/I-O failure, 2 bad command line, 3 scene/plugin/checkpoint rejected,\n"
-    "            4 simulation unstable (stopped by the blow-up guard)\n";
+    "            4 simulation unstable (stopped by the blow-up guard), 5 a scene check failed (run --check)\n";
 
 struct Args {
   std::string command, target;
   RunOptions run;
   std::vector<Override> overrides;
   std::vector<std::string> plugins;
+  bool check = false;  // a failed scene check is exit code 5
 };
 
 [[noreturn]] void usageError(const std::string& message) {
@@ -67,6 +68,7 @@ Args parseArgs(int argc, char** argv) {
     else if (arg == "--plugin") a.plugins.push_back(value());
     else if (arg == "--no-frames") a.run.writeFrames = false;
     else if (arg == "--quiet") a.run.progress = false;
+    else if (arg == "--check") a.check = true;
     else if (arg == "--set") {
       const std::string kv = value();
       const auto eq = kv.find('=');
@@ -181,5 +183,10 @@ int main(int argc, char** argv) {
     return r.exitCode;
   }
   std::printf("run written to %s (%ld steps, %.3f s of stepping)\n", r.outDir.c_str(), r.stepsCompleted, r.wallSeconds);
+  std::printf("%s", formatChecks(r.checks).c_str());
+  if (args.check && !r.checksPass()) {
+    std::fprintf(stderr, "monolith: a check failed\n");
+    return kExitCheckFailed;
+  }
   return kExitOk;
 }

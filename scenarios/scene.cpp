@@ -1,4 +1,5 @@
 #include "scenarios/scene.h"
+#include "scenarios/checks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -131,6 +132,17 @@ class DuplicateKeyCheck {
 };
 
 Json parseOverrideValue(const std::string& value) {
+  // A fraction of two numbers ("1/30") is that number: steps are naturally written so.
+  const auto slash = value.find('/');
+  if (slash != std::string::npos && slash > 0 && value.find('/', slash + 1) == std::string::npos) {
+    try {
+      std::size_t n = 0, m = 0;
+      const std::string a = value.substr(0, slash), b = value.substr(slash + 1);
+      const double num = std::stod(a, &n), den = std::stod(b, &m);
+      if (n == a.size() && m == b.size() && den != 0 && std::isfinite(num / den)) return Json(num / den);
+    } catch (const std::exception&) {
+    }
+  }
   try {
     return Json::parse(value);
   } catch (const Json::parse_error&) {
@@ -358,6 +370,8 @@ SceneSpec parseScene(const std::string& text, const std::string& file, const std
   top.markUsed("gravity");
   top.markUsed("solvers");
   top.markUsed("entities");
+  top.markUsed("checks");
+  parseChecks(s.json, file, s.dimension);  // validated here, evaluated by the run (checks.h)
   if (!s.json.contains("entities")) top.failAt("entities", "an array of entities (required key is missing)", "");
   if (!s.json["entities"].is_array()) top.failAt("entities", "an array of entities", describeJson(s.json["entities"]));
   top.finish();
