@@ -155,6 +155,12 @@ void applyOverride(Json& root, const Override& o, const std::string& file) {
   std::stringstream ss(o.first);
   for (std::string part; std::getline(ss, part, '.');) parts.push_back(part);
   if (parts.empty() || o.first.empty()) throw SceneError(file, "--set " + o.first, "key=value with a non-empty key", "");
+  // The length of a run is given once: "--set time.end" replaces the scene's "steps" and
+  // "--set time.steps" its "end" (so a sweep over dt can keep the simulated time fixed).
+  if (o.first == "time.end" || o.first == "time.steps") {
+    Json* time = root.is_object() && root.contains("time") && root["time"].is_object() ? &root["time"] : nullptr;
+    if (time) time->erase(o.first == "time.end" ? "steps" : "end");
+  }
   Json* node = &root;
   std::string path;
   for (std::size_t i = 0; i < parts.size(); ++i) {
