@@ -194,7 +194,24 @@ int benchCommand(int argc, char** argv) {
 
 }  // namespace
 
+#ifndef MONOLITH_SOURCE_TREE
+#define MONOLITH_SOURCE_TREE "."
+#endif
+
+// `monolith plot ...`: hands the arguments to scenarios/plot.py (Debian's python3-matplotlib).
+int plotCommand(int argc, char** argv) {
+  const char* env = std::getenv("MONOLITH_PLOT_SCRIPT");
+  const std::string script = env ? env : std::string(MONOLITH_SOURCE_TREE) + "/scenarios/plot.py";
+  std::vector<char*> args = {const_cast<char*>("/usr/bin/python3"), const_cast<char*>(script.c_str())};
+  for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
+  args.push_back(nullptr);
+  execv("/usr/bin/python3", args.data());
+  std::fprintf(stderr, "monolith: plot needs /usr/bin/python3 with matplotlib (apt-get install python3-matplotlib)\n");
+  return kExitFailure;
+}
+
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::strcmp(argv[1], "plot") == 0) return plotCommand(argc, argv);
   if (argc >= 2 && std::strcmp(argv[1], "sweep") == 0) return sweepCommand(argc, argv);
   if (argc >= 2 && std::strcmp(argv[1], "bench") == 0) return benchCommand(argc, argv);
   const Args args = parseArgs(argc, argv);
