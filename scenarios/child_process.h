@@ -20,7 +20,7 @@ inline Json readJson(const std::string& path) {
   std::ifstream in(path);
   if (!in) return Json();
   try {
-    return Json::parse(in);
+    return Json::parse(in, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
   } catch (const std::exception&) {
     return Json();
   }
