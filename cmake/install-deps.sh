@@ -10,6 +10,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libbullet-dev libbox2d-dev
   python3 python3-vtk9 python3-matplotlib
+  slurm-wlm munge
 )
 missing=()
 for p in "${PACKAGES[@]}"; do
