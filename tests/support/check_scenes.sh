@@ -14,7 +14,7 @@ for scene in scenarios/scenes/*.json; do
   start=$(date +%s.%N)
   "$build/monolith" run "$scene" --out "$out/$name" --quiet --no-frames --check > "$out.$name.log" 2>&1
   rc=$?
-  printf '%-24s exit %d  %6.1f s\n' "$name" "$rc" "$(echo "$(date +%s.%N) - $start" | bc)"
+  printf '%-24s exit %d  %6.1f s\n' "$name" "$rc" "$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { print b - a }')"
   grep '^check ' "$out.$name.log" | sed 's/^/    /'
   [ "$rc" -eq 0 ] || failed=1
 done

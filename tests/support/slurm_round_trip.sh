@@ -50,7 +50,7 @@ CONF
 export SLURM_CONF=$conf
 
 started_munge=""
-if ! pgrep -x munged >/dev/null; then
+if ! { [ -f /run/munge/munged.pid ] && kill -0 "$(cat /run/munge/munged.pid)" 2>/dev/null; }; then
   mkdir -p /run/munge /var/log/munge /var/lib/munge
   chown munge:munge /run/munge /var/log/munge /var/lib/munge 2>/dev/null || true
   runuser -u munge -- /usr/sbin/munged
@@ -66,18 +66,24 @@ stop() {
 trap stop EXIT
 slurmctld -f "$conf"
 slurmd -f "$conf"
+up=""
 for _ in $(seq 1 60); do
-  sinfo -h -o %T 2>/dev/null | grep -q idle && break
+  if sinfo -h -o %T 2>/dev/null | grep -q idle; then up=yes; break; fi
   sleep 0.5
 done
+if [ -z "$up" ]; then  # the machine cannot run the daemons (e.g. a restricted container)
+  echo "skipped: the single-node Slurm did not come up in 30 s"
+  tail -5 "$scratch/slurmctld.log" "$scratch/slurmd.log" 2>/dev/null || true
+  exit 77
+fi
 sinfo -h -o "%P %T %c" || true
 
 sweep=("$scenes/spin_sliver.json" --vary time.dt=1/30,1/60 --vary solvers.rigid_rotation.order=1,2,3 --set time.end=1)
 "$monolith" sweep "${sweep[@]}" --out "$scratch/local" 2>/dev/null
 "$monolith" sweep "${sweep[@]}" --out "$scratch/cluster" --emit-slurm
-start=$(date +%s.%N)
-sbatch --wait --chdir="$scratch" "$scratch/cluster/sweep.slurm"
-echo "array job done in $(echo "$(date +%s.%N) - $start" | bc) s"
+start=$SECONDS
+timeout 200 sbatch --wait --chdir="$scratch" "$scratch/cluster/sweep.slurm"
+echo "array job done in $((SECONDS - start)) s"
 "$monolith" sweep --collect "$scratch/cluster"
 # Compare every column but the timings.
 columns() { cut -d, -f1-7,10- "$1"; }
