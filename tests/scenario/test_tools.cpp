@@ -298,3 +298,34 @@ TEST(Plot, RunDirectoryAndSweepFrontArePngs) {
   EXPECT_NE(bad.exitCode, 0);
   EXPECT_TRUE(contains(bad.err, "no column 'no_such_column'")) << bad.err;
 }
+
+TEST(Checks, ProbeAndProfileChecksSampleTheFluid) {
+  // A uniform stream in a doubly periodic box stays uniform (to rounding): the probe reads u = 1
+  // and the profile v = 0.5 everywhere; a wrong reference (u = 2) fails with error 1.
+  TempDir tmp;
+  const fs::path scene = tmp.path() / "stream.json";
+  writeFile(scene, R"({"dimension": 2, "time": {"dt": 0.05, "steps": 4},
+    "entities": [{"name": "fluid",
+      "mac_grid": {"cells": [16, 16], "domain_min": [0, 0], "domain_max": [1, 1],
+                   "boundaries": {"x_min": {"type": "periodic"}, "x_max": {"type": "periodic"},
+                                  "y_min": {"type": "periodic"}, "y_max": {"type": "periodic"}},
+                   "initial_velocity": {"type": "uniform", "velocity": [1, 0.5]}},
+      "fluid_material": {"density": 1, "viscosity": 0.01}}],
+    "checks": [
+      {"name": "probe_u", "kind": "probe", "position": [0.3, 0.7], "field": "u", "reference": 1, "tolerance": 1e-9},
+      {"name": "profile_v", "kind": "profile", "field": "v", "from": [0.1, 0.5], "to": [0.9, 0.5], "points": 9,
+       "reference": [0.5], "norm": "max", "tolerance": 1e-9},
+      {"name": "probe_wrong", "kind": "probe", "position": [0.3, 0.7], "field": "u", "reference": 2, "tolerance": 1e-9}
+    ]})");
+  const CommandResult r = run({MONOLITH_CLI, "run", scene.string(), "--out", (tmp.path() / "o").string(), "--quiet",
+                               "--no-frames", "--check"},
+                              tmp.logs());
+  EXPECT_EQ(r.exitCode, 5) << r.out << r.err;
+  const Json s = summaryOf(tmp.path() / "o");
+  ASSERT_EQ(s["checks"].size(), 3u);
+  EXPECT_TRUE(s["checks"][0]["pass"].get<bool>()) << s["checks"][0];
+  EXPECT_NEAR(s["checks"][0]["value"].get<double>(), 1.0, 1e-9);
+  EXPECT_TRUE(s["checks"][1]["pass"].get<bool>()) << s["checks"][1];
+  EXPECT_FALSE(s["checks"][2]["pass"].get<bool>());
+  EXPECT_NEAR(s["checks"][2]["error"].get<double>(), 1.0, 1e-9);
+}
