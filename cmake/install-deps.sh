@@ -9,7 +9,8 @@ PACKAGES=(
   libeigen3-dev libtbb-dev libfcl-dev libccd-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libbullet-dev libbox2d-dev
-  python3 python3-vtk9
+  python3 python3-vtk9 python3-matplotlib
+  slurm-wlm munge
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

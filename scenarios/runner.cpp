@@ -76,7 +76,7 @@ class Run {
   std::string checkpointPath(long step) const;
   bool guard(long step, std::string& diagnosis) const;
   void writeSummary(const std::string& status, const std::string& diagnosis, long stepsDone,
-                    const std::map<std::string, double>& finalDiagnostics);
+                    const std::map<std::string, double>& finalDiagnostics, const std::vector<CheckResult>& checks = {});
 
   const SceneSpec& scene_;
   Registry& registry_;
@@ -162,7 +162,8 @@ bool Run<d>::guard(long step, std::string& diagnosis) const {
 
 template <int d>
 void Run<d>::writeSummary(const std::string& status, const std::string& diagnosis, long stepsDone,
-                          const std::map<std::string, double>& finalDiagnostics) {
+                          const std::map<std::string, double>& finalDiagnostics,
+                          const std::vector<CheckResult>& checks) {
   Json s;
   s["scene"] = scene_.file;
   s["description"] = scene_.description;
@@ -181,6 +182,7 @@ void Run<d>::writeSummary(const std::string& status, const std::string& diagnosi
   Json finals = Json::object();
   for (const auto& [k, v] : finalDiagnostics) finals[k] = std::isfinite(v) ? Json(v) : Json(std::to_string(v));
   s["final_diagnostics"] = finals;
+  if (!checks.empty()) s["checks"] = checksToJson(checks);
   Json systems = Json::array();
   for (const auto* sys : sim_->scheduler().systems()) systems.push_back({{"name", sys->name()}, {"stage", stageName(sys->stage())}});
   s["systems"] = systems;
@@ -230,6 +232,7 @@ RunResult Run<d>::execute() {
   }
 
   setUpFrameSeries();
+  CheckEvaluator<d> checks(parseChecks(scene_.json, scene_.file, d), world(), scene_.file, sim_->time());
   probes_ = std::make_unique<FluidProbeWriter<d>>(scene_, world(), outDir_, resume_ ? firstStep : -1);
   MetricsWriter metrics(outDir_ + "/metrics.csv", resume_ ? firstStep : -1);
   if (!resume_) writeFrame(0);
@@ -278,7 +281,9 @@ RunResult Run<d>::execute() {
       progress.finish("stopped: unstable");
       if (!lastGoodCheckpoint.empty()) diagnosis += "; last good checkpoint: " + lastGoodCheckpoint;
       else diagnosis += "; no checkpoint was written (use --checkpoint-every K)";
-      writeSummary("unstable", diagnosis, done, *diagnostics);
+      result.checks = checks.finish(world(), sim_->time());  // an unstable run's checks fail
+      for (auto& c : result.checks) c.pass = false;
+      writeSummary("unstable", diagnosis, done, *diagnostics, result.checks);
       result.exitCode = kExitUnstable;
       result.message = diagnosis;
       result.stepsCompleted = done;
@@ -286,6 +291,7 @@ RunResult Run<d>::execute() {
       return result;  // the bad state is neither framed nor checkpointed
     }
     if (diagnostics != &lastDiagnostics) lastDiagnostics = *diagnostics;
+    checks.observe(world(), *diagnostics, sim_->time());
     probes_->afterStep(world(), done, sim_->time());
     if (sim_->frameDue()) writeFrame(done);
     if (checkpointEvery > 0 && done % checkpointEvery == 0) {
@@ -306,7 +312,8 @@ RunResult Run<d>::execute() {
   progress.finish((converged ? "converged: " : "done: ") + std::to_string(sim_->stepsDone() - firstStep) + " steps");
   if (converged && sim_->frameDue() == false) writeFrame(sim_->stepsDone());  // the steady state itself
   probes_->frame(world(), sim_->stepsDone());  // profiles of the final state in any case
-  writeSummary(converged ? "converged" : "completed", "", sim_->stepsDone(), lastDiagnostics);
+  result.checks = checks.finish(world(), sim_->time());
+  writeSummary(converged ? "converged" : "completed", "", sim_->stepsDone(), lastDiagnostics, result.checks);
   result.stepsCompleted = sim_->stepsDone();
   result.stateHash = stateHash(world());
   result.wallSeconds = wallTotal_;

@@ -8,6 +8,7 @@
 
 #include "ecs/plugin.h"
 #include "ecs/registry.h"
+#include "scenarios/checks.h"
 #include "scenarios/scene.h"
 
 namespace monolith {
@@ -19,6 +20,7 @@ enum ExitCode : int {
   kExitUsage = 2,        // bad command line
   kExitInvalidScene = 3, // scene, plugin or checkpoint rejected before simulating
   kExitUnstable = 4,     // the blow-up guard stopped the run
+  kExitCheckFailed = 5,  // run --check: the run completed but a scene check failed
 };
 
 struct RunOptions {
@@ -36,6 +38,12 @@ struct RunResult {
   long stepsCompleted = 0;
   std::uint64_t stateHash = 0;
   double wallSeconds = 0;
+  std::vector<CheckResult> checks;  // the scene's checks, evaluated at the end
+  bool checksPass() const {
+    for (const auto& c : checks)
+      if (!c.pass) return false;
+    return true;
+  }
 };
 
 RunResult runScene(const SceneSpec& scene, Registry& registry, PluginLoader& plugins, const RunOptions& options);

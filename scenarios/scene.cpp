@@ -1,4 +1,5 @@
 #include "scenarios/scene.h"
+#include "scenarios/checks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -132,6 +133,17 @@ class DuplicateKeyCheck {
 };
 
 Json parseOverrideValue(const std::string& value) {
+  // A fraction of two numbers ("1/30") is that number: steps are naturally written so.
+  const auto slash = value.find('/');
+  if (slash != std::string::npos && slash > 0 && value.find('/', slash + 1) == std::string::npos) {
+    try {
+      std::size_t n = 0, m = 0;
+      const std::string a = value.substr(0, slash), b = value.substr(slash + 1);
+      const double num = std::stod(a, &n), den = std::stod(b, &m);
+      if (n == a.size() && m == b.size() && den != 0 && std::isfinite(num / den)) return Json(num / den);
+    } catch (const std::exception&) {
+    }
+  }
   try {
     return Json::parse(value);
   } catch (const Json::parse_error&) {
@@ -144,6 +156,12 @@ void applyOverride(Json& root, const Override& o, const std::string& file) {
   std::stringstream ss(o.first);
   for (std::string part; std::getline(ss, part, '.');) parts.push_back(part);
   if (parts.empty() || o.first.empty()) throw SceneError(file, "--set " + o.first, "key=value with a non-empty key", "");
+  // The length of a run is given once: "--set time.end" replaces the scene's "steps" and
+  // "--set time.steps" its "end" (so a sweep over dt can keep the simulated time fixed).
+  if (o.first == "time.end" || o.first == "time.steps") {
+    Json* time = root.is_object() && root.contains("time") && root["time"].is_object() ? &root["time"] : nullptr;
+    if (time) time->erase(o.first == "time.end" ? "steps" : "end");
+  }
   Json* node = &root;
   std::string path;
   for (std::size_t i = 0; i < parts.size(); ++i) {
@@ -359,6 +377,8 @@ SceneSpec parseScene(const std::string& text, const std::string& file, const std
   top.markUsed("gravity");
   top.markUsed("solvers");
   top.markUsed("entities");
+  top.markUsed("checks");
+  parseChecks(s.json, file, s.dimension);  // validated here, evaluated by the run (checks.h)
   if (!s.json.contains("entities")) top.failAt("entities", "an array of entities (required key is missing)", "");
   if (!s.json["entities"].is_array()) top.failAt("entities", "an array of entities", describeJson(s.json["entities"]));
   top.finish();

@@ -89,7 +89,7 @@ struct Body {
 
 // Builds the scene's bodies in `world`; returns them in entity order.
 std::vector<Body> load(const Options& o, const json& root, b2World& world) {
-  refuseOtherKeys(root, {"description", "dimension", "time", "gravity", "entities", "solvers"}, o.scene + ":",
+  refuseOtherKeys(root, {"description", "dimension", "time", "gravity", "entities", "solvers", "checks"}, o.scene + ":",
                   "Box2D");
   if (root.value("dimension", 3) != 2) fail(o.scene + ": dimension: only 2-D scenes run in Box2D");
   if (root.contains("gravity")) world.SetGravity(vec2(root["gravity"], o.scene + ": gravity"));

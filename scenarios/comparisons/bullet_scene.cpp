@@ -218,7 +218,7 @@ Scene load(const Options& o) {
   const json root = readSceneFile(o.scene);
   Scene s;
   // Monolith's own solver settings ("solvers") have no Bullet counterpart and are left out.
-  refuseOtherKeys(root, {"description", "dimension", "time", "gravity", "entities", "solvers"}, o.scene + ":",
+  refuseOtherKeys(root, {"description", "dimension", "time", "gravity", "entities", "solvers", "checks"}, o.scene + ":",
                   "Bullet");
   if (root.value("dimension", 3) != 3) fail(o.scene + ": dimension: only 3-D scenes run in Bullet here");
   if (root.contains("gravity")) s.gravity = vec3(root["gravity"], o.scene + ": gravity");

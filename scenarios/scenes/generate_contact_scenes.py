@@ -33,12 +33,14 @@ def ground(friction=0.5, restitution=0.0):
                 restitution=restitution)
 
 
-def write(directory, name, description, dt, end, entities, frame_rate=30, solvers=None, dimension=3):
+def write(directory, name, description, dt, end, entities, frame_rate=30, solvers=None, dimension=3, checks=None):
     scene = {"description": description, "dimension": dimension,
              "time": {"dt": dt, "end": end, "frame_rate": frame_rate},
              "gravity": [0, -9.81, 0][:dimension], "entities": entities}
     if solvers:
         scene["solvers"] = solvers
+    if checks:
+        scene["checks"] = checks
     entities = scene.pop("entities")
     with open(os.path.join(directory, name + ".json"), "w") as f:
         f.write(HEADER)
@@ -46,6 +48,15 @@ def write(directory, name, description, dt, end, entities, frame_rate=30, solver
         f.write(head[:-1] + ",\n \"entities\": [\n")
         f.write(",\n".join("  " + json.dumps(e, separators=(", ", ": ")) for e in entities))
         f.write("\n ]\n}\n")
+
+
+def pyramid_checks(layers):
+    """A pyramid stands: its top box moves less than 0.05 and all comes to rest (KE < 1e-3 J)."""
+    top = "box_%d_0" % (layers - 1)
+    return [{"name": "top_drift", "kind": "body", "body": top, "field": "displacement", "reference": 0,
+             "tolerance": 0.05},
+            {"name": "final_kinetic_energy", "kind": "diagnostic", "diagnostic": "kinetic_energy", "reference": 0,
+             "tolerance": 1e-3}]
 
 
 def pyramid(directory, layers):
@@ -58,7 +69,7 @@ def pyramid(directory, layers):
                                  position=(x, 0.5 + k, 0)))
     write(directory, "pyramid_%d" % layers,
           "pyramid of %d boxes in %d layers at one step per frame" % (len(entities) - 1, layers),
-          1 / 30, 10.0, entities)
+          1 / 30, 10.0, entities, checks=pyramid_checks(layers))
 
 
 def pyramid_2d(directory, layers):
@@ -71,7 +82,7 @@ def pyramid_2d(directory, layers):
                                  position=(x, 0.5 + k)))
     write(directory, "pyramid_2d_%d" % layers,
           "2-D pyramid of %d boxes in %d layers at one step per frame" % (len(entities) - 1, layers),
-          1 / 30, 10.0, entities, dimension=2)
+          1 / 30, 10.0, entities, dimension=2, checks=pyramid_checks(layers))
 
 
 def sliver_shards(directory):
