@@ -109,8 +109,10 @@ int remeshClosedFront(Front2& front, double minLength, double maxLength) {
   for (const auto& indices : loopsOf(front)) {
     std::vector<Eigen::Vector2d> x;
     for (int k : indices) x.push_back(front.points[k]);
-    // Split long segments with the third-order stencil (needs the neighbours on both sides).
-    for (std::size_t k = 0; k < x.size() && x.size() >= 4;) {
+    // Split long segments with the third-order stencil (needs the neighbours on both sides). On a
+    // wildly distorted loop the stencil need not shorten a segment: the splits are capped.
+    const std::size_t cap = 16 * x.size() + 64;
+    for (std::size_t k = 0; k < x.size() && x.size() >= 4 && x.size() < cap;) {
       const std::size_t n = x.size(), k1 = (k + 1) % n;
       if ((x[k1] - x[k]).norm() > maxLength) {
         const Eigen::Vector2d mid = -x[(k + n - 1) % n] / 16 + 9 * x[k] / 16 + 9 * x[k1] / 16 - x[(k + 2) % n] / 16;

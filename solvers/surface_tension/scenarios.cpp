@@ -173,10 +173,10 @@ RisingBubbleStability runRisingBubbleStability(int n, double dt, bool implicit, 
       r.reason = report.blowUpReason;
       break;
     }
-    if (r.areaChange > 0.5) {
+    if (r.areaChange > 0.2) {
       r.stable = false;
       r.reason = std::string(implicit ? "implicit" : "explicit") + " surface tension blew up at step " +
-                 std::to_string(state.step) + ": the bubble's area changed by more than half";
+                 std::to_string(state.step) + ": the bubble's area changed by more than 20 %";
       break;
     }
   }

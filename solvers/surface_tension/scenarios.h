@@ -44,7 +44,7 @@ OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTi
 
 // Sec. 6.4.4: [0, 1] x [0, 2] m with n x 2n cells, an air bubble (rho 1e3) of r = 0.2 m at (0.5, 0.5)
 // in water (rho 1e4), mu = 1, sigma = 0.5, g = -8e-4, semi-Lagrangian advection. `steps` steps of dt;
-// stable unless the blow-up guard (max speed above 0.1 m/s, or the bubble's area changing by half)
+// stable unless the blow-up guard (max speed above 0.1 m/s, or the bubble's area changing by 20 %)
 // fires. The bubble rises at about 1e-3 m/s.
 struct RisingBubbleStability {
   bool stable = true;

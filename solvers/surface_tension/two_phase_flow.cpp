@@ -77,7 +77,7 @@ FrontOnGrid placeFront(const MacLayout<2>& layout, const Front2& front) {
     const Eigen::Vector2d ga = (a - layout.origin) / dx, gb = (b - layout.origin) / dx;
     std::vector<double> ts{0.0, 1.0};
     for (int axis = 0; axis < 2; ++axis) {
-      const double lo = std::min(ga[axis], gb[axis]), hi = std::max(ga[axis], gb[axis]);
+      const double lo = std::max(std::min(ga[axis], gb[axis]), 0.0), hi = std::min(std::max(ga[axis], gb[axis]), 1.0 * n[axis]);
       for (int line = static_cast<int>(std::ceil(lo)); line <= static_cast<int>(std::floor(hi)); ++line) {
         if (line < 0 || line > n[axis]) continue;
         const double A = ga[axis], B = gb[axis], L = line;
@@ -225,6 +225,18 @@ InterfaceDiscretization discretizeInterface(const MacLayout<2>& layout, const Fr
     g.emplace_back(q, D.insideDof[c], -l);
     if (two) g.emplace_back(q, D.outsideDof[c], l);
   }
+  // A phase part whose faces are all of roundoff length (a front through a cell corner) would
+  // put a ~1e-30 entry on the diagonal and break the Jacobi-preconditioned CG: such parts get no
+  // faces (their pressure unknown is left out of every row; its zero column is harmless).
+  {
+    std::vector<double> column(D.pressureCount, 0.0);
+    for (const auto& t : g) column[t.col()] += t.value() * t.value() / D.beta[t.row()];
+    const double full = 4.0 / std::max(rhoIn, rhoOut);  // a whole cell's G^T beta^-1 G diagonal
+    Triplets kept;
+    for (const auto& t : g)
+      if (column[t.col()] > 1e-12 * full) kept.push_back(t);
+    g.swap(kept);
+  }
   D.G.resize(nu, D.pressureCount);
   D.G.setFromTriplets(g.begin(), g.end());
 
@@ -348,6 +360,17 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
   TwoPhaseStepReport report;
   const MacLayout<2>& layout = state.layout;
   const double dx = layout.dx;
+  // The guard's second half: a front that left the domain (or is no longer finite) is not stepped.
+  const Eigen::Vector2d upper = layout.origin + dx * layout.cells.cast<double>();
+  for (const auto& x : state.front.points)
+    if (!x.allFinite() || (x.array() < layout.origin.array()).any() || (x.array() > upper.array()).any()) {
+      report.blewUp = true;
+      std::ostringstream why;
+      why << (settings.implicitSurfaceTension ? "implicit" : "explicit") << " surface tension blew up before step "
+          << state.step + 1 << " (t = " << state.time << "): the front left the domain";
+      report.blowUpReason = why.str();
+      return report;
+    }
   const InterfaceDiscretization D = discretizeInterface(layout, state.front, settings, dt);
   const int nu = D.unknowns(), np = D.pressureCount;
 
