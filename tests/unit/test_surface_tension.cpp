@@ -115,8 +115,11 @@ TEST(SurfaceTensionDiscretization, UniformFlowHasNoDivergenceInAnyCellPart) {
     for (int c = 0; c < layout.cellCount(); ++c) {
       const Eigen::Vector2i ci = layout.cellCoord(c);
       if (ci.minCoeff() == 0 || ci.maxCoeff() == 15) continue;
-      for (int dof : {D.insideDof[c], D.outsideDof[c]})
-        if (dof >= 0) EXPECT_NEAR(divergence[dof], 0.0, 1e-14) << "cell " << c;
+      for (int dof : {D.insideDof[c], D.outsideDof[c]}) {
+        if (dof >= 0) {
+          EXPECT_NEAR(divergence[dof], 0.0, 1e-14) << "cell " << c;
+        }
+      }
     }
   }
 }
