@@ -9,12 +9,14 @@
 #include "ecs/registry.h"
 #include "scenarios/contact_components.h"
 #include "scenarios/fluid_components.h"
+#include "scenarios/surface_tension_components.h"
 #include "systems/advance_positions.h"
 #include "systems/advance_velocity.h"
 #include "systems/rigid_diagnostics.h"
 #include "systems/fluid_advection.h"
 #include "systems/fluid_obstacles.h"
 #include "systems/fluid_projection.h"
+#include "systems/surface_tension_flow.h"
 #include "systems/kinematic_motion.h"
 #include "systems/rigid_contact.h"
 #include "systems/rigid_forces.h"
@@ -142,6 +144,7 @@ void registerDimension(Registry& r) {
   r.addComponentOf<d, RigidForces<d>>("(internal) force/torque accumulator of a dynamic rigid body", nullptr);
   registerContactComponents<d>(r);
   registerFluidComponents<d>(r);
+  registerSurfaceTensionComponents<d>(r);
 
   r.addSystem<d>({"clear_rigid_forces", "zero the force accumulators before each force evaluation",
                   [] { return atBothForceStages<ClearRigidForces<d>, d>(); }, ""});
@@ -174,6 +177,9 @@ void registerDimension(Registry& r) {
                   [] { return single<ObstacleForces<d>>(); }, ""});
   r.addSystem<d>({"rigid_diagnostics", "energies and momenta of the rigid bodies",
                   [] { return single<RigidDiagnostics<d>>(); }, ""});
+  r.addSystem<d>({"surface_tension_flow",
+                  "two-phase flow with implicit surface tension on a Lagrangian front (Ch. 6, eq. 6.33)",
+                  [] { return single<SurfaceTensionFlow<d>>(); }, ""});
 }
 
 }  // namespace
