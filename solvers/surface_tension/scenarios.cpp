@@ -184,4 +184,47 @@ RisingBubbleStability runRisingBubbleStability(int n, double dt, bool implicit, 
   return r;
 }
 
+double stabilityCapillaryDt(int n) {
+  const double dx = 0.04 / n;
+  return std::sqrt(1000 * dx * dx * dx / (4 * M_PI * 0.0728));
+}
+
+StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps) {
+  const double dx = 0.04 / n;
+  const Eigen::Vector2d centre(0.02, 0.02);
+  const int points = static_cast<int>(std::lround(2 * M_PI * 0.01 / dx));
+  Front2 front;
+  if (ellipse) {
+    std::vector<Eigen::Vector2d> x;
+    for (int k = 0; k < points; ++k) {
+      const double theta = (k + 0.5) * 2 * M_PI / points;
+      x.push_back(centre + Eigen::Vector2d(0.011 * std::cos(theta), 0.009 * std::sin(theta)));
+    }
+    front = closedPolyline(x);
+  } else {
+    front = perturbedCircle(centre, 0.01, 0, 0, points);
+  }
+  TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(n, n), dx), front);
+  TwoPhaseSettings settings;
+  settings.densityInside = 1000;
+  settings.onePhase = true;
+  settings.sigma = 0.0728;
+  settings.implicitSurfaceTension = implicit;
+  settings.blowUpSpeed = 1.0;
+  settings.solve.relativeTolerance = 1e-10;
+  const double area0 = enclosedArea(state.front);
+  StabilityCase r;
+  r.capillaryDt = stabilityCapillaryDt(n);
+  for (int i = 0; i < steps; ++i) {
+    const TwoPhaseStepReport report = advanceTwoPhase(state, settings, dt);
+    r.maxSpeed = std::max(r.maxSpeed, report.maxSpeed);
+    if (report.blewUp || std::abs(report.area / area0 - 1) > 0.2) {
+      r.stable = false;
+      break;
+    }
+  }
+  r.steps = state.step;
+  return r;
+}
+
 }  // namespace monolith::solvers

@@ -54,4 +54,16 @@ struct RisingBubbleStability {
 };
 RisingBubbleStability runRisingBubbleStability(int n, double dt, bool implicit, int steps);
 
+// Sec. 6.4.6 (Figs. 6.6/6.7): [0, 0.04]^2 m, a drop (one phase, rho = 1000, sigma = 0.0728, no
+// viscosity) of r = 0.01 m about the centre, or an ellipse of semi-axes 0.011 x 0.009 m; `steps`
+// steps of dt. Unstable when the guard fires (max speed above 1 m/s, about 12x the capillary
+// velocity sqrt(sigma / (rho r)), or the front leaving the domain) or the area drifts by 20 %.
+struct StabilityCase {
+  bool stable = true;
+  double capillaryDt = 0, maxSpeed = 0;
+  int steps = 0;
+};
+StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps);
+double stabilityCapillaryDt(int n);
+
 }  // namespace monolith::solvers

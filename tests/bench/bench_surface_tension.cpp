@@ -77,6 +77,32 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
       }
     }
+  } else if (mode == "stability_map") {
+    // Figs. 6.6/6.7: o stable for 500 steps, x unstable; rows dt as multiples of the explicit
+    // capillary limit at that dx, columns 1/dx.
+    const int steps = argc > 2 ? std::atoi(argv[2]) : 500;
+    const std::vector<int> ns{16, 32, 64};
+    const std::vector<double> multiples{0.5, 1, 2, 4, 8, 16, 32, 64, 128};
+    for (bool ellipse : {false, true})
+      for (bool implicit : {false, true}) {
+        const auto start = std::chrono::steady_clock::now();
+        std::printf("\n%s, front tracking, %s (%d steps)\n| dt / capillary dt |", ellipse ? "ellipse 0.011 x 0.009" : "circle r = 0.01",
+                    implicit ? "implicit" : "explicit", steps);
+        for (int n : ns) std::printf(" N=%d |", n);
+        std::printf("\n|---|");
+        for (std::size_t i = 0; i < ns.size(); ++i) std::printf("---|");
+        std::printf("\n");
+        for (double m : multiples) {
+          std::printf("| %g |", m);
+          for (int n : ns) {
+            const StabilityCase r = runStabilityCase(n, m * stabilityCapillaryDt(n), implicit, ellipse, steps);
+            std::printf(" %s |", r.stable ? "o" : "x");
+            std::fflush(stdout);
+          }
+          std::printf("\n");
+        }
+        std::printf("(wall %.1f s)\n", seconds(start));
+      }
   } else {
     std::fprintf(stderr, "unknown mode %s\n", mode.c_str());
     return 2;
