@@ -70,12 +70,19 @@ TwoPhaseSettings staticCircleSettings(bool onePhase, bool implicit) {
   return s;
 }
 
-StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double endTime) {
+StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double endTime, bool levelSet) {
   const double dx = 1.0 / n, dt = 0.2 * dx;
   const int points = static_cast<int>(std::lround(2 * M_PI * 0.25 / dx));
   TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(n, n), dx),
                                           perturbedCircle(Eigen::Vector2d(0.5, 0.5), 0.25, 0, 0, points));
-  const TwoPhaseSettings settings = staticCircleSettings(onePhase, implicit);
+  TwoPhaseSettings settings = staticCircleSettings(onePhase, implicit);
+  if (levelSet) {
+    settings.levelSetFront = true;
+    state.phi.resize(state.layout.cellCount());
+    for (int c = 0; c < state.layout.cellCount(); ++c)
+      state.phi[c] = (state.layout.cellCenter(state.layout.cellCoord(c)) - Eigen::Vector2d(0.5, 0.5)).norm() - 0.25;
+    state.front = frontFromLevelSet(state.layout, state.phi, CrossingOrder::Fourth);
+  }
   StaticCircleResult r;
   const int steps = static_cast<int>(std::lround(endTime / dt));
   TwoPhaseStepReport last;
@@ -189,7 +196,7 @@ double stabilityCapillaryDt(int n) {
   return std::sqrt(1000 * dx * dx * dx / (4 * M_PI * 0.0728));
 }
 
-StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps) {
+StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps, bool levelSet) {
   const double dx = 0.04 / n;
   const Eigen::Vector2d centre(0.02, 0.02);
   const int points = static_cast<int>(std::lround(2 * M_PI * 0.01 / dx));
@@ -212,6 +219,11 @@ StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, in
   settings.implicitSurfaceTension = implicit;
   settings.blowUpSpeed = 1.0;
   settings.solve.relativeTolerance = 1e-10;
+  if (levelSet) {
+    settings.levelSetFront = true;
+    state.phi = signedDistanceToFront(state.layout, state.front);
+    state.front = frontFromLevelSet(state.layout, state.phi, CrossingOrder::Fourth);
+  }
   const double area0 = enclosedArea(state.front);
   StabilityCase r;
   r.capillaryDt = stabilityCapillaryDt(n);

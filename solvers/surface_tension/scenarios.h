@@ -5,6 +5,7 @@
 #include <string>
 
 #include "solvers/surface_tension/level_set_front.h"
+#include "solvers/surface_tension/level_set_tracking.h"
 #include "solvers/surface_tension/two_phase_flow.h"
 
 namespace monolith::solvers {
@@ -27,7 +28,8 @@ struct StaticCircleResult {
   int steps = 0, lastIterations = 0;
   bool stable = true;
 };
-StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double endTime);
+// levelSet: the level-set-tracked front (level_set_tracking.h) from the circle's exact signed distance.
+StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double endTime, bool levelSet = false);
 TwoPhaseSettings staticCircleSettings(bool onePhase, bool implicit);
 
 // Sec. 6.4.3 / Table 6.4: [0, 1]^2, r = (1/3)(1 + eps cos 2 theta) about (0.5, 0.5), rho = 27,
@@ -63,7 +65,7 @@ struct StabilityCase {
   double capillaryDt = 0, maxSpeed = 0;
   int steps = 0;
 };
-StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps);
+StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps, bool levelSet = false);
 double stabilityCapillaryDt(int n);
 
 }  // namespace monolith::solvers

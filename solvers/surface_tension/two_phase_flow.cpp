@@ -8,6 +8,8 @@
 #include <stdexcept>
 
 #include "solvers/advection/semi_lagrangian.h"
+#include "solvers/surface_tension/level_set_front.h"
+#include "solvers/surface_tension/level_set_tracking.h"
 
 namespace monolith::solvers {
 
@@ -371,6 +373,11 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
       report.blowUpReason = why.str();
       return report;
     }
+  if (settings.levelSetFront) {
+    if (static_cast<int>(state.phi.size()) != layout.cellCount())
+      throw std::invalid_argument("advanceTwoPhase: a level-set front needs phi on every cell");
+    state.front = frontFromLevelSet(layout, state.phi, CrossingOrder::Fourth);
+  }
   const InterfaceDiscretization D = discretizeInterface(layout, state.front, settings, dt);
   const int nu = D.unknowns(), np = D.pressureCount;
 
@@ -446,9 +453,17 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
     state.pInside[c] = D.insideDof[c] >= 0 ? z[D.insideDof[c]] / dt : 0.0;
     state.pOutside[c] = D.outsideDof[c] >= 0 ? z[D.outsideDof[c]] / dt : 0.0;
   }
-  const Eigen::VectorXd v = D.Ht.transpose() * unew;  // H u^{n+1}
-  for (int k = 0; k < state.front.pointCount(); ++k) state.front.points[k] += dt * v.segment<2>(2 * k);
-  report.remeshChanges = remeshClosedFront(state.front, settings.minSegment * dx, settings.maxSegment * dx);
+  if (settings.levelSetFront) {
+    // The level set moves with the grid velocity; the mesh is rebuilt from it and it is
+    // redistanced to that mesh.
+    state.phi = advectCellField(layout, state.phi, state.u, dt);
+    state.front = frontFromLevelSet(layout, state.phi, CrossingOrder::Fourth);
+    redistanceToFront(layout, state.front, state.phi);
+  } else {
+    const Eigen::VectorXd v = D.Ht.transpose() * unew;  // H u^{n+1}
+    for (int k = 0; k < state.front.pointCount(); ++k) state.front.points[k] += dt * v.segment<2>(2 * k);
+    report.remeshChanges = remeshClosedFront(state.front, settings.minSegment * dx, settings.maxSegment * dx);
+  }
   state.time += dt;
   ++state.step;
 

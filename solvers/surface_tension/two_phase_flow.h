@@ -55,6 +55,9 @@ struct TwoPhaseSettings {
   double minSegment = 0.5, maxSegment = 1.5;  // remeshing bounds, in dx
   CgSettings solve{20000, 1e-12, 0};
   double blowUpSpeed = 1e3;  // the guard: a step whose max speed exceeds this (or is not finite) blew up
+  // Level-set-tracked front (level_set_tracking.h): the front is rebuilt from TwoPhaseState::phi
+  // each step and phi, not the points, is advected. Else front tracking.
+  bool levelSetFront = false;
 };
 
 struct TwoPhaseState {
@@ -62,6 +65,7 @@ struct TwoPhaseState {
   Eigen::VectorXd u;                  // grid face velocities (layout.faceIndex order)
   Front2 front;
   std::vector<double> pInside, pOutside;  // per cell: the phase's pressure (0 where it has none)
+  std::vector<double> phi;                // level-set-tracked fronts: signed distance per cell
   double time = 0;
   int step = 0;
 };

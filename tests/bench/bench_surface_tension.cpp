@@ -1,7 +1,7 @@
 // Surface tension on a Lagrangian front (thesis Ch. 6): the experiments of Sec. 6.4 with the
 // solvers of solvers/surface_tension, printed with wall time and error beside the thesis's tables.
 //   bench_surface_tension sine [N...]                 Table 6.1
-//   bench_surface_tension static one|two [N...]       Tables 6.2 / 6.3 (t = 5, dt = 0.2 dx)
+//   bench_surface_tension static one|two|one_ls|two_ls [N...]   Tables 6.2 / 6.3 (t = 5, dt = 0.2 dx)
 //   bench_surface_tension oscillating [N...]          Table 6.4 refinement test (period, u at t = 0.5)
 //   bench_surface_tension epsilon N                   Table 6.4 epsilon test
 //   bench_surface_tension rising_stability [dt...]    Sec. 6.4.4 (implicit and explicit)
@@ -42,13 +42,14 @@ int main(int argc, char** argv) {
       }
     }
   } else if (mode == "static") {
-    const bool one = argc > 2 && std::string(argv[2]) == "one";
-    std::printf("static circle, %s phase, front tracking, implicit, t = 5, dt = 0.2 dx\n"
+    const bool one = argc > 2 && (std::string(argv[2]) == "one" || std::string(argv[2]) == "one_ls");
+    const bool ls = argc > 2 && std::string(argv[2]).find("_ls") != std::string::npos;
+    std::printf("static circle, %s phase, %s, implicit, t = 5, dt = 0.2 dx\n"
                 "| 1/dx | L1(u) | Linf(u) | pressure jump | jump error | steps | CG its (last) | wall s |\n|---|---|---|---|---|---|---|---|\n",
-                one ? "one" : "two");
+                one ? "one" : "two", ls ? "level-set front" : "front tracking");
     for (int n : sizes(argc, argv, 3, {20, 40, 80})) {
       const auto start = std::chrono::steady_clock::now();
-      const StaticCircleResult r = runStaticCircle(n, one, true, 5.0);
+      const StaticCircleResult r = runStaticCircle(n, one, true, 5.0, ls);
       std::printf("| %d | %.3e | %.3e | %.5f | %.2e | %d | %d | %.1f |\n", n, r.l1, r.linf, r.pressureJump,
                   std::abs(r.pressureJump - 4.0) / 4.0, r.steps, r.lastIterations, seconds(start));
       std::fflush(stdout);
@@ -84,10 +85,11 @@ int main(int argc, char** argv) {
     const std::vector<int> ns{16, 32, 64};
     const std::vector<double> multiples{0.5, 1, 2, 4, 8, 16, 32, 64, 128};
     for (bool ellipse : {false, true})
-      for (bool implicit : {false, true}) {
+      for (int scheme = 0; scheme < 4; ++scheme) {
+        const bool implicit = scheme % 2 == 1, ls = scheme >= 2;
         const auto start = std::chrono::steady_clock::now();
-        std::printf("\n%s, front tracking, %s (%d steps)\n| dt / capillary dt |", ellipse ? "ellipse 0.011 x 0.009" : "circle r = 0.01",
-                    implicit ? "implicit" : "explicit", steps);
+        std::printf("\n%s, %s, %s (%d steps)\n| dt / capillary dt |", ellipse ? "ellipse 0.011 x 0.009" : "circle r = 0.01",
+                    ls ? "level set" : "front tracking", implicit ? "implicit" : "explicit", steps);
         for (int n : ns) std::printf(" N=%d |", n);
         std::printf("\n|---|");
         for (std::size_t i = 0; i < ns.size(); ++i) std::printf("---|");
@@ -95,7 +97,7 @@ int main(int argc, char** argv) {
         for (double m : multiples) {
           std::printf("| %g |", m);
           for (int n : ns) {
-            const StabilityCase r = runStabilityCase(n, m * stabilityCapillaryDt(n), implicit, ellipse, steps);
+            const StabilityCase r = runStabilityCase(n, m * stabilityCapillaryDt(n), implicit, ellipse, steps, ls);
             std::printf(" %s |", r.stable ? "o" : "x");
             std::fflush(stdout);
           }
