@@ -33,12 +33,14 @@ struct TwoPhaseFlow {
   double minSegment = 0.5, maxSegment = 1.5;     // remeshing bounds in dx
   double blowUpSpeed = 1e3;                      // the guard (m/s)
   double tolerance = 1e-12;                      // CG relative tolerance of (6.33)
+  std::uint8_t levelSetFront = 0;                // 1: the front is rebuilt each step from `phi`
 
   // --- state ---
   std::vector<double> u;               // face velocities, MAC layout order
   std::vector<double> frontPoints;     // d per point
   std::vector<int> frontElements;      // d per element (segments in 2-D)
   std::vector<double> pInside, pOutside;  // per cell
+  std::vector<double> phi;             // level-set-tracked fronts: signed distance per cell
   double initialArea = 0;              // enclosed by the front at the start (area drift)
 
   // --- probes: velocity sampled at points, reported as <name>_u, <name>_v in metrics.csv ---
@@ -62,6 +64,8 @@ struct TwoPhaseFlow {
     visit("max_segment", maxSegment);
     visit("blow_up_speed", blowUpSpeed);
     visit("tolerance", tolerance);
+    visit("level_set_front", levelSetFront);
+    visit("phi", phi);
     visit("velocity", u);
     visit("front_points", frontPoints);
     visit("front_elements", frontElements);

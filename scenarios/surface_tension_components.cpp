@@ -6,6 +6,8 @@
 #include "components/two_phase_flow.h"
 #include "solvers/mac_layout.h"
 #include "solvers/surface_tension/front.h"
+#include "solvers/surface_tension/level_set_front.h"
+#include "solvers/surface_tension/level_set_tracking.h"
 
 namespace monolith {
 
@@ -101,16 +103,29 @@ void parseTwoPhaseFlow(World<d>& world, Entity e, const Config& c) {
       r.finish();
     }
     const Config f = c.child("front");
-    const solvers::Front2 front = parseFront(f, flow.dx);
+    flow.levelSetFront = f.oneOf("tracking", {"front", "level_set"}, "front") == "level_set";
+    solvers::Front2 front = parseFront(f, flow.dx);
     const Eigen::Vector2d upper = flow.origin + flow.dx * flow.cells.cast<double>();
     for (const auto& x : front.points)
       if ((x.array() <= flow.origin.array()).any() || (x.array() >= upper.array()).any())
         f.fail("a front strictly inside the domain", "a point at (" + std::to_string(x.x()) + ", " + std::to_string(x.y()) + ")");
     f.finish();
+    const solvers::MacLayout<2> layout(flow.cells, flow.dx, flow.origin);
+    if (flow.levelSetFront) {
+      // The level set: the signed distance to the front (a circle's polygon refined 16x first, so
+      // the distance is the circle's to ~1e-4 dx), and the mesh rebuilt from it.
+      solvers::Front2 fine = front;
+      if (f.raw().value("shape", std::string()) == "circle") {
+        const Eigen::VectorXd centre = f.vector("centre", 2);
+        fine = solvers::perturbedCircle(Eigen::Vector2d(centre[0], centre[1]), f.number("radius"), f.number("epsilon", 0.0),
+                                        static_cast<int>(f.integer("mode", 2, 0, 1000)), 16 * front.pointCount());
+      }
+      flow.phi = solvers::signedDistanceToFront(layout, fine);
+      front = solvers::frontFromLevelSet(layout, flow.phi, solvers::CrossingOrder::Fourth);
+    }
     for (const auto& x : front.points) flow.frontPoints.insert(flow.frontPoints.end(), {x.x(), x.y()});
     for (const auto& el : front.elements) flow.frontElements.insert(flow.frontElements.end(), {el[0], el[1]});
     flow.initialArea = solvers::enclosedArea(front);
-    const solvers::MacLayout<2> layout(flow.cells, flow.dx, flow.origin);
     flow.u.assign(layout.totalFaces(), 0.0);
     flow.pInside.assign(layout.cellCount(), 0.0);
     flow.pOutside.assign(layout.cellCount(), 0.0);
@@ -140,7 +155,7 @@ void registerSurfaceTensionComponents(Registry& r) {
   r.addComponentOf<d, TwoPhaseFlow<d>>(
       "one- or two-phase flow with surface tension on a Lagrangian front (2-D): cells, domain_min/max, phases "
       "(one|two), density_inside/outside, viscosity, surface_tension, treatment (implicit|explicit), gravity, "
-      "advection, front {shape: circle|polygon}, probes [{name, position}]",
+      "advection, front {shape: circle|polygon, tracking: front|level_set}, probes [{name, position}]",
       parseTwoPhaseFlow<d>);
 }
 

@@ -37,6 +37,7 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
         state.front.elements.push_back({flow.frontElements[k], flow.frontElements[k + 1]});
       state.pInside = flow.pInside;
       state.pOutside = flow.pOutside;
+      state.phi = flow.phi;
       state.time = ctx.time;
       state.step = static_cast<int>(ctx.step);
 
@@ -53,6 +54,7 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
       s.maxSegment = flow.maxSegment;
       s.blowUpSpeed = flow.blowUpSpeed;
       s.solve.relativeTolerance = flow.tolerance;
+      s.levelSetFront = flow.levelSetFront != 0;
 
       const solvers::TwoPhaseStepReport r = solvers::advanceTwoPhase(state, s, ctx.dt);
 
@@ -63,6 +65,7 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
       for (const auto& e : state.front.elements) flow.frontElements.insert(flow.frontElements.end(), {e[0], e[1]});
       flow.pInside = state.pInside;
       flow.pOutside = state.pOutside;
+      flow.phi = state.phi;
 
       auto& out = ctx.diagnostics;
       out.max("fluid_max_speed", r.maxSpeed);

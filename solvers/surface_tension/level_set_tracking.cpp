@@ -57,9 +57,10 @@ std::vector<double> advectCellField(const MacLayout<2>& layout, const std::vecto
   return out;
 }
 
-void redistanceToFront(const MacLayout<2>& layout, const Front2& front, std::vector<double>& phi, double band) {
+void redistanceToFront(const MacLayout<2>& layout, const Front2& front, std::vector<double>& phi, double band, double keep) {
   const std::vector<double> distance = bandDistance(layout, front, band);
-  for (int c = 0; c < layout.cellCount(); ++c) phi[c] = phi[c] < 0 ? -distance[c] : distance[c];
+  for (int c = 0; c < layout.cellCount(); ++c)
+    if (distance[c] > keep * layout.dx) phi[c] = phi[c] < 0 ? -distance[c] : distance[c];
 }
 
 std::vector<double> signedDistanceToFront(const MacLayout<2>& layout, const Front2& front, double band) {
