@@ -357,6 +357,25 @@ void extrapolateToAir(const MacLayout<2>& layout, const InterfaceDiscretization&
 
 }  // namespace
 
+namespace {
+// The level set's mesh; a level set so distorted that its marching-squares segments no longer
+// chain into curves (two segments leaving one crossing) is a blow-up, reported as such.
+bool rebuildFront(TwoPhaseState& state, const MacLayout<2>& layout, const TwoPhaseSettings& settings,
+                  TwoPhaseStepReport& report) {
+  try {
+    state.front = frontFromLevelSet(layout, state.phi, CrossingOrder::Fourth);
+    return true;
+  } catch (const std::invalid_argument&) {
+    report.blewUp = true;
+    std::ostringstream why;
+    why << (settings.implicitSurfaceTension ? "implicit" : "explicit") << " surface tension blew up at step "
+        << state.step + 1 << " (t = " << state.time << "): the level set's mesh no longer forms closed curves";
+    report.blowUpReason = why.str();
+    return false;
+  }
+}
+}  // namespace
+
 TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings& settings, double dt) {
   if (!(dt > 0) || !std::isfinite(dt)) throw std::invalid_argument("advanceTwoPhase: dt must be positive and finite");
   TwoPhaseStepReport report;
@@ -376,7 +395,7 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
   if (settings.levelSetFront) {
     if (static_cast<int>(state.phi.size()) != layout.cellCount())
       throw std::invalid_argument("advanceTwoPhase: a level-set front needs phi on every cell");
-    state.front = frontFromLevelSet(layout, state.phi, CrossingOrder::Fourth);
+    if (!rebuildFront(state, layout, settings, report)) return report;
   }
   const InterfaceDiscretization D = discretizeInterface(layout, state.front, settings, dt);
   const int nu = D.unknowns(), np = D.pressureCount;
@@ -457,8 +476,7 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
     // The level set moves with the grid velocity; the mesh is rebuilt from it and it is
     // redistanced to that mesh.
     state.phi = advectCellField(layout, state.phi, state.u, dt);
-    state.front = frontFromLevelSet(layout, state.phi, CrossingOrder::Fourth);
-    redistanceToFront(layout, state.front, state.phi);
+    if (rebuildFront(state, layout, settings, report)) redistanceToFront(layout, state.front, state.phi);
   } else {
     const Eigen::VectorXd v = D.Ht.transpose() * unew;  // H u^{n+1}
     for (int k = 0; k < state.front.pointCount(); ++k) state.front.points[k] += dt * v.segment<2>(2 * k);
@@ -489,7 +507,7 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
   report.pressureJump = (countIn ? sumIn / countIn : 0.0) - (countOut ? sumOut / countOut : 0.0);
   report.area = enclosedArea(state.front);
   report.cutCells = static_cast<int>(std::count(D.cutCell.begin(), D.cutCell.end(), 1));
-  if (!finite || maxSpeed > settings.blowUpSpeed) {
+  if (!report.blewUp && (!finite || maxSpeed > settings.blowUpSpeed)) {
     report.blewUp = true;
     std::ostringstream why;
     why << (settings.implicitSurfaceTension ? "implicit" : "explicit") << " surface tension blew up at step "
