@@ -11,6 +11,7 @@
 #include "scenarios/fluid_components.h"
 #include "scenarios/joint_components.h"
 #include "systems/articulation.h"
+#include "scenarios/surface_tension_components.h"
 #include "systems/advance_positions.h"
 #include "systems/advance_velocity.h"
 #include "systems/rigid_diagnostics.h"
@@ -18,6 +19,7 @@
 #include "systems/fluid_obstacles.h"
 #include "systems/fluid_projection.h"
 #include "systems/fluid_structure_coupling.h"
+#include "systems/surface_tension_flow.h"
 #include "systems/kinematic_motion.h"
 #include "systems/rigid_contact.h"
 #include "systems/rigid_forces.h"
@@ -146,6 +148,7 @@ void registerDimension(Registry& r) {
   registerContactComponents<d>(r);
   registerFluidComponents<d>(r);
   if constexpr (d == 3) registerJointComponents(r);
+  registerSurfaceTensionComponents<d>(r);
 
   r.addSystem<d>({"clear_rigid_forces", "zero the force accumulators before each force evaluation",
                   [] { return atBothForceStages<ClearRigidForces<d>, d>(); }, ""});
@@ -195,6 +198,9 @@ void registerDimension(Registry& r) {
                   [] { return single<FluidStructureProjection<d>>(); }, ""});
   r.addSystem<d>({"rigid_diagnostics", "energies and momenta of the rigid bodies",
                   [] { return single<RigidDiagnostics<d>>(); }, ""});
+  r.addSystem<d>({"surface_tension_flow",
+                  "two-phase flow with implicit surface tension on a Lagrangian front (Ch. 6, eq. 6.33)",
+                  [] { return single<SurfaceTensionFlow<d>>(); }, ""});
 }
 
 }  // namespace

@@ -1,0 +1,242 @@
+#include "solvers/surface_tension/scenarios.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace monolith::solvers {
+
+namespace {
+// Distance from (x0, y0) to the curve y = sin x: the vertical distance bounds it, so the nearest
+// point lies within that many units in x; sample, then Newton on the derivative of the squared distance.
+double distanceToSine(double x0, double y0) {
+  const double bound = std::abs(y0 - std::sin(x0));
+  double best = x0, bestValue = bound * bound;
+  for (int i = -40; i <= 40; ++i) {
+    const double x = x0 + bound * i / 40.0;
+    const double value = (x - x0) * (x - x0) + (std::sin(x) - y0) * (std::sin(x) - y0);
+    if (value < bestValue) best = x, bestValue = value;
+  }
+  double x = best;
+  for (int it = 0; it < 50; ++it) {
+    const double g = (x - x0) + (std::sin(x) - y0) * std::cos(x);
+    const double h = 1 + std::cos(x) * std::cos(x) - (std::sin(x) - y0) * std::sin(x);
+    const double step = g / h;
+    x -= step;
+    if (std::abs(step) < 1e-16) break;
+  }
+  return std::sqrt((x - x0) * (x - x0) + (std::sin(x) - y0) * (std::sin(x) - y0));
+}
+}  // namespace
+
+SineInterfaceErrors sineInterfaceErrors(int n, CrossingOrder order) {
+  const double dx = 4.0 / n;
+  const MacLayout<2> layout(Eigen::Vector2i(2 * n, n), dx, Eigen::Vector2d(0, -2));
+  std::vector<double> phi(layout.cellCount());
+  for (int c = 0; c < layout.cellCount(); ++c) {
+    const Eigen::Vector2d x = layout.cellCenter(layout.cellCoord(c));
+    const double vertical = x.y() - std::sin(x.x());
+    const double distance = std::abs(vertical) < 10 * dx ? distanceToSine(x.x(), x.y()) : std::abs(vertical);
+    phi[c] = vertical >= 0 ? -distance : distance;  // the fluid y >= sin x is inside
+  }
+  const Front2 front = frontFromLevelSet(layout, phi, order);
+  const auto kn = curvatureNormals(front);
+  const auto incident = pointSegments(front);
+  SineInterfaceErrors e;
+  for (int k = 0; k < front.pointCount(); ++k) {
+    const Eigen::Vector2d x = front.points[k];
+    if (x.x() < 8 * dx || x.x() > 8 - 8 * dx) continue;
+    if (incident[k][0] < 0 || incident[k][1] < 0) continue;
+    const double eg = std::abs(x.y() - std::sin(x.x()));
+    const double c = std::cos(x.x());
+    const double ek = std::abs(kn[k].norm() - std::abs(std::sin(x.x())) / std::pow(1 + c * c, 1.5));
+    e.interfaceMax = std::max(e.interfaceMax, eg);
+    e.curvatureMax = std::max(e.curvatureMax, ek);
+    e.interfaceMean += eg;
+    e.curvatureMean += ek;
+    ++e.points;
+  }
+  if (e.points > 0) e.interfaceMean /= e.points, e.curvatureMean /= e.points;
+  return e;
+}
+
+TwoPhaseSettings staticCircleSettings(bool onePhase, bool implicit) {
+  TwoPhaseSettings s;
+  s.densityInside = 1e4;
+  s.densityOutside = 1e4;
+  s.onePhase = onePhase;
+  s.viscosity = 1;
+  s.sigma = 1;
+  s.implicitSurfaceTension = implicit;
+  return s;
+}
+
+StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double endTime, bool levelSet) {
+  const double dx = 1.0 / n, dt = 0.2 * dx;
+  const int points = static_cast<int>(std::lround(2 * M_PI * 0.25 / dx));
+  TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(n, n), dx),
+                                          perturbedCircle(Eigen::Vector2d(0.5, 0.5), 0.25, 0, 0, points));
+  TwoPhaseSettings settings = staticCircleSettings(onePhase, implicit);
+  if (levelSet) {
+    settings.levelSetFront = true;
+    state.phi.resize(state.layout.cellCount());
+    for (int c = 0; c < state.layout.cellCount(); ++c)
+      state.phi[c] = (state.layout.cellCenter(state.layout.cellCoord(c)) - Eigen::Vector2d(0.5, 0.5)).norm() - 0.25;
+    state.front = frontFromLevelSet(state.layout, state.phi, CrossingOrder::Fourth);
+  }
+  StaticCircleResult r;
+  const int steps = static_cast<int>(std::lround(endTime / dt));
+  TwoPhaseStepReport last;
+  for (int i = 0; i < steps; ++i) {
+    last = advanceTwoPhase(state, settings, dt);
+    if (last.blewUp) {
+      r.stable = false;
+      break;
+    }
+  }
+  const auto [l1, linf] = velocityNorms(state.u);
+  r.l1 = l1;
+  r.linf = linf;
+  r.pressureJump = last.pressureJump;
+  r.steps = state.step;
+  r.lastIterations = last.solve.iterations;
+  return r;
+}
+
+OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTime) {
+  const double dx = 1.0 / n, dt = 0.25 * dx, rhat = 1.0 / 3, omega = 2.0;
+  const int points = static_cast<int>(std::lround(2 * M_PI * rhat / dx));
+  TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(n, n), dx),
+                                          perturbedCircle(Eigen::Vector2d(0.5, 0.5), rhat, epsilon, 2, points));
+  TwoPhaseSettings settings;
+  settings.densityInside = 27;
+  settings.onePhase = true;
+  settings.sigma = 2.0 / 3;
+  settings.blowUpSpeed = 10;
+  OscillatingCircleResult r;
+  const Eigen::Vector2d probe(0.75, 0.5);
+  double previousTime = 0, previousU = 0;
+  int crossings = 0;
+  bool halfDone = false;
+  while (state.time < endTime - 1e-12) {
+    const TwoPhaseStepReport report = advanceTwoPhase(state, settings, dt);
+    if (report.blewUp) {
+      r.stable = false;
+      break;
+    }
+    const double u = sampleFaceVelocity(state.layout, state.u, 0, probe);
+    if (!halfDone && state.time >= 0.5 - 1e-12) {
+      halfDone = true;
+      // Linear interpolation to t = 0.5 between the last two steps.
+      const double w = (0.5 - previousTime) / (state.time - previousTime);
+      r.probeAtHalf = previousU + w * (u - previousU);
+      const double scale = epsilon * omega * rhat * std::abs(std::sin(omega * state.time));
+      double worst = 0;
+      for (int f = 0; f < state.layout.totalFaces(); ++f) {
+        const auto [axis, idx] = state.layout.faceCoord(f);
+        const Eigen::Vector2d x = state.layout.faceCenter(axis, idx);
+        if (!insideFront(state.front, x)) continue;
+        const Eigen::Vector2d rel = x - Eigen::Vector2d(0.5, 0.5);
+        const double radius = rel.norm(), theta = std::atan2(rel.y(), rel.x());
+        const double a = -epsilon * omega * rhat * (radius / rhat) * std::sin(omega * state.time);
+        const double exact = axis == 0 ? a * std::cos(-theta) : a * std::sin(-theta);
+        worst = std::max(worst, std::abs(state.u[f] - exact));
+      }
+      r.relativeErrorAtHalf = worst / scale;
+    }
+    if (state.step > 1 && (previousU < 0) != (u < 0)) {
+      ++crossings;
+      if (crossings == 2 && r.period == 0) r.period = previousTime + (state.time - previousTime) * previousU / (previousU - u);
+    }
+    previousTime = state.time;
+    previousU = u;
+  }
+  r.steps = state.step;
+  return r;
+}
+
+RisingBubbleStability runRisingBubbleStability(int n, double dt, bool implicit, int steps) {
+  const double dx = 1.0 / n;
+  const int points = static_cast<int>(std::lround(2 * M_PI * 0.2 / dx));
+  TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(n, 2 * n), dx),
+                                          perturbedCircle(Eigen::Vector2d(0.5, 0.5), 0.2, 0, 0, points));
+  TwoPhaseSettings settings;
+  settings.densityInside = 1e3;
+  settings.densityOutside = 1e4;
+  settings.viscosity = 1;
+  settings.sigma = 0.5;
+  settings.gravity = Eigen::Vector2d(0, -8e-4);
+  settings.implicitSurfaceTension = implicit;
+  settings.blowUpSpeed = 0.1;
+  settings.solve.relativeTolerance = 1e-10;
+  const double area0 = enclosedArea(state.front);
+  RisingBubbleStability r;
+  for (int i = 0; i < steps; ++i) {
+    const TwoPhaseStepReport report = advanceTwoPhase(state, settings, dt);
+    r.maxSpeed = std::max(r.maxSpeed, report.maxSpeed);
+    r.capillaryDt = report.capillaryDt;
+    r.areaChange = std::abs(report.area / area0 - 1);
+    if (report.blewUp) {
+      r.stable = false;
+      r.reason = report.blowUpReason;
+      break;
+    }
+    if (r.areaChange > 0.2) {
+      r.stable = false;
+      r.reason = std::string(implicit ? "implicit" : "explicit") + " surface tension blew up at step " +
+                 std::to_string(state.step) + ": the bubble's area changed by more than 20 %";
+      break;
+    }
+  }
+  r.steps = state.step;
+  return r;
+}
+
+double stabilityCapillaryDt(int n) {
+  const double dx = 0.04 / n;
+  return std::sqrt(1000 * dx * dx * dx / (4 * M_PI * 0.0728));
+}
+
+StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps, bool levelSet) {
+  const double dx = 0.04 / n;
+  const Eigen::Vector2d centre(0.02, 0.02);
+  const int points = static_cast<int>(std::lround(2 * M_PI * 0.01 / dx));
+  Front2 front;
+  if (ellipse) {
+    std::vector<Eigen::Vector2d> x;
+    for (int k = 0; k < points; ++k) {
+      const double theta = (k + 0.5) * 2 * M_PI / points;
+      x.push_back(centre + Eigen::Vector2d(0.011 * std::cos(theta), 0.009 * std::sin(theta)));
+    }
+    front = closedPolyline(x);
+  } else {
+    front = perturbedCircle(centre, 0.01, 0, 0, points);
+  }
+  TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(n, n), dx), front);
+  TwoPhaseSettings settings;
+  settings.densityInside = 1000;
+  settings.onePhase = true;
+  settings.sigma = 0.0728;
+  settings.implicitSurfaceTension = implicit;
+  settings.blowUpSpeed = 1.0;
+  settings.solve.relativeTolerance = 1e-10;
+  if (levelSet) {
+    settings.levelSetFront = true;
+    state.phi = signedDistanceToFront(state.layout, state.front);
+    state.front = frontFromLevelSet(state.layout, state.phi, CrossingOrder::Fourth);
+  }
+  const double area0 = enclosedArea(state.front);
+  StabilityCase r;
+  r.capillaryDt = stabilityCapillaryDt(n);
+  for (int i = 0; i < steps; ++i) {
+    const TwoPhaseStepReport report = advanceTwoPhase(state, settings, dt);
+    r.maxSpeed = std::max(r.maxSpeed, report.maxSpeed);
+    if (report.blewUp || std::abs(report.area / area0 - 1) > 0.2) {
+      r.stable = false;
+      break;
+    }
+  }
+  r.steps = state.step;
+  return r;
+}
+
+}  // namespace monolith::solvers

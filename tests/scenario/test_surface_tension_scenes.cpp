@@ -1,0 +1,132 @@
+// The surface-tension scenes through the CLI: metrics.csv columns, the static circle's pressure
+// jump, checkpoint/restart carrying the front, 1 vs 2 threads, the blow-up guard naming the
+// explicit variant, and scene validation of the two_phase_flow component.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "support/cli_harness.h"
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using namespace monolith::test;
+
+namespace {
+const std::string kScenes = std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/";
+
+// Column `name` of the last row of metrics.csv.
+double lastValue(const fs::path& metrics, const std::string& name) {
+  const auto rows = lines(slurp(metrics));
+  if (rows.size() < 2) return std::nan("");
+  auto split = [](const std::string& row) {
+    std::vector<std::string> cells;
+    std::stringstream s(row);
+    for (std::string cell; std::getline(s, cell, ',');) cells.push_back(cell);
+    return cells;
+  };
+  const std::vector<std::string> header = split(rows.front()), last = split(rows.back());
+  for (std::size_t i = 0; i < header.size() && i < last.size(); ++i)
+    if (header[i] == name) return std::stod(last[i]);
+  return std::nan("");
+}
+}  // namespace
+
+TEST(SurfaceTensionScenes, StaticCircleReportsSpeedsLimitsAndThePressureJump) {
+  TempDir tmp;
+  const CommandResult r = run({MONOLITH_CLI, "run", kScenes + "static_circle.json", "--out", (tmp.path() / "A").string(),
+                               "--set", "time.end=0.5", "--quiet"},
+                              tmp.logs());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const fs::path metrics = tmp.path() / "A" / "metrics.csv";
+  EXPECT_NEAR(lastValue(metrics, "surface_tension_pressure_jump"), 4.0, 0.04);  // sigma / r within 1 %
+  EXPECT_LT(lastValue(metrics, "fluid_max_speed"), 1e-5);  // measured 3.8e-6 at t = 0.5
+  EXPECT_NEAR(lastValue(metrics, "capillary_dt"), std::sqrt(2e4 * 0.05 * 0.05 * 0.05 / (4 * M_PI)), 1e-12);
+  EXPECT_GE(lastValue(metrics, "fluid_cfl"), 0.0);
+  EXPECT_EQ(lastValue(metrics, "front_points"), 31.0);
+  const Json summary = Json::parse(slurp(tmp.path() / "A" / "summary.json"));
+  bool scheduled = false;
+  for (const auto& s : summary["systems"]) scheduled |= s["name"] == "surface_tension_flow";
+  EXPECT_TRUE(scheduled);
+}
+
+TEST(SurfaceTensionScenes, CheckpointRestartCarriesTheFrontAndThreadsAgree) {
+  // The oscillating drop at 40 x 40 (its front moves and is remeshed): 2 x 20 steps straight with a
+  // checkpoint at 20, resumed from it, and the straight run on 1 thread: all three end bitwise equal.
+  TempDir tmp;
+  const std::vector<std::string> common = {"--set", "entities.0.two_phase_flow.cells=[40,40]", "--set",
+                                           "time.end=0.4", "--set", "time.dt=0.01", "--quiet"};
+  auto runWith = [&](const std::string& out, std::vector<std::string> extra) {
+    std::vector<std::string> argv = {MONOLITH_CLI, "run", kScenes + "oscillating_circle.json", "--out", (tmp.path() / out).string()};
+    argv.insert(argv.end(), common.begin(), common.end());
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return run(argv, tmp.logs());
+  };
+  ASSERT_EQ(runWith("A", {"--checkpoint-every", "20", "--threads", "2"}).exitCode, 0);
+  ASSERT_EQ(runWith("C", {"--threads", "1"}).exitCode, 0);
+  const fs::path checkpoint = tmp.path() / "A" / "checkpoints" / "step_00000020.ckpt";
+  ASSERT_TRUE(fs::exists(checkpoint));
+  const CommandResult b = run({MONOLITH_CLI, "resume", checkpoint.string(), "--out", (tmp.path() / "B").string(), "--quiet"},
+                              tmp.logs());
+  ASSERT_EQ(b.exitCode, 0) << b.err;
+  const Json a = Json::parse(slurp(tmp.path() / "A" / "summary.json"));
+  const Json rb = Json::parse(slurp(tmp.path() / "B" / "summary.json"));
+  const Json c = Json::parse(slurp(tmp.path() / "C" / "summary.json"));
+  EXPECT_EQ(a["steps_completed"], 40);
+  EXPECT_EQ(a["state_hash"], rb["state_hash"]);
+  EXPECT_EQ(a["state_hash"], c["state_hash"]);
+  EXPECT_EQ(lastValue(tmp.path() / "A" / "metrics.csv", "p1_u"), lastValue(tmp.path() / "B" / "metrics.csv", "p1_u"));
+  EXPECT_LT(lastValue(tmp.path() / "A" / "metrics.csv", "p1_u"), 0.0);  // the drop's first half-period
+}
+
+TEST(SurfaceTensionScenes, ExplicitRisingBubbleIsStoppedByTheGuardThatNamesIt) {
+  // 40 x 80 instead of 80 x 160 (the bench runs the full size): dt = 3 s is 18x the capillary limit.
+  TempDir tmp;
+  const CommandResult r = run({MONOLITH_CLI, "run", kScenes + "rising_bubble_stability.json", "--out",
+                               (tmp.path() / "A").string(), "--set", "entities.0.two_phase_flow.cells=[40,80]", "--set",
+                               "entities.0.two_phase_flow.treatment=explicit", "--set", "time.end=30", "--quiet"},
+                              tmp.logs());
+  EXPECT_EQ(r.exitCode, 4) << r.err;
+  const Json summary = Json::parse(slurp(tmp.path() / "A" / "summary.json"));
+  EXPECT_EQ(summary["status"], "unstable");
+  EXPECT_NE(summary["diagnosis"].get<std::string>().find("surface_tension_explicit_blew_up"), std::string::npos)
+      << summary["diagnosis"];
+  EXPECT_NE(r.err.find("explicit surface tension blew up"), std::string::npos) << r.err;
+  const CommandResult implicitRun = run({MONOLITH_CLI, "run", kScenes + "rising_bubble_stability.json", "--out",
+                                         (tmp.path() / "B").string(), "--set", "entities.0.two_phase_flow.cells=[40,80]",
+                                         "--set", "time.end=30", "--quiet"},
+                                        tmp.logs());
+  EXPECT_EQ(implicitRun.exitCode, 0) << implicitRun.err;
+}
+
+TEST(SurfaceTensionScenes, ValidationNamesFilePathAndExpectation) {
+  TempDir tmp;
+  auto validate = [&](const std::string& name, const std::string& entity, int dimension = 2) {
+    const fs::path scene = tmp.path() / name;
+    writeFile(scene, "{ \"dimension\": " + std::to_string(dimension) +
+                         ", \"time\": { \"dt\": 0.01, \"steps\": 1 }, \"entities\": [ { \"name\": \"drop\", "
+                         "\"two_phase_flow\": " + entity + " } ] }");
+    return run({MONOLITH_CLI, "validate", scene.string()}, tmp.logs());
+  };
+  const std::string base = R"("cells": [10, 10], "domain_max": [1, 1], "density_inside": 1, "surface_tension": 1, )";
+  const CommandResult jump = validate("jump.json", "{" + base + R"("density_outside": 1, "viscosity": 1, "viscosity_outside": 2,
+      "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2 } })");
+  EXPECT_NE(jump.exitCode, 0);
+  EXPECT_NE(jump.err.find("jump.json"), std::string::npos) << jump.err;
+  EXPECT_NE(jump.err.find("entities[0].two_phase_flow.viscosity_outside"), std::string::npos) << jump.err;
+  EXPECT_NE(jump.err.find("one viscosity for both phases"), std::string::npos) << jump.err;
+  const CommandResult clockwise = validate("cw.json", "{" + base + R"("density_outside": 1,
+      "front": { "shape": "polygon", "points": [[0.3, 0.3], [0.3, 0.7], [0.7, 0.7], [0.7, 0.3]] } })");
+  EXPECT_NE(clockwise.exitCode, 0);
+  EXPECT_NE(clockwise.err.find("two_phase_flow.front.points"), std::string::npos) << clockwise.err;
+  EXPECT_NE(clockwise.err.find("counter-clockwise"), std::string::npos) << clockwise.err;
+  const CommandResult outside = validate("out.json", "{" + base + R"("density_outside": 1,
+      "front": { "shape": "circle", "centre": [0.9, 0.5], "radius": 0.2 } })");
+  EXPECT_NE(outside.exitCode, 0);
+  EXPECT_NE(outside.err.find("strictly inside the domain"), std::string::npos) << outside.err;
+  const CommandResult threeD = validate("3d.json", R"({"cells": [4, 4, 4], "domain_max": [1, 1, 1]})", 3);
+  EXPECT_NE(threeD.exitCode, 0);
+  EXPECT_NE(threeD.err.find("2-D only"), std::string::npos) << threeD.err;
+}

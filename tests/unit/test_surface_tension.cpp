@@ -1,0 +1,229 @@
+// Surface tension on a Lagrangian front (thesis Ch. 6): the front's geometry and remeshing, the
+// level-set front of Table 6.1, the cut-cell discretization's identities, and short runs of the
+// Sec. 6.4 experiments whose tolerances come from the tables measured in
+// docs/benchmarks_surface_tension.md.
+#include <gtest/gtest.h>
+#include <oneapi/tbb/global_control.h>
+
+#include <cmath>
+
+#include "solvers/surface_tension/scenarios.h"
+
+using namespace monolith::solvers;
+
+TEST(SurfaceTensionFront, CurvatureOfAUniformCircleIsExact) {
+  // Sec. 6.3.2: for vertices on a circle with uniform spacing (6.34) is exact to roundoff.
+  const Front2 front = perturbedCircle(Eigen::Vector2d(0.5, 0.5), 0.25, 0, 0, 40);
+  const auto kn = curvatureNormals(front);
+  for (int k = 0; k < front.pointCount(); ++k) {
+    EXPECT_NEAR(kn[k].norm(), 4.0, 1e-12);
+    const Eigen::Vector2d inward = (Eigen::Vector2d(0.5, 0.5) - front.points[k]).normalized();
+    EXPECT_NEAR(kn[k].normalized().dot(inward), 1.0, 1e-12);
+  }
+}
+
+TEST(SurfaceTensionFront, ForceIsMinusTheGradientOfSigmaTimesLength) {
+  // (6.36): phi = sigma l per segment, f = -d phi / dx; checked by central differences.
+  const Front2 front = perturbedCircle(Eigen::Vector2d(0.3, 0.4), 0.2, 0.1, 3, 17);
+  const double sigma = 0.7, h = 1e-6;
+  const auto f = surfaceTensionForces(front, sigma);
+  Eigen::Vector2d total = Eigen::Vector2d::Zero();
+  for (int k = 0; k < front.pointCount(); ++k) {
+    total += f[k];
+    for (int a = 0; a < 2; ++a) {
+      Front2 plus = front, minus = front;
+      plus.points[k][a] += h;
+      minus.points[k][a] -= h;
+      const double derivative = sigma * (frontLength(plus) - frontLength(minus)) / (2 * h);
+      EXPECT_NEAR(f[k][a], -derivative, 1e-8);
+    }
+  }
+  EXPECT_LT(total.norm(), 1e-14);  // surface tension exerts no net force
+}
+
+TEST(SurfaceTensionFront, RemeshingKeepsSegmentsBetweenHalfAndOneAndAHalfCells) {
+  const double dx = 0.05;
+  for (int n : {200, 10}) {  // too fine (merges) and too coarse (third-order splits)
+    Front2 front = perturbedCircle(Eigen::Vector2d(0.5, 0.5), 0.25, 0, 0, n);
+    const double area = enclosedArea(front);
+    EXPECT_GT(remeshClosedFront(front, 0.5 * dx, 1.5 * dx), 0);
+    for (const auto& e : front.elements) {
+      const double l = (front.points[e[1]] - front.points[e[0]]).norm();
+      EXPECT_GE(l, 0.5 * dx);
+      EXPECT_LE(l, 1.5 * dx);
+    }
+    // Merging keeps points on the circle; splitting the 10-gon adds points within the stencil's
+    // third-order error of the chord-to-arc gap (the area moves toward the circle's, pi r^2).
+    if (n == 200) {
+      EXPECT_NEAR(enclosedArea(front) / area, 1.0, 0.02);
+    } else {
+      EXPECT_GT(enclosedArea(front), area);
+    }
+  }
+}
+
+TEST(SurfaceTensionFront, SineInterfaceMatchesTable61) {
+  // Table 6.1's L-inf columns (N = 40, 80, 160); the construction reproduces them to 4 digits, the
+  // L1 columns within 3 % (the thesis does not say exactly which points it averages).
+  struct Row { int n; double linfG, l1G, linfK, l1K; };
+  const Row third[] = {{40, 1.299e-5, 3.214e-6, 3.375e-2, 9.626e-3},
+                       {80, 1.478e-6, 2.838e-7, 2.063e-2, 4.931e-3},
+                       {160, 1.783e-7, 2.637e-8, 1.065e-2, 2.350e-3}};
+  const Row fourth[] = {{40, 1.295e-5, 3.012e-6, 2.876e-2, 8.497e-3},
+                        {80, 8.227e-7, 1.848e-7, 1.425e-2, 4.318e-3},
+                        {160, 5.179e-8, 1.166e-8, 7.636e-3, 2.043e-3}};
+  for (int variant = 0; variant < 2; ++variant) {
+    const Row* rows = variant == 0 ? third : fourth;
+    std::vector<SineInterfaceErrors> measured;
+    for (int i = 0; i < 3; ++i) {
+      const SineInterfaceErrors e = sineInterfaceErrors(rows[i].n, variant == 0 ? CrossingOrder::Third : CrossingOrder::Fourth);
+      EXPECT_NEAR(e.interfaceMax / rows[i].linfG, 1.0, 1e-3) << rows[i].n;
+      EXPECT_NEAR(e.curvatureMax / rows[i].linfK, 1.0, 1e-3) << rows[i].n;
+      EXPECT_NEAR(e.interfaceMean / rows[i].l1G, 1.0, 0.03) << rows[i].n;
+      EXPECT_NEAR(e.curvatureMean / rows[i].l1K, 1.0, 0.03) << rows[i].n;
+      measured.push_back(e);
+    }
+    // Orders: interface ~3 (third) / ~4 (fourth), curvature ~1.
+    const double orderG = std::log2(measured[1].interfaceMax / measured[2].interfaceMax);
+    const double orderK = std::log2(measured[1].curvatureMean / measured[2].curvatureMean);
+    EXPECT_NEAR(orderG, variant == 0 ? 3.0 : 4.0, 0.2);
+    EXPECT_NEAR(orderK, 1.0, 0.2);
+  }
+}
+
+namespace {
+TwoPhaseSettings circleSettings(bool onePhase) {
+  TwoPhaseSettings s = staticCircleSettings(onePhase, true);
+  return s;
+}
+}  // namespace
+
+TEST(SurfaceTensionDiscretization, UniformFlowHasNoDivergenceInAnyCellPart) {
+  // The coupling face closes each cut cell's phase parts: G^T u = 0 for a uniform velocity whose
+  // coupling-face values are its normal components (one and two phases).
+  const MacLayout<2> layout(Eigen::Vector2i(16, 16), 1.0 / 16);
+  const Front2 front = perturbedCircle(Eigen::Vector2d(0.52, 0.47), 0.27, 0.1, 3, 60);
+  const Eigen::Vector2d U(0.3, -0.7);
+  for (bool onePhase : {true, false}) {
+    const InterfaceDiscretization D = discretizeInterface(layout, front, circleSettings(onePhase), 0.01);
+    EXPECT_GT(static_cast<int>(D.couplingCell.size()), 20);
+    Eigen::VectorXd u(D.unknowns());
+    for (int q = 0; q < D.gridUnknowns; ++q) u[q] = U[layout.faceCoord(D.unknownFace[q]).first];
+    for (std::size_t k = 0; k < D.couplingCell.size(); ++k) u[D.gridUnknowns + static_cast<int>(k)] = U.dot(D.couplingNormal[k]);
+    const Eigen::VectorXd divergence = D.G.transpose() * u;
+    // Wall-adjacent parts see the walls' zero velocity: only check cells away from the walls.
+    for (int c = 0; c < layout.cellCount(); ++c) {
+      const Eigen::Vector2i ci = layout.cellCoord(c);
+      if (ci.minCoeff() == 0 || ci.maxCoeff() == 15) continue;
+      for (int dof : {D.insideDof[c], D.outsideDof[c]}) {
+        if (dof >= 0) {
+          EXPECT_NEAR(divergence[dof], 0.0, 1e-14) << "cell " << c;
+        }
+      }
+    }
+  }
+}
+
+TEST(SurfaceTensionDiscretization, ForceDistributionConservesEveryParticlesForce) {
+  // Each particle's weights in H^T sum to 1 (the force density integrates back to the force), and
+  // H^T only acts on coupling faces along their normals; C H has one row per segment.
+  const MacLayout<2> layout(Eigen::Vector2i(20, 20), 0.05);
+  const Front2 front = perturbedCircle(Eigen::Vector2d(0.5, 0.5), 0.25, 0.05, 2, 37);
+  const InterfaceDiscretization D = discretizeInterface(layout, front, circleSettings(false), 0.01);
+  std::vector<double> weight(front.pointCount(), 0.0);
+  for (int o = 0; o < D.Ht.outerSize(); ++o)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(D.Ht, o); it; ++it) {
+      ASSERT_GE(it.row(), D.gridUnknowns);
+      const int k = static_cast<int>(it.col()) / 2, a = static_cast<int>(it.col()) % 2;
+      weight[k] += it.value() * D.couplingNormal[it.row() - D.gridUnknowns][a];
+    }
+  for (double w : weight) EXPECT_NEAR(w, 1.0, 1e-12);
+  EXPECT_EQ(D.CH.rows(), front.elementCount());
+  TwoPhaseSettings explicitSettings = circleSettings(false);
+  explicitSettings.implicitSurfaceTension = false;
+  EXPECT_EQ(discretizeInterface(layout, front, explicitSettings, 0.01).CH.rows(), 0);  // D = C = 0
+}
+
+TEST(SurfaceTensionStaticCircle, PressureJumpAndParasiticCurrentsOnePhaseAndTwoPhase) {
+  // Tables 6.2/6.3 at 1/dx = 20, t = 5 (500 steps). Measured: two phase L1 2.14e-6, Linf 3.55e-5;
+  // one phase L1 2.27e-6, Linf 1.27e-5 (the thesis's front tracking: 2.8e-7 / 8.3e-7 and
+  // 1.8e-7 / 9.6e-7, see docs/benchmarks_surface_tension.md). The bounds are 1.5x the measured
+  // values; the jump sigma / r = 4 within 1 % (measured 0.19 % / 0.20 %).
+  for (bool onePhase : {false, true}) {
+    const StaticCircleResult r = runStaticCircle(20, onePhase, true, 5.0);
+    EXPECT_TRUE(r.stable);
+    EXPECT_EQ(r.steps, 500);
+    EXPECT_NEAR(r.pressureJump, 4.0, 0.04) << (onePhase ? "one phase" : "two phase");
+    EXPECT_LT(r.l1, 3.5e-6);
+    EXPECT_LT(r.linf, onePhase ? 2e-5 : 5.5e-5);
+  }
+}
+
+TEST(SurfaceTensionOscillatingCircle, PeriodAndProbeAtCoarseResolution) {
+  // Table 6.4's refinement test at N = 50 (the bench runs N = 100, period within 3 % of pi).
+  // Measured here: T = 3.295 (+4.9 %), u(0.75, 0.5, t = 0.5) = -1.812e-2; the thesis's front
+  // tracking at N = 50: 3.222 and -1.945e-2.
+  const OscillatingCircleResult r = runOscillatingCircle(50, 0.05, 1.2 * M_PI);
+  EXPECT_TRUE(r.stable);
+  EXPECT_NEAR(r.period / M_PI, 1.0, 0.06);
+  EXPECT_NEAR(r.probeAtHalf / -1.945e-2, 1.0, 0.1);
+}
+
+TEST(SurfaceTensionRisingBubble, ImplicitStableWhereExplicitBlowsUp) {
+  // Sec. 6.4.4 at 40 x 80 (the bench runs 80 x 160): dt = 3 s is 18x the capillary limit here. The
+  // explicit variant (D = C = 0) trips the guard within 10 steps (measured: step 6) and the guard
+  // names it; the implicit one stays bounded by the bubble's rise speed.
+  const RisingBubbleStability explicitRun = runRisingBubbleStability(40, 3.0, false, 10);
+  EXPECT_FALSE(explicitRun.stable);
+  EXPECT_NE(explicitRun.reason.find("explicit surface tension blew up"), std::string::npos) << explicitRun.reason;
+  const RisingBubbleStability implicitRun = runRisingBubbleStability(40, 3.0, true, 10);
+  EXPECT_TRUE(implicitRun.stable) << implicitRun.reason;
+  EXPECT_LT(implicitRun.maxSpeed, 0.02);
+  EXPECT_GT(3.0 / implicitRun.capillaryDt, 15.0);
+}
+
+TEST(SurfaceTensionDeterminism, OneAndTwoThreadsAgreeBitwise) {
+  auto run = [](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(24, 24), 1.0 / 24),
+                                            perturbedCircle(Eigen::Vector2d(0.5, 0.5), 0.3, 0.1, 2, 50));
+    TwoPhaseSettings s = staticCircleSettings(false, true);
+    s.densityOutside = 1e3;
+    s.gravity = Eigen::Vector2d(0, -1e-2);
+    for (int i = 0; i < 20; ++i) advanceTwoPhase(state, s, 0.01);
+    return state;
+  };
+  const TwoPhaseState a = run(1), b = run(2);
+  ASSERT_EQ(a.u.size(), b.u.size());
+  for (Eigen::Index f = 0; f < a.u.size(); ++f) ASSERT_EQ(a.u[f], b.u[f]);
+  ASSERT_EQ(a.front.pointCount(), b.front.pointCount());
+  for (int k = 0; k < a.front.pointCount(); ++k) ASSERT_EQ(a.front.points[k], b.front.points[k]);
+}
+
+TEST(SurfaceTensionInput, RefusesPeriodicAxesAndBadTimeSteps) {
+  MacLayout<2> periodic(Eigen::Vector2i(8, 8), 0.125, Eigen::Vector2d::Zero(), {true, false});
+  EXPECT_THROW(makeTwoPhaseState(periodic, perturbedCircle(Eigen::Vector2d(0.5, 0.5), 0.25, 0, 0, 12)), std::invalid_argument);
+  TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(8, 8), 0.125),
+                                          perturbedCircle(Eigen::Vector2d(0.5, 0.5), 0.25, 0, 0, 12));
+  EXPECT_THROW(advanceTwoPhase(state, TwoPhaseSettings{}, 0.0), std::invalid_argument);
+  EXPECT_THROW(advanceTwoPhase(state, TwoPhaseSettings{}, std::nan("")), std::invalid_argument);
+  // A front that left the domain is reported by the guard, not stepped.
+  state.front.points[0] = Eigen::Vector2d(2, 0.5);
+  const TwoPhaseStepReport r = advanceTwoPhase(state, TwoPhaseSettings{}, 0.01);
+  EXPECT_TRUE(r.blewUp);
+  EXPECT_NE(r.blowUpReason.find("left the domain"), std::string::npos);
+}
+
+TEST(SurfaceTensionStaticCircle, LevelSetTrackedFrontOnePhaseAndTwoPhase) {
+  // The level-set-tracked front at 1/dx = 20, t = 5. Measured: one phase L1 1.70e-7, Linf 1.11e-6
+  // (the thesis's level set 1.07e-4 / 3.70e-4); two phase L1 4.49e-7, Linf 5.55e-6 (thesis 8.57e-5 /
+  // 2.48e-4). Bounds 1.5x measured; the jump within 1 % (measured 0.63 % / 0.82 %, the semi-Lagrangian
+  // level set's slow drift).
+  for (bool onePhase : {true, false}) {
+    const StaticCircleResult r = runStaticCircle(20, onePhase, true, 5.0, true);
+    EXPECT_TRUE(r.stable);
+    EXPECT_NEAR(r.pressureJump, 4.0, 0.04) << (onePhase ? "one phase" : "two phase");
+    EXPECT_LT(r.l1, onePhase ? 2.6e-7 : 6.8e-7);
+    EXPECT_LT(r.linf, onePhase ? 1.7e-6 : 8.5e-6);
+  }
+}
