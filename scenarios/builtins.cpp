@@ -8,6 +8,7 @@
 #include "components/shape.h"
 #include "ecs/registry.h"
 #include "scenarios/contact_components.h"
+#include "scenarios/deformable_components.h"
 #include "scenarios/fluid_components.h"
 #include "systems/advance_positions.h"
 #include "systems/advance_velocity.h"
@@ -142,6 +143,7 @@ void registerDimension(Registry& r) {
   r.addComponentOf<d, RigidForces<d>>("(internal) force/torque accumulator of a dynamic rigid body", nullptr);
   registerContactComponents<d>(r);
   registerFluidComponents<d>(r);
+  registerDeformableComponents<d>(r);
 
   r.addSystem<d>({"clear_rigid_forces", "zero the force accumulators before each force evaluation",
                   [] { return atBothForceStages<ClearRigidForces<d>, d>(); }, ""});
@@ -159,6 +161,7 @@ void registerDimension(Registry& r) {
                   [] { return single<RigidHalfKick<d>>(Stage::AdvanceVelocity); }, ""});
   r.addSystem<d>({"advance_kinematic_positions", "Step IV for kinematic bodies: x += dt v, R = exp(dt w) R",
                   [] { return single<AdvanceKinematicPositions<d>>(); }, ""});
+  registerParticleCollisionSystems<d>(r);
   r.addSystem<d>({"rigid_contact",
                   "Steps II-V contact (Sec. 4.4-4.7, App. B): collisions, contact, shock_propagation, "
                   "resolve_interpenetration, velocity_contact",
@@ -174,6 +177,7 @@ void registerDimension(Registry& r) {
                   [] { return single<ObstacleForces<d>>(); }, ""});
   r.addSystem<d>({"rigid_diagnostics", "energies and momenta of the rigid bodies",
                   [] { return single<RigidDiagnostics<d>>(); }, ""});
+  registerDeformableSystems<d>(r);
 }
 
 }  // namespace
