@@ -69,3 +69,41 @@ struct Elasticity {
 };
 
 }  // namespace monolith
+
+namespace monolith {
+
+// Particles of a deformable body hard-bound to rigid bodies (Sifakis et al. 2007 [138]): a bound
+// particle has no freedom of its own; it moves with its body at a fixed body-frame offset. Its
+// mass and inertia about the body's centre were added to the body when the scene was built, the
+// elastic and damping forces on it act on the body (force and torque), and it is projected out of
+// the implicit solves with its velocity prescribed (Sec. 4.7.3). Bound particles carry
+// Particles::fixed == 2.
+template <int d>
+struct RigidBinding {
+  static constexpr const char* kName = "rigid_binding";
+  std::string bodies;             // the bound bodies' names, one per line
+  std::vector<int> particle;      // bound particle indices
+  std::vector<int> body;          // per bound particle: index into the names
+  std::vector<double> offset;     // per bound particle: d numbers, body frame
+
+  template <class V>
+  void visitFields(V& visit) {
+    visit("bodies", bodies);
+    visit("particle", particle);
+    visit("body", body);
+    visit("offset", offset);
+  }
+  std::vector<std::string> bodyNames() const {
+    std::vector<std::string> out;
+    std::string::size_type start = 0;
+    while (start < bodies.size()) {
+      const auto end = bodies.find('\n', start);
+      out.push_back(bodies.substr(start, end == std::string::npos ? std::string::npos : end - start));
+      if (end == std::string::npos) break;
+      start = end + 1;
+    }
+    return out;
+  }
+};
+
+}  // namespace monolith

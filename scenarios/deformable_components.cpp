@@ -4,8 +4,11 @@
 #include <filesystem>
 
 #include "components/deformable.h"
+#include "components/kinematic.h"
+#include "components/rigid_body.h"
 #include "solvers/deformable/simplex_mesh.h"
 #include "systems/deformable_dynamics.h"
+#include "systems/particle_binding.h"
 #include "systems/particle_contact.h"
 
 namespace monolith {
@@ -134,6 +137,57 @@ void parseDeformable(World<d>& world, Entity e, const Config& c) {
   dm::Material mat;
   mat.density = el.density;
   p.m = dm::prepareForceModel<d>(sm.restX, sm.elements, mat).mass;
+  // "bind": [{"body": NAME, "min": [...], "max": [...]}, ...]: particles inside the world box are
+  // hard-bound to the rigid body NAME (listed before this entity); their mass and inertia about
+  // the body's centre join a dynamic body's (the shift of its centre of mass is neglected).
+  if (c.has("bind")) {
+    const Config list(c.raw()["bind"], c.file(), c.pathOf("bind"));
+    c.markUsed("bind");
+    RigidBinding<d> binding;
+    for (std::size_t k = 0; k < list.arraySize(); ++k) {
+      const Config item = list.element(k);
+      const std::string name = item.string("body");
+      const auto target = world.find(name);
+      RigidBody<d>* body = target ? world.template get<RigidBody<d>>(*target) : nullptr;
+      if (!body) item.failAt("body", "the name of a rigid body listed before this entity", "\"" + name + "\"");
+      const Vec<d> lo = item.vector("min", d), hi = item.vector("max", d);
+      item.finish();
+      const bool heavy = !body->isStatic && !world.template has<KinematicMotion<d>>(*target);
+      const Eigen::Matrix<double, d, d> Rb = body->rotation();
+      int count = 0;
+      for (std::size_t i = 0; i < mesh.x.size(); ++i) {
+        const Vec<d> x = Eigen::Map<const Vec<d>>(&p.x[d * i]);
+        if (!((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all()) || p.fixed[i]) continue;
+        p.fixed[i] = 2;
+        const Vec<d> r = Rb.transpose() * (x - body->x);
+        binding.particle.push_back(static_cast<int>(i));
+        binding.body.push_back(static_cast<int>(k));
+        for (int a = 0; a < d; ++a) binding.offset.push_back(r(a));
+        if (heavy) {
+          body->mass += p.m[i];
+          if constexpr (d == 3)
+            body->inertiaBody += p.m[i] * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+          else
+            body->inertiaBody(0) += p.m[i] * r.squaredNorm();
+        }
+        ++count;
+      }
+      if (count == 0) item.fail("a box containing at least one free particle of the mesh", "a box containing none");
+      if (heavy) body->refresh();
+      binding.bodies += (k ? "\n" : "") + name;
+      // The bound particles start with the body's point velocity.
+      for (std::size_t q = 0; q < binding.particle.size(); ++q) {
+        if (binding.body[q] != static_cast<int>(k)) continue;
+        const int i = binding.particle[q];
+        const Vec<d> r = Rb * Vec<d>(Eigen::Map<const Vec<d>>(&binding.offset[d * q]));
+        Vec<d> w = Vec<d>::Zero();
+        if constexpr (d == 3) w = body->omega().cross(r);
+        else w = Vec<d>(-body->omega()(0) * r.y(), body->omega()(0) * r.x());
+        for (int a = 0; a < d; ++a) p.v[d * i + a] = body->isStatic ? 0.0 : body->v(a) + w(a);
+      }
+    }
+    world.add(e, binding);
+  }
   world.add(e, p);
   world.add(e, sm);
   world.add(e, el);
@@ -156,17 +210,19 @@ void registerDeformableComponents(Registry& r) {
           std::string(d == 3 ? " | tetgen BASE" : "") +
           "}, model (corotated | neo_hookean | springs), youngs_modulus, poisson_ratio, density, rayleigh_alpha, "
           "rayleigh_beta, overdamping, clamp, position, " +
-          std::string(d == 3 ? "orientation" : "angle") + ", velocity, fixed [{min, max}]",
+          std::string(d == 3 ? "orientation" : "angle") + ", velocity, fixed [{min, max}], bind [{body, min, max}]",
       parseDeformable<d>,
       [](World<d>& w) {
         w.template ensurePool<Particles<d>>();
         w.template ensurePool<SimplexMesh<d>>();
         w.template ensurePool<Elasticity>();
+        w.template ensurePool<RigidBinding<d>>();
       },
       ""});
   r.addComponentOf<d, Particles<d>>("(internal) a deformable body's particles: position, velocity, mass, fixed", nullptr);
   r.addComponentOf<d, SimplexMesh<d>>("(internal) a deformable body's elements and rest positions", nullptr);
   r.addComponentOf<d, Elasticity>("(internal) a deformable body's material", nullptr);
+  r.addComponentOf<d, RigidBinding<d>>("(internal) a deformable body's particles hard-bound to rigid bodies", nullptr);
 }
 
 template <int d>
@@ -179,6 +235,18 @@ void registerDeformableSystems(Registry& r) {
   r.addSystem<d>({"advance_deformable_velocity",
                   "Step V (Sec. 4.7) for deformables: trapezoid in the damping as backward Euler + extrapolation, CG",
                   [] { return single<AdvanceDeformableVelocity<d>>(Stage::AdvanceVelocity); }, ""});
+  r.addSystem<d>({"particle_bindings",
+                  "particles hard-bound to rigid bodies: binding_forces@n/@n+1 (elastic forces on the bodies), "
+                  "follow_bound_bodies (Step IV, Step V)",
+                  [] {
+                    std::vector<std::unique_ptr<System<d>>> v;
+                    v.push_back(std::make_unique<BindingForces<d>>(Stage::ForcesAtStart));
+                    v.push_back(std::make_unique<BindingForces<d>>(Stage::ForcesAtEnd));
+                    v.push_back(std::make_unique<FollowBoundBodies<d>>(Stage::AdvancePositions));
+                    v.push_back(std::make_unique<FollowBoundBodies<d>>(Stage::AdvanceVelocity));
+                    return v;
+                  },
+                  ""});
   r.addSystem<d>({"particle_contact",
                   "particles against rigid bodies (zero restitution, Coulomb friction): particle_contact (Step III), "
                   "particle_push_out (Step IV), particle_velocity_contact (Step V, two-way)",

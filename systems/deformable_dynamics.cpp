@@ -43,32 +43,42 @@ std::vector<double> explicitForces(const dm::ForceModel<d>& fm, const Particles<
 
 template <int d>
 ImplicitSolveReport implicitDampingSolve(const dm::ForceModel<d>& fm, const Particles<d>& p,
-                                         const std::vector<double>& f, double h, std::vector<double>& u) {
+                                         const std::vector<double>& f, double h, std::vector<double>& u,
+                                         std::vector<double>* dampingForce) {
   const int n = static_cast<int>(p.x.size());
   ImplicitSolveReport report;
   u.assign(n, 0.0);
+  auto constrained = [&](int i) { return p.fixed[i / d] != 0; };
   if (fm.dampingRows() == 0) {  // no damping: M u = M v + h f directly
-    for (int i = 0; i < n; ++i) u[i] = p.fixed[i / d] ? 0.0 : p.v[i] + h * f[i] / p.m[i / d];
+    for (int i = 0; i < n; ++i) u[i] = constrained(i) ? p.v[i] : p.v[i] + h * f[i] / p.m[i / d];
+    if (dampingForce) dampingForce->assign(n, 0.0);
     return report;
   }
   const auto R = dm::dampingRotations<d>(fm, p.x.data());
-  Eigen::VectorXd b(n), diag(n), x(n);
+  Eigen::VectorXd diag(n), prescribed = Eigen::VectorXd::Zero(n);
   for (int i = 0; i < n; ++i) {
-    b(i) = p.m[i / d] * p.v[i] + h * f[i];
     diag(i) = p.m[i / d];
-    x(i) = p.v[i];
+    if (constrained(i)) prescribed(i) = p.v[i];  // fixed: 0; bound: the body's point velocity
   }
-  // P zeroes the fixed particles' components: symmetric, so P (M - h D) P stays SPD on the
-  // free subspace (Sec. 4.7.3 with the constraint rows of the fixed particles).
-  const solvers::Projector project = [&](Eigen::VectorXd& v) {
-    for (int i = 0; i < n; ++i)
-      if (p.fixed[i / d]) v(i) = 0;
-  };
   const solvers::LinearOperator A = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
     std::vector<double> Dv(n, 0.0);
     dm::addDampingForces<d>(fm, R, p.x.data(), in.data(), Dv.data());
     for (int i = 0; i < n; ++i) out(i) = diag(i) * in(i) - h * Dv[i];
   };
+  // Constrained components are prescribed: u = w + prescribed with w zero on them, and
+  // P A P w = P (b - A prescribed), P zeroing the constrained components. P is symmetric, so
+  // P A P stays SPD on the free subspace (Sec. 4.7.3 with the constraint rows of the fixed and
+  // bound particles).
+  const solvers::Projector project = [&](Eigen::VectorXd& v) {
+    for (int i = 0; i < n; ++i)
+      if (constrained(i)) v(i) = 0;
+  };
+  Eigen::VectorXd b(n), Ap(n), x(n);
+  A(prescribed, Ap);
+  for (int i = 0; i < n; ++i) {
+    b(i) = p.m[i / d] * p.v[i] + h * f[i] - Ap(i);
+    x(i) = p.v[i];
+  }
   solvers::CgSettings settings;
   settings.relativeTolerance = 1e-10;
   settings.maxIterations = 2000;
@@ -77,9 +87,42 @@ ImplicitSolveReport implicitDampingSolve(const dm::ForceModel<d>& fm, const Part
       solvers::conjugateGradient(A, solvers::jacobiPreconditioner(diag), project, b, x, settings);
   report.iterations = r.iterations;
   report.relativeResidual = r.relativeResidual();
-  for (int i = 0; i < n; ++i) u[i] = x(i);
+  for (int i = 0; i < n; ++i) u[i] = x(i) + prescribed(i);
+  if (dampingForce) {
+    dampingForce->assign(n, 0.0);
+    dm::addDampingForces<d>(fm, R, p.x.data(), u.data(), dampingForce->data());
+  }
   return report;
 }
+
+namespace {
+
+template <int d>
+AngularVec<d> armCross(const Vec<d>& r, const Vec<d>& f) {
+  if constexpr (d == 3) return r.cross(f);
+  else return AngularVec<2>(r.x() * f.y() - r.y() * f.x());
+}
+
+template <int d>
+void applyBoundDamping(World<d>& world, const RigidBinding<d>& b, const Particles<d>& p, const std::vector<double>& Du,
+                       double duration) {
+  const auto names = b.bodyNames();
+  std::vector<RigidBody<d>*> bodies;
+  for (const auto& name : names) {
+    const auto e = world.find(name);
+    bodies.push_back(e ? world.template get<RigidBody<d>>(*e) : nullptr);
+  }
+  for (std::size_t k = 0; k < b.particle.size(); ++k) {
+    RigidBody<d>* body = bodies[b.body[k]];
+    if (!body || body->isStatic) continue;
+    const int i = b.particle[k];
+    const Vec<d> j = duration * Vec<d>(Eigen::Map<const Vec<d>>(&Du[d * i]));
+    body->v += j / body->mass;
+    body->L += armCross<d>(Vec<d>(Eigen::Map<const Vec<d>>(&p.x[d * i]) - body->x), j);
+  }
+}
+
+}  // namespace
 
 template <int d>
 void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
@@ -91,8 +134,14 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
         const auto& fm = cache_.get(e, p, mesh, el);
         const std::vector<double> f = explicitForces(fm, p, g);
         std::vector<double> u;
-        const ImplicitSolveReport r = implicitDampingSolve(fm, p, f, half ? 0.5 * ctx.dt : 0.25 * ctx.dt, u);
+        const double h = half ? 0.5 * ctx.dt : 0.25 * ctx.dt;
+        RigidBinding<d>* binding = world.template get<RigidBinding<d>>(e);
+        std::vector<double> Du;
+        const ImplicitSolveReport r = implicitDampingSolve(fm, p, f, h, u, binding ? &Du : nullptr);
         iterations = std::max(iterations, r.iterations);
+        // The damping forces the solve put on bound particles act on their bodies: over this
+        // stage's velocity change, h (Step I) or 2h (Step V's extrapolation) times D u.
+        if (binding) applyBoundDamping(world, *binding, p, Du, half ? h : 2 * h);
         if (half) p.v = u;
         else
           for (std::size_t i = 0; i < u.size(); ++i) p.v[i] = 2 * u[i] - p.v[i];
@@ -119,9 +168,10 @@ DeformableTotals measureDeformableTotals(const World<d>& world) {
     const Entity e = pool->entities()[k];
     const Particles<d>& p = pool->components()[k];
     for (int i = 0; i < p.count(); ++i) {
+      if (p.fixed[i] == 2) continue;  // bound: its mass is part of its rigid body's
       const Eigen::Map<const Vec<d>> x(&p.x[d * i]), v(&p.v[d * i]);
       t.kinetic += 0.5 * p.m[i] * v.squaredNorm();
-      if (!p.fixed[i]) t.potential -= p.m[i] * g.dot(x);
+      if (p.fixed[i] == 0) t.potential -= p.m[i] * g.dot(x);
       Eigen::Vector3d x3 = Eigen::Vector3d::Zero(), p3 = Eigen::Vector3d::Zero();
       x3.template head<d>() = x;
       p3.template head<d>() = p.m[i] * v;
@@ -156,7 +206,8 @@ void DeformableDiagnostics<d>::run(World<d>& world, StepContext& ctx) {
   template class ForceModelCache<D>;                                                                            \
   template std::vector<double> explicitForces<D>(const dm::ForceModel<D>&, const Particles<D>&, const Vec<D>&); \
   template ImplicitSolveReport implicitDampingSolve<D>(const dm::ForceModel<D>&, const Particles<D>&,          \
-                                                       const std::vector<double>&, double, std::vector<double>&); \
+                                                       const std::vector<double>&, double, std::vector<double>&, \
+                                                       std::vector<double>*);                                   \
   template class AdvanceDeformableVelocity<D>;                                                                  \
   template class AdvanceDeformablePositions<D>;                                                                 \
   template class DeformableDiagnostics<D>;                                                                      \

@@ -17,6 +17,7 @@
 #include <unordered_map>
 
 #include "components/deformable.h"
+#include "components/rigid_body.h"
 #include "ecs/system.h"
 #include "solvers/deformable/elasticity.h"
 
@@ -42,10 +43,12 @@ struct ImplicitSolveReport {
   double relativeResidual = 0;
 };
 
-// Solves (M - h D(x)) u = M v + h f with fixed particles projected out; u returned in `u`.
+// Solves (M - h D(x)) u = M v + h f with the fixed and bound particles' u prescribed (their
+// current v) and projected out of the solve; u returned in `u`, and D u in `dampingForce` if given.
 template <int d>
 ImplicitSolveReport implicitDampingSolve(const solvers::deformable::ForceModel<d>& fm, const Particles<d>& p,
-                                         const std::vector<double>& f, double h, std::vector<double>& u);
+                                         const std::vector<double>& f, double h, std::vector<double>& u,
+                                         std::vector<double>* dampingForce = nullptr);
 
 // Elastic forces plus gravity at the particles' current positions (zero on fixed particles).
 template <int d>
@@ -61,7 +64,9 @@ class AdvanceDeformableVelocity final : public System<d> {
   }
   Stage stage() const override { return stage_; }
   std::vector<std::string> reads() const override { return {SimplexMesh<d>::kName, Elasticity::kName}; }
-  std::vector<std::string> writes() const override { return {Particles<d>::kName, "diagnostics"}; }
+  std::vector<std::string> writes() const override {
+    return {Particles<d>::kName, RigidBody<d>::kName, "diagnostics"};  // bodies: damping on bound particles
+  }
   bool needed(const World<d>& w) const override { return w.template count<SimplexMesh<d>>() > 0; }
   void run(World<d>& world, StepContext& ctx) override;
 
