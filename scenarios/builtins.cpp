@@ -8,6 +8,7 @@
 #include "components/shape.h"
 #include "ecs/registry.h"
 #include "scenarios/contact_components.h"
+#include "scenarios/deformable_components.h"
 #include "scenarios/fluid_components.h"
 #include "scenarios/joint_components.h"
 #include "systems/articulation.h"
@@ -149,6 +150,7 @@ void registerDimension(Registry& r) {
   registerFluidComponents<d>(r);
   if constexpr (d == 3) registerJointComponents(r);
   registerSurfaceTensionComponents<d>(r);
+  registerDeformableComponents<d>(r);
 
   r.addSystem<d>({"clear_rigid_forces", "zero the force accumulators before each force evaluation",
                   [] { return atBothForceStages<ClearRigidForces<d>, d>(); }, ""});
@@ -171,6 +173,7 @@ void registerDimension(Registry& r) {
     r.addSystem<d>({"joint_pd_control", "Step III.2 (Sec. 4.5): PD drive of revolute joints as impulses",
                     [] { return single<JointPdControl>(); }, ""});
   }
+  registerParticleCollisionSystems<d>(r);
   r.addSystem<d>({"rigid_contact",
                   "Steps II-V contact (Sec. 4.4-4.7, App. B): collisions, contact, shock_propagation, "
                   "resolve_interpenetration, velocity_contact",
@@ -201,6 +204,7 @@ void registerDimension(Registry& r) {
   r.addSystem<d>({"surface_tension_flow",
                   "two-phase flow with implicit surface tension on a Lagrangian front (Ch. 6, eq. 6.33)",
                   [] { return single<SurfaceTensionFlow<d>>(); }, ""});
+  registerDeformableSystems<d>(r);
 }
 
 }  // namespace

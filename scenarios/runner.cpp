@@ -22,6 +22,8 @@
 #include "components/rigid_body.h"
 #include "scenarios/vtk_grid_writer.h"
 #include "scenarios/vtk_writer.h"
+#include "scenarios/vtk_deformable_writer.h"
+#include "components/deformable.h"
 
 namespace monolith {
 
@@ -132,6 +134,8 @@ void Run<d>::setUpFrameSeries() {
   }
   if (world().template count<MacGrid<d>>() > 0)
     add("fluid", ".vti", [](const World<d>& w, const std::string& p) { writeMacGridFrame(w, p); });
+  if (world().template count<Particles<d>>() > 0)
+    add("deformables", ".vtu", [](const World<d>& w, const std::string& p) { writeDeformableFrame(w, p); });
 }
 
 template <int d>

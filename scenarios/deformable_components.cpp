@@ -1,0 +1,272 @@
+#include "scenarios/deformable_components.h"
+
+#include <Eigen/Geometry>
+#include <filesystem>
+
+#include "components/deformable.h"
+#include "components/kinematic.h"
+#include "components/rigid_body.h"
+#include "solvers/deformable/simplex_mesh.h"
+#include "systems/deformable_dynamics.h"
+#include "systems/particle_binding.h"
+#include "systems/particle_contact.h"
+
+namespace monolith {
+
+namespace {
+
+namespace dm = solvers::deformable;
+
+std::string resolvePath(const Config& c, const std::string& file) {
+  std::filesystem::path path(file);
+  if (path.is_relative()) path = std::filesystem::path(c.file()).parent_path() / path;
+  return path.string();
+}
+
+// "mesh": {"box": {half_extents, edge_length}} | {"sphere": {radius, edge_length}} |
+//         {"gmsh": "file.msh"} | {"tetgen": "base"} (3-D; base.node + base.ele)
+template <int d>
+dm::MeshData<d> parseMesh(const Config& c, std::string& origin) {
+  const std::vector<std::string> forms = d == 3 ? std::vector<std::string>{"box", "sphere", "gmsh", "tetgen"}
+                                                : std::vector<std::string>{"box", "sphere", "gmsh"};
+  int given = 0;
+  for (const auto& f : forms) given += c.has(f);
+  std::string list;
+  for (const auto& f : forms) list += (list.empty() ? "" : ", ") + f;
+  if (given != 1) c.fail("exactly one mesh form of: " + list, std::to_string(given) + " given");
+  try {
+    if (c.has("box")) {
+      const Config b = c.child("box");
+      const Vec<d> half = b.vector("half_extents", d, Bound::Positive);
+      const double h = b.number("edge_length", Bound::Positive);
+      b.finish();
+      origin = "built-in box";
+      return dm::boxMesh<d>(half, h);
+    }
+    if (c.has("sphere")) {
+      const Config b = c.child("sphere");
+      const double r = b.number("radius", Bound::Positive), h = b.number("edge_length", Bound::Positive);
+      b.finish();
+      origin = "built-in sphere";
+      return dm::sphereMesh<d>(r, h);
+    }
+    if (c.has("gmsh")) {
+      origin = resolvePath(c, c.string("gmsh"));
+      return dm::readGmsh<d>(origin);
+    }
+    if constexpr (d == 3) {
+      origin = resolvePath(c, c.string("tetgen"));
+      return dm::readTetgen(origin);
+    }
+  } catch (const dm::MeshError& e) {
+    c.failAt(c.has("gmsh") ? "gmsh" : "tetgen", "a readable, valid mesh file", e.what());
+  }
+  c.fail("a mesh", "none");
+}
+
+template <int d>
+void parseDeformable(World<d>& world, Entity e, const Config& c) {
+  std::string origin;
+  const Config meshConfig = c.child("mesh");
+  dm::MeshData<d> mesh = parseMesh<d>(meshConfig, origin);
+  meshConfig.finish();
+  if (const std::string problem = dm::meshProblem(mesh); !problem.empty())
+    c.failAt("mesh", "a valid simplex mesh (positively oriented, non-degenerate, connected)", origin + ": " + problem);
+
+  Elasticity el;
+  const std::string model = c.oneOf("model", {"corotated", "neo_hookean", "springs"}, "corotated");
+  el.model = model == "corotated" ? 0 : model == "neo_hookean" ? 1 : 2;
+  el.density = c.number("density", 1000.0, Bound::Positive);
+  el.youngsModulus = c.number("youngs_modulus", Bound::Positive);
+  el.poissonRatio = c.number("poisson_ratio", 0.3);
+  if (!(el.poissonRatio > -1 && el.poissonRatio < 0.5))
+    c.failAt("poisson_ratio", "a Poisson ratio in (-1, 0.5)", std::to_string(el.poissonRatio));
+  el.rayleighAlpha = c.number("rayleigh_alpha", 0.0, Bound::NonNegative);
+  el.rayleighBeta = c.number("rayleigh_beta", 0.0, Bound::NonNegative);
+  el.overdamping = c.number("overdamping", 0.0, Bound::NonNegative);
+  el.clamp = c.number("clamp", 0.3, Bound::Positive);
+  if (el.clamp >= 1) c.failAt("clamp", "a singular-value clamp below 1", std::to_string(el.clamp));
+
+  // Placement: rotate about the mesh's own origin, then translate.
+  Eigen::Matrix<double, d, d> R = Eigen::Matrix<double, d, d>::Identity();
+  if constexpr (d == 3) {
+    if (c.has("orientation")) {
+      const Eigen::VectorXd q = c.vector("orientation", 4);
+      if (q.norm() < 1e-12) c.failAt("orientation", "a non-zero quaternion [w, x, y, z]", "a zero quaternion");
+      R = Eigen::Quaterniond(q(0), q(1), q(2), q(3)).normalized().toRotationMatrix();
+    }
+  } else {
+    R = Eigen::Rotation2Dd(c.number("angle", 0.0)).toRotationMatrix();
+  }
+  const Vec<d> position = c.vector("position", Eigen::VectorXd::Zero(d));
+  const Vec<d> velocity = c.vector("velocity", Eigen::VectorXd::Zero(d));
+
+  Particles<d> p;
+  SimplexMesh<d> sm;
+  sm.elements = mesh.elements;
+  for (const auto& x : mesh.x) {
+    const Vec<d> w = R * x + position;
+    for (int a = 0; a < d; ++a) {
+      p.x.push_back(w(a));
+      p.v.push_back(velocity(a));
+      sm.restX.push_back(w(a));
+    }
+  }
+  p.fixed.assign(mesh.x.size(), 0);
+  // "fixed": [{"min": [...], "max": [...]}, ...]: particles inside any of these world boxes.
+  if (c.has("fixed")) {
+    const Config list(c.raw()["fixed"], c.file(), c.pathOf("fixed"));
+    c.markUsed("fixed");
+    for (std::size_t k = 0; k < list.arraySize(); ++k) {
+      const Config box = list.element(k);
+      const Vec<d> lo = box.vector("min", d), hi = box.vector("max", d);
+      box.finish();
+      int count = 0;
+      for (std::size_t i = 0; i < mesh.x.size(); ++i) {
+        const Vec<d> x = Eigen::Map<const Vec<d>>(&p.x[d * i]);
+        if ((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all()) {
+          p.fixed[i] = 1;
+          for (int a = 0; a < d; ++a) p.v[d * i + a] = 0;
+          ++count;
+        }
+      }
+      if (count == 0) box.fail("a box containing at least one particle of the mesh", "a box containing none");
+    }
+  }
+  // Lumped masses from the density (the force model's own computation).
+  dm::Material mat;
+  mat.density = el.density;
+  p.m = dm::prepareForceModel<d>(sm.restX, sm.elements, mat).mass;
+  // "bind": [{"body": NAME, "min": [...], "max": [...]}, ...]: particles inside the world box are
+  // hard-bound to the rigid body NAME (listed before this entity); their mass and inertia about
+  // the body's centre join a dynamic body's (the shift of its centre of mass is neglected).
+  if (c.has("bind")) {
+    const Config list(c.raw()["bind"], c.file(), c.pathOf("bind"));
+    c.markUsed("bind");
+    RigidBinding<d> binding;
+    for (std::size_t k = 0; k < list.arraySize(); ++k) {
+      const Config item = list.element(k);
+      const std::string name = item.string("body");
+      const auto target = world.find(name);
+      RigidBody<d>* body = target ? world.template get<RigidBody<d>>(*target) : nullptr;
+      if (!body) item.failAt("body", "the name of a rigid body listed before this entity", "\"" + name + "\"");
+      const Vec<d> lo = item.vector("min", d), hi = item.vector("max", d);
+      item.finish();
+      const bool heavy = !body->isStatic && !world.template has<KinematicMotion<d>>(*target);
+      const Eigen::Matrix<double, d, d> Rb = body->rotation();
+      int count = 0;
+      for (std::size_t i = 0; i < mesh.x.size(); ++i) {
+        const Vec<d> x = Eigen::Map<const Vec<d>>(&p.x[d * i]);
+        if (!((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all()) || p.fixed[i]) continue;
+        p.fixed[i] = 2;
+        const Vec<d> r = Rb.transpose() * (x - body->x);
+        binding.particle.push_back(static_cast<int>(i));
+        binding.body.push_back(static_cast<int>(k));
+        for (int a = 0; a < d; ++a) binding.offset.push_back(r(a));
+        if (heavy) {
+          body->mass += p.m[i];
+          if constexpr (d == 3)
+            body->inertiaBody += p.m[i] * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+          else
+            body->inertiaBody(0) += p.m[i] * r.squaredNorm();
+        }
+        ++count;
+      }
+      if (count == 0) item.fail("a box containing at least one free particle of the mesh", "a box containing none");
+      if (heavy) body->refresh();
+      binding.bodies += (k ? "\n" : "") + name;
+      // The bound particles start with the body's point velocity.
+      for (std::size_t q = 0; q < binding.particle.size(); ++q) {
+        if (binding.body[q] != static_cast<int>(k)) continue;
+        const int i = binding.particle[q];
+        const Vec<d> r = Rb * Vec<d>(Eigen::Map<const Vec<d>>(&binding.offset[d * q]));
+        Vec<d> w = Vec<d>::Zero();
+        if constexpr (d == 3) w = body->omega().cross(r);
+        else w = Vec<d>(-body->omega()(0) * r.y(), body->omega()(0) * r.x());
+        for (int a = 0; a < d; ++a) p.v[d * i + a] = body->isStatic ? 0.0 : body->v(a) + w(a);
+      }
+    }
+    world.add(e, binding);
+  }
+  world.add(e, p);
+  world.add(e, sm);
+  world.add(e, el);
+}
+
+template <class S, class... Args>
+auto single(Args... args) {
+  std::vector<std::unique_ptr<System<S::dimension>>> v;
+  v.push_back(std::make_unique<S>(args...));
+  return v;
+}
+
+}  // namespace
+
+template <int d>
+void registerDeformableComponents(Registry& r) {
+  r.addComponent<d>(ComponentType<d>{
+      "deformable",
+      "deformable solid: mesh {box {half_extents, edge_length} | sphere {radius, edge_length} | gmsh FILE" +
+          std::string(d == 3 ? " | tetgen BASE" : "") +
+          "}, model (corotated | neo_hookean | springs), youngs_modulus, poisson_ratio, density, rayleigh_alpha, "
+          "rayleigh_beta, overdamping, clamp, position, " +
+          std::string(d == 3 ? "orientation" : "angle") + ", velocity, fixed [{min, max}], bind [{body, min, max}]",
+      parseDeformable<d>,
+      [](World<d>& w) {
+        w.template ensurePool<Particles<d>>();
+        w.template ensurePool<SimplexMesh<d>>();
+        w.template ensurePool<Elasticity>();
+        w.template ensurePool<RigidBinding<d>>();
+      },
+      ""});
+  r.addComponentOf<d, Particles<d>>("(internal) a deformable body's particles: position, velocity, mass, fixed", nullptr);
+  r.addComponentOf<d, SimplexMesh<d>>("(internal) a deformable body's elements and rest positions", nullptr);
+  r.addComponentOf<d, Elasticity>("(internal) a deformable body's material", nullptr);
+  r.addComponentOf<d, RigidBinding<d>>("(internal) a deformable body's particles hard-bound to rigid bodies", nullptr);
+}
+
+template <int d>
+void registerDeformableSystems(Registry& r) {
+  r.addSystem<d>({"advance_deformable_velocity_half",
+                  "Step I (Sec. 4.3) for deformables: (M - dt/2 D) v^{n+1/2} = M v^n + dt/2 f(x^n), CG",
+                  [] { return single<AdvanceDeformableVelocity<d>>(Stage::AdvanceVelocityHalf); }, ""});
+  r.addSystem<d>({"advance_deformable_positions", "Step IV (Sec. 4.6) for deformables: x^{n+1} = x^n + dt v^{n+1/2}",
+                  [] { return single<AdvanceDeformablePositions<d>>(); }, ""});
+  r.addSystem<d>({"advance_deformable_velocity",
+                  "Step V (Sec. 4.7) for deformables: trapezoid in the damping as backward Euler + extrapolation, CG",
+                  [] { return single<AdvanceDeformableVelocity<d>>(Stage::AdvanceVelocity); }, ""});
+  r.addSystem<d>({"particle_bindings",
+                  "particles hard-bound to rigid bodies: binding_forces@n/@n+1 (elastic forces on the bodies), "
+                  "follow_bound_bodies (Step IV, Step V)",
+                  [] {
+                    std::vector<std::unique_ptr<System<d>>> v;
+                    v.push_back(std::make_unique<BindingForces<d>>(Stage::ForcesAtStart));
+                    v.push_back(std::make_unique<BindingForces<d>>(Stage::ForcesAtEnd));
+                    v.push_back(std::make_unique<FollowBoundBodies<d>>(Stage::AdvancePositions));
+                    v.push_back(std::make_unique<FollowBoundBodies<d>>(Stage::AdvanceVelocity));
+                    return v;
+                  },
+                  ""});
+  r.addSystem<d>({"particle_contact",
+                  "particles against rigid bodies (zero restitution, Coulomb friction): particle_contact (Step III), "
+                  "particle_push_out (Step IV), particle_velocity_contact (Step V, two-way)",
+                  [] { return makeParticleContactSystems<d>(); }, ""});
+  r.addSystem<d>({"deformable_diagnostics", "energies (kinetic, gravity, elastic) and momenta of deformables",
+                  [] { return single<DeformableDiagnostics<d>>(); }, ""});
+}
+
+template <int d>
+void registerParticleCollisionSystems(Registry& r) {
+  r.addSystem<d>({"particle_collisions",
+                  "Step II (Sec. 4.4) particles against rigid bodies, two-way, restitution zero, Coulomb friction",
+                  [] { return makeParticleCollisionSystems<d>(); }, ""});
+}
+
+template void registerParticleCollisionSystems<2>(Registry&);
+template void registerParticleCollisionSystems<3>(Registry&);
+template void registerDeformableComponents<2>(Registry&);
+template void registerDeformableComponents<3>(Registry&);
+template void registerDeformableSystems<2>(Registry&);
+template void registerDeformableSystems<3>(Registry&);
+
+}  // namespace monolith

@@ -1,0 +1,299 @@
+#include "solvers/deformable/elasticity.h"
+
+#include <cmath>
+
+#include <Eigen/LU>
+#include <Eigen/SVD>
+
+// GCC 12 reports Eigen's JacobiSVD internals as maybe-uninitialized where they are instantiated
+// (a false positive inside Eigen); silenced for this file.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+
+namespace monolith::solvers::deformable {
+
+namespace {
+
+// Each element writes only its own slot; a fixed grain and simple partitioner keep the split
+// independent of the thread count, and the scatter afterwards is serial in element order, so the
+// forces are bitwise the same on any number of threads.
+template <class F>
+void forEachElement(int n, F&& f) {
+  if (n <= 0) return;
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, n, 256),
+      [&](const tbb::blocked_range<int>& r) {
+        for (int i = r.begin(); i != r.end(); ++i) f(i);
+      },
+      tbb::simple_partitioner());
+}
+
+template <int d>
+VecD<d> at(const double* a, int i) {
+  return Eigen::Map<const VecD<d>>(a + d * i);
+}
+
+template <int d>
+MatD<d> edgeMatrix(const ForceModel<d>& fm, int e, const double* a) {
+  const int* n = &fm.elements[(d + 1) * e];
+  MatD<d> D;
+  for (int k = 0; k < d; ++k) D.col(k) = at<d>(a, n[k + 1]) - at<d>(a, n[0]);
+  return D;
+}
+
+// Adds the nodal forces of an element whose force on the edge matrix Ds is G (d x d): node k+1
+// receives column k, node 0 minus their sum.
+template <int d>
+void scatter(const ForceModel<d>& fm, int e, const MatD<d>& G, double* f) {
+  const int* n = &fm.elements[(d + 1) * e];
+  for (int k = 0; k < d; ++k) {
+    Eigen::Map<VecD<d>>(f + d * n[k + 1]) += G.col(k);
+    Eigen::Map<VecD<d>>(f + d * n[0]) -= G.col(k);
+  }
+}
+
+template <int d>
+MatD<d> deviator(const MatD<d>& A) {
+  return A - (A.trace() / d) * MatD<d>::Identity();
+}
+
+}  // namespace
+
+template <int d>
+void rotatedSvd(const MatD<d>& F, MatD<d>& U, VecD<d>& s, MatD<d>& V) {
+  Eigen::JacobiSVD<MatD<d>> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  U = svd.matrixU();
+  V = svd.matrixV();
+  s = svd.singularValues();
+  // [81] Sec. 5: make U and V rotations; the reflection goes into the smallest singular value.
+  if (U.determinant() < 0) {
+    U.col(d - 1) *= -1;
+    s(d - 1) *= -1;
+  }
+  if (V.determinant() < 0) {
+    V.col(d - 1) *= -1;
+    s(d - 1) *= -1;
+  }
+}
+
+template <int d>
+double energyDensity(Model m, const Lame& lame, const VecD<d>& s, double clamp) {
+  if (m == Model::Corotated) {
+    const VecD<d> e = s - VecD<d>::Ones();
+    return lame.mu * e.squaredNorm() + 0.5 * lame.lambda * e.sum() * e.sum();
+  }
+  const VecD<d> c = s.cwiseMax(clamp);
+  const double lnJ = c.array().log().sum();
+  return 0.5 * lame.mu * (c.squaredNorm() - d) - lame.mu * lnJ + 0.5 * lame.lambda * lnJ * lnJ;
+}
+
+template <int d>
+VecD<d> diagonalStress(Model m, const Lame& lame, const VecD<d>& s, double clamp) {
+  if (m == Model::Corotated) {
+    const VecD<d> e = s - VecD<d>::Ones();
+    return 2 * lame.mu * e + VecD<d>::Constant(lame.lambda * e.sum());
+  }
+  const VecD<d> c = s.cwiseMax(clamp);
+  const double lnJ = c.array().log().sum();
+  VecD<d> P;
+  for (int i = 0; i < d; ++i) P(i) = lame.mu * c(i) - (lame.mu - lame.lambda * lnJ) / c(i);
+  return P;
+}
+
+template <int d>
+int ForceModel<d>::dampingRows() const {
+  int rows = 0;
+  if (finiteElements() && rayleighBeta > 0) rows += (d * d + 1) * elementCount();
+  if (rayleighAlpha > 0) rows += d * static_cast<int>(mass.size());
+  rows += springCount();
+  return rows;
+}
+
+template <int d>
+MatD<d> deformationGradient(const ForceModel<d>& fm, int e, const double* x) {
+  return edgeMatrix(fm, e, x) * fm.DmInv[e];
+}
+
+template <int d>
+double elasticEnergy(const ForceModel<d>& fm, const double* x) {
+  double E = 0;
+  if (fm.finiteElements()) {
+    for (int e = 0; e < fm.elementCount(); ++e) {
+      MatD<d> U, V;
+      VecD<d> s;
+      rotatedSvd<d>(deformationGradient(fm, e, x), U, s, V);
+      E += fm.restVolume[e] * energyDensity<d>(fm.model, fm.lame, s, fm.clamp);
+    }
+  }
+  for (int k = 0; k < fm.springCount(); ++k) {
+    const double L = (at<d>(x, fm.springs[2 * k + 1]) - at<d>(x, fm.springs[2 * k])).norm();
+    E += 0.5 * fm.springK[k] * (L - fm.springRest[k]) * (L - fm.springRest[k]);
+  }
+  return E;
+}
+
+template <int d>
+void addElasticForces(const ForceModel<d>& fm, const double* x, double* f) {
+  if (fm.finiteElements()) {
+    std::vector<MatD<d>> G(fm.elementCount());
+    forEachElement(fm.elementCount(), [&](int e) {
+      MatD<d> U, V;
+      VecD<d> s;
+      rotatedSvd<d>(deformationGradient(fm, e, x), U, s, V);
+      const MatD<d> P = U * diagonalStress<d>(fm.model, fm.lame, s, fm.clamp).asDiagonal() * V.transpose();
+      G[e] = -fm.restVolume[e] * P * fm.DmInv[e].transpose();
+    });
+    for (int e = 0; e < fm.elementCount(); ++e) scatter(fm, e, G[e], f);
+  }
+  for (int k = 0; k < fm.springCount(); ++k) {
+    const int i = fm.springs[2 * k], j = fm.springs[2 * k + 1];
+    const VecD<d> l = at<d>(x, j) - at<d>(x, i);
+    const double L = l.norm();
+    if (L == 0) continue;
+    const VecD<d> fi = fm.springK[k] * (L - fm.springRest[k]) / L * l;
+    Eigen::Map<VecD<d>>(f + d * i) += fi;
+    Eigen::Map<VecD<d>>(f + d * j) -= fi;
+  }
+}
+
+template <int d>
+std::vector<MatD<d>> dampingRotations(const ForceModel<d>& fm, const double* x) {
+  std::vector<MatD<d>> R;
+  if (!fm.finiteElements() || fm.rayleighBeta <= 0) return R;
+  R.resize(fm.elementCount());
+  forEachElement(fm.elementCount(), [&](int e) {
+    MatD<d> U, V;
+    VecD<d> s;
+    rotatedSvd<d>(deformationGradient(fm, e, x), U, s, V);
+    R[e] = U * V.transpose();
+  });
+  return R;
+}
+
+namespace {
+
+template <int d>
+VecD<d> springDirection(const ForceModel<d>& fm, int k, const double* x) {
+  const VecD<d> l = at<d>(x, fm.springs[2 * k + 1]) - at<d>(x, fm.springs[2 * k]);
+  const double L = l.norm();
+  return L > 0 ? VecD<d>(l / L) : VecD<d>::Zero();
+}
+
+}  // namespace
+
+template <int d>
+void addDampingForces(const ForceModel<d>& fm, const std::vector<MatD<d>>& R, const double* x, const double* v,
+                      double* f) {
+  if (!R.empty()) {
+    std::vector<MatD<d>> G(fm.elementCount());
+    const double beta = fm.rayleighBeta;
+    forEachElement(fm.elementCount(), [&](int e) {
+      const MatD<d> Fdot = edgeMatrix(fm, e, v) * fm.DmInv[e];
+      const MatD<d> RtF = R[e].transpose() * Fdot;
+      const MatD<d> eps = 0.5 * (RtF + RtF.transpose());
+      const MatD<d> S = beta * (2 * fm.lame.mu * eps + fm.lame.lambda * eps.trace() * MatD<d>::Identity());
+      G[e] = -fm.restVolume[e] * R[e] * S * fm.DmInv[e].transpose();
+    });
+    for (int e = 0; e < fm.elementCount(); ++e) scatter(fm, e, G[e], f);
+  }
+  if (fm.rayleighAlpha > 0)
+    for (std::size_t p = 0; p < fm.mass.size(); ++p)
+      for (int a = 0; a < d; ++a) f[d * p + a] -= fm.rayleighAlpha * fm.mass[p] * v[d * p + a];
+  for (int k = 0; k < fm.springCount(); ++k) {
+    const int i = fm.springs[2 * k], j = fm.springs[2 * k + 1];
+    const VecD<d> n = springDirection(fm, k, x);
+    const VecD<d> fi = fm.springC[k] * n.dot(at<d>(v, j) - at<d>(v, i)) * n;
+    Eigen::Map<VecD<d>>(f + d * i) += fi;
+    Eigen::Map<VecD<d>>(f + d * j) -= fi;
+  }
+}
+
+template <int d>
+void applyDampingFactor(const ForceModel<d>& fm, const std::vector<MatD<d>>& R, const double* x, double dt,
+                        const double* v, double* y) {
+  int row = 0;
+  if (!R.empty()) {
+    forEachElement(fm.elementCount(), [&](int e) {
+      const double w = dt * fm.restVolume[e] * fm.rayleighBeta;
+      const double a = std::sqrt(w * 2 * fm.lame.mu), b = std::sqrt(w * (2 * fm.lame.mu / d + fm.lame.lambda));
+      const MatD<d> RtF = R[e].transpose() * edgeMatrix(fm, e, v) * fm.DmInv[e];
+      const MatD<d> eps = 0.5 * (RtF + RtF.transpose());
+      const MatD<d> dev = deviator<d>(eps);
+      double* out = y + (d * d + 1) * e;
+      for (int i = 0; i < d; ++i)
+        for (int j = 0; j < d; ++j) out[d * i + j] = a * dev(i, j);
+      out[d * d] = b * eps.trace();
+    });
+    row += (d * d + 1) * fm.elementCount();
+  }
+  if (fm.rayleighAlpha > 0) {
+    for (std::size_t p = 0; p < fm.mass.size(); ++p) {
+      const double a = std::sqrt(dt * fm.rayleighAlpha * fm.mass[p]);
+      for (int k = 0; k < d; ++k) y[row++] = a * v[d * p + k];
+    }
+  }
+  for (int k = 0; k < fm.springCount(); ++k) {
+    const int i = fm.springs[2 * k], j = fm.springs[2 * k + 1];
+    y[row++] = std::sqrt(dt * fm.springC[k]) * springDirection(fm, k, x).dot(at<d>(v, j) - at<d>(v, i));
+  }
+}
+
+template <int d>
+void applyDampingFactorTranspose(const ForceModel<d>& fm, const std::vector<MatD<d>>& R, const double* x, double dt,
+                                 const double* y, double* f) {
+  int row = 0;
+  if (!R.empty()) {
+    std::vector<MatD<d>> G(fm.elementCount());
+    forEachElement(fm.elementCount(), [&](int e) {
+      const double w = dt * fm.restVolume[e] * fm.rayleighBeta;
+      const double a = std::sqrt(w * 2 * fm.lame.mu), b = std::sqrt(w * (2 * fm.lame.mu / d + fm.lame.lambda));
+      const double* in = y + (d * d + 1) * e;
+      MatD<d> Y;
+      for (int i = 0; i < d; ++i)
+        for (int j = 0; j < d; ++j) Y(i, j) = in[d * i + j];
+      // The adjoint of v -> (a dev(e), b tr e), e = sym(R^T Ds(v) DmInv): dev and sym are
+      // self-adjoint projections, so the stress-like matrix is a sym(dev Y) + b y_t I.
+      const MatD<d> devY = deviator<d>(Y);
+      const MatD<d> S = a * 0.5 * (devY + devY.transpose()) + b * in[d * d] * MatD<d>::Identity();
+      G[e] = R[e] * S * fm.DmInv[e].transpose();
+    });
+    for (int e = 0; e < fm.elementCount(); ++e) scatter(fm, e, G[e], f);
+    row += (d * d + 1) * fm.elementCount();
+  }
+  if (fm.rayleighAlpha > 0) {
+    for (std::size_t p = 0; p < fm.mass.size(); ++p) {
+      const double a = std::sqrt(dt * fm.rayleighAlpha * fm.mass[p]);
+      for (int k = 0; k < d; ++k) f[d * p + k] += a * y[row++];
+    }
+  }
+  for (int k = 0; k < fm.springCount(); ++k) {
+    const int i = fm.springs[2 * k], j = fm.springs[2 * k + 1];
+    const VecD<d> g = std::sqrt(dt * fm.springC[k]) * y[row++] * springDirection(fm, k, x);
+    Eigen::Map<VecD<d>>(f + d * i) -= g;
+    Eigen::Map<VecD<d>>(f + d * j) += g;
+  }
+}
+
+#define MONOLITH_INSTANTIATE(D)                                                                                   \
+  template void rotatedSvd<D>(const MatD<D>&, MatD<D>&, VecD<D>&, MatD<D>&);                                      \
+  template double energyDensity<D>(Model, const Lame&, const VecD<D>&, double);                                   \
+  template VecD<D> diagonalStress<D>(Model, const Lame&, const VecD<D>&, double);                                 \
+  template struct ForceModel<D>;                                                                                  \
+  template MatD<D> deformationGradient<D>(const ForceModel<D>&, int, const double*);                              \
+  template double elasticEnergy<D>(const ForceModel<D>&, const double*);                                          \
+  template void addElasticForces<D>(const ForceModel<D>&, const double*, double*);                                \
+  template std::vector<MatD<D>> dampingRotations<D>(const ForceModel<D>&, const double*);                         \
+  template void addDampingForces<D>(const ForceModel<D>&, const std::vector<MatD<D>>&, const double*,             \
+                                    const double*, double*);                                                      \
+  template void applyDampingFactor<D>(const ForceModel<D>&, const std::vector<MatD<D>>&, const double*, double,   \
+                                      const double*, double*);                                                    \
+  template void applyDampingFactorTranspose<D>(const ForceModel<D>&, const std::vector<MatD<D>>&, const double*, \
+                                               double, const double*, double*);
+MONOLITH_INSTANTIATE(2)
+MONOLITH_INSTANTIATE(3)
+#undef MONOLITH_INSTANTIATE
+
+}  // namespace monolith::solvers::deformable

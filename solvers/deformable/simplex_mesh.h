@@ -1,0 +1,68 @@
+#pragma once
+// Simplex meshes of deformable bodies, entity-free: tetrahedra in 3-D, triangles in 2-D.
+// A built-in mesher (a structured grid of cubes/squares split into simplices, kept where a
+// level set is negative and its boundary vertices moved onto the surface) so scenes need no
+// files, readers for Gmsh .msh (v2 ASCII) and TetGen .node/.ele, and the checks every mesh
+// passes before it is simulated.
+#include <Eigen/Core>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "solvers/deformable/elasticity.h"
+
+namespace monolith::solvers::deformable {
+
+template <int d>
+struct MeshData {
+  std::vector<VecD<d>> x;     // vertices
+  std::vector<int> elements;  // d+1 vertex indices per simplex, positively oriented
+  int elementCount() const { return static_cast<int>(elements.size()) / (d + 1); }
+};
+
+// A mesh file that cannot be read or is not a valid mesh: the message names the file, the
+// line or element and what is wrong.
+struct MeshError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Box [-a, a] (componentwise), cells of edge ~h (at least one per axis), each cube split into
+// six tetrahedra around its main diagonal (each square into two triangles).
+template <int d>
+MeshData<d> boxMesh(const VecD<d>& halfExtents, double h);
+// Ball of the given radius: grid cells whose centre is inside, the surface vertices then moved
+// radially onto the sphere where no element inverts or flattens by it.
+template <int d>
+MeshData<d> sphereMesh(double radius, double h);
+
+// "" when the mesh is valid, else what is wrong, naming the first bad element or vertex:
+// indices out of range, repeated vertices in an element, inverted (negative signed volume) or
+// degenerate (volume below 1e-10 of its edge length^d) elements, vertices used by no element,
+// and a mesh in more than one connected piece.
+template <int d>
+std::string meshProblem(const MeshData<d>& mesh);
+
+// Readers. 3-D takes the 4-node tetrahedra (Gmsh type 4), 2-D the 3-node triangles (type 2,
+// z dropped); other element types (points, lines, boundary faces) are skipped. Negatively
+// oriented simplices are NOT reordered: they are reported as inverted by meshProblem.
+template <int d>
+MeshData<d> readGmsh(const std::string& path);
+// TetGen: `base`.node and `base`.ele (3-D only; 0- or 1-based as the .node numbering says).
+MeshData<3> readTetgen(const std::string& base);
+
+// Lumped masses (density * volume / (d+1) per vertex), rest shape matrices and volumes of
+// the elements, and for the spring model the unique edges of the mesh with their rest lengths.
+struct Material {
+  Model model = Model::Corotated;
+  double density = 1000;
+  double youngsModulus = 1e5;
+  double poissonRatio = 0.3;
+  double rayleighAlpha = 0, rayleighBeta = 0;
+  double overdamping = 0;     // spring damping as a fraction of critical damping
+  double clamp = 0.3;
+};
+template <int d>
+ForceModel<d> prepareForceModel(const std::vector<double>& restX, const std::vector<int>& elements,
+                                const Material& material);
+
+}  // namespace monolith::solvers::deformable

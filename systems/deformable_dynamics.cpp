@@ -1,0 +1,219 @@
+#include "systems/deformable_dynamics.h"
+
+#include "solvers/deformable/simplex_mesh.h"
+#include "solvers/fluid/krylov.h"
+
+namespace monolith {
+
+namespace dm = solvers::deformable;
+
+template <int d>
+dm::ForceModel<d> forceModelOf(const Particles<d>& p, const SimplexMesh<d>& mesh, const Elasticity& e) {
+  dm::Material mat;
+  mat.model = static_cast<dm::Model>(e.model);
+  mat.density = e.density;
+  mat.youngsModulus = e.youngsModulus;
+  mat.poissonRatio = e.poissonRatio;
+  mat.rayleighAlpha = e.rayleighAlpha;
+  mat.rayleighBeta = e.rayleighBeta;
+  mat.overdamping = e.overdamping;
+  mat.clamp = e.clamp;
+  dm::ForceModel<d> fm = dm::prepareForceModel<d>(mesh.restX, mesh.elements, mat);
+  fm.mass = p.m;  // the state's masses are authoritative
+  return fm;
+}
+
+template <int d>
+const dm::ForceModel<d>& ForceModelCache<d>::get(Entity e, const Particles<d>& p, const SimplexMesh<d>& m,
+                                                 const Elasticity& el) {
+  const std::uint64_t key = (std::uint64_t(e.index) << 32) | e.generation;
+  auto it = models_.find(key);
+  if (it == models_.end()) it = models_.emplace(key, forceModelOf(p, m, el)).first;
+  return it->second;
+}
+
+template <int d>
+std::vector<double> explicitForces(const dm::ForceModel<d>& fm, const Particles<d>& p, const Vec<d>& gravity) {
+  std::vector<double> f(p.x.size(), 0.0);
+  dm::addElasticForces<d>(fm, p.x.data(), f.data());
+  for (int i = 0; i < p.count(); ++i)
+    for (int a = 0; a < d; ++a) f[d * i + a] = p.fixed[i] ? 0.0 : f[d * i + a] + p.m[i] * gravity(a);
+  return f;
+}
+
+template <int d>
+ImplicitSolveReport implicitDampingSolve(const dm::ForceModel<d>& fm, const Particles<d>& p,
+                                         const std::vector<double>& f, double h, std::vector<double>& u,
+                                         std::vector<double>* dampingForce) {
+  const int n = static_cast<int>(p.x.size());
+  ImplicitSolveReport report;
+  u.assign(n, 0.0);
+  auto constrained = [&](int i) { return p.fixed[i / d] != 0; };
+  if (fm.dampingRows() == 0) {  // no damping: M u = M v + h f directly
+    for (int i = 0; i < n; ++i) u[i] = constrained(i) ? p.v[i] : p.v[i] + h * f[i] / p.m[i / d];
+    if (dampingForce) dampingForce->assign(n, 0.0);
+    return report;
+  }
+  const auto R = dm::dampingRotations<d>(fm, p.x.data());
+  Eigen::VectorXd diag(n), prescribed = Eigen::VectorXd::Zero(n);
+  for (int i = 0; i < n; ++i) {
+    diag(i) = p.m[i / d];
+    if (constrained(i)) prescribed(i) = p.v[i];  // fixed: 0; bound: the body's point velocity
+  }
+  const solvers::LinearOperator A = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
+    std::vector<double> Dv(n, 0.0);
+    dm::addDampingForces<d>(fm, R, p.x.data(), in.data(), Dv.data());
+    for (int i = 0; i < n; ++i) out(i) = diag(i) * in(i) - h * Dv[i];
+  };
+  // Constrained components are prescribed: u = w + prescribed with w zero on them, and
+  // P A P w = P (b - A prescribed), P zeroing the constrained components. P is symmetric, so
+  // P A P stays SPD on the free subspace (Sec. 4.7.3 with the constraint rows of the fixed and
+  // bound particles).
+  const solvers::Projector project = [&](Eigen::VectorXd& v) {
+    for (int i = 0; i < n; ++i)
+      if (constrained(i)) v(i) = 0;
+  };
+  Eigen::VectorXd b(n), Ap(n), x(n);
+  A(prescribed, Ap);
+  for (int i = 0; i < n; ++i) {
+    b(i) = p.m[i / d] * p.v[i] + h * f[i] - Ap(i);
+    x(i) = p.v[i];
+  }
+  solvers::CgSettings settings;
+  settings.relativeTolerance = 1e-10;
+  settings.maxIterations = 2000;
+  project(x);
+  const solvers::CgReport r =
+      solvers::conjugateGradient(A, solvers::jacobiPreconditioner(diag), project, b, x, settings);
+  report.iterations = r.iterations;
+  report.relativeResidual = r.relativeResidual();
+  for (int i = 0; i < n; ++i) u[i] = x(i) + prescribed(i);
+  if (dampingForce) {
+    dampingForce->assign(n, 0.0);
+    dm::addDampingForces<d>(fm, R, p.x.data(), u.data(), dampingForce->data());
+  }
+  return report;
+}
+
+namespace {
+
+template <int d>
+AngularVec<d> armCross(const Vec<d>& r, const Vec<d>& f) {
+  if constexpr (d == 3) return r.cross(f);
+  else return AngularVec<2>(r.x() * f.y() - r.y() * f.x());
+}
+
+template <int d>
+void applyBoundDamping(World<d>& world, const RigidBinding<d>& b, const Particles<d>& p, const std::vector<double>& Du,
+                       double duration) {
+  const auto names = b.bodyNames();
+  std::vector<RigidBody<d>*> bodies;
+  for (const auto& name : names) {
+    const auto e = world.find(name);
+    bodies.push_back(e ? world.template get<RigidBody<d>>(*e) : nullptr);
+  }
+  for (std::size_t k = 0; k < b.particle.size(); ++k) {
+    RigidBody<d>* body = bodies[b.body[k]];
+    if (!body || body->isStatic) continue;
+    const int i = b.particle[k];
+    const Vec<d> j = duration * Vec<d>(Eigen::Map<const Vec<d>>(&Du[d * i]));
+    body->v += j / body->mass;
+    body->L += armCross<d>(Vec<d>(Eigen::Map<const Vec<d>>(&p.x[d * i]) - body->x), j);
+  }
+}
+
+}  // namespace
+
+template <int d>
+void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
+  const bool half = stage_ == Stage::AdvanceVelocityHalf;
+  const Vec<d> g = world.settings().gravity;
+  int iterations = 0;
+  world.template each<Particles<d>, SimplexMesh<d>, Elasticity>(
+      [&](Entity e, Particles<d>& p, SimplexMesh<d>& mesh, Elasticity& el) {
+        const auto& fm = cache_.get(e, p, mesh, el);
+        const std::vector<double> f = explicitForces(fm, p, g);
+        std::vector<double> u;
+        const double h = half ? 0.5 * ctx.dt : 0.25 * ctx.dt;
+        RigidBinding<d>* binding = world.template get<RigidBinding<d>>(e);
+        std::vector<double> Du;
+        const ImplicitSolveReport r = implicitDampingSolve(fm, p, f, h, u, binding ? &Du : nullptr);
+        iterations = std::max(iterations, r.iterations);
+        // The damping forces the solve put on bound particles act on their bodies: over this
+        // stage's velocity change, h (Step I) or 2h (Step V's extrapolation) times D u.
+        if (binding) applyBoundDamping(world, *binding, p, Du, half ? h : 2 * h);
+        if (half) p.v = u;
+        else
+          for (std::size_t i = 0; i < u.size(); ++i) p.v[i] = 2 * u[i] - p.v[i];
+      });
+  ctx.diagnostics.max(half ? "deformable_cg_iterations_half" : "deformable_cg_iterations", iterations);
+}
+
+template <int d>
+void AdvanceDeformablePositions<d>::run(World<d>& world, StepContext& ctx) {
+  world.template each<Particles<d>>([&](Entity, Particles<d>& p) {
+    for (int i = 0; i < p.count(); ++i)
+      if (!p.fixed[i])
+        for (int a = 0; a < d; ++a) p.x[d * i + a] += ctx.dt * p.v[d * i + a];
+  });
+}
+
+template <int d>
+DeformableTotals measureDeformableTotals(const World<d>& world) {
+  DeformableTotals t;
+  const auto* pool = world.template findPool<Particles<d>>();
+  if (!pool) return t;
+  const Vec<d> g = world.settings().gravity;
+  for (std::size_t k = 0; k < pool->size(); ++k) {
+    const Entity e = pool->entities()[k];
+    const Particles<d>& p = pool->components()[k];
+    for (int i = 0; i < p.count(); ++i) {
+      if (p.fixed[i] == 2) continue;  // bound: its mass is part of its rigid body's
+      const Eigen::Map<const Vec<d>> x(&p.x[d * i]), v(&p.v[d * i]);
+      t.kinetic += 0.5 * p.m[i] * v.squaredNorm();
+      if (p.fixed[i] == 0) t.potential -= p.m[i] * g.dot(x);
+      Eigen::Vector3d x3 = Eigen::Vector3d::Zero(), p3 = Eigen::Vector3d::Zero();
+      x3.template head<d>() = x;
+      p3.template head<d>() = p.m[i] * v;
+      t.linearMomentum += p3;
+      t.angularMomentum += x3.cross(p3);
+    }
+    const auto* mesh = world.template get<SimplexMesh<d>>(e);
+    const auto* el = world.template get<Elasticity>(e);
+    if (mesh && el) t.elastic += dm::elasticEnergy<d>(forceModelOf(p, *mesh, *el), p.x.data());
+  }
+  return t;
+}
+
+template <int d>
+void DeformableDiagnostics<d>::run(World<d>& world, StepContext& ctx) {
+  const DeformableTotals t = measureDeformableTotals(world);
+  auto& out = ctx.diagnostics;
+  out.add("kinetic_energy", t.kinetic);
+  out.add("potential_energy", t.potential + t.elastic);
+  out.add("total_energy", t.kinetic + t.potential + t.elastic);
+  out.set("deformable_elastic_energy", t.elastic);
+  out.add("linear_momentum_x", t.linearMomentum.x());
+  out.add("linear_momentum_y", t.linearMomentum.y());
+  out.add("linear_momentum_z", t.linearMomentum.z());
+  out.add("angular_momentum_x", t.angularMomentum.x());
+  out.add("angular_momentum_y", t.angularMomentum.y());
+  out.add("angular_momentum_z", t.angularMomentum.z());
+}
+
+#define MONOLITH_INSTANTIATE(D)                                                                                 \
+  template dm::ForceModel<D> forceModelOf<D>(const Particles<D>&, const SimplexMesh<D>&, const Elasticity&);   \
+  template class ForceModelCache<D>;                                                                            \
+  template std::vector<double> explicitForces<D>(const dm::ForceModel<D>&, const Particles<D>&, const Vec<D>&); \
+  template ImplicitSolveReport implicitDampingSolve<D>(const dm::ForceModel<D>&, const Particles<D>&,          \
+                                                       const std::vector<double>&, double, std::vector<double>&, \
+                                                       std::vector<double>*);                                   \
+  template class AdvanceDeformableVelocity<D>;                                                                  \
+  template class AdvanceDeformablePositions<D>;                                                                 \
+  template class DeformableDiagnostics<D>;                                                                      \
+  template DeformableTotals measureDeformableTotals<D>(const World<D>&);
+MONOLITH_INSTANTIATE(2)
+MONOLITH_INSTANTIATE(3)
+#undef MONOLITH_INSTANTIATE
+
+}  // namespace monolith

@@ -1,0 +1,116 @@
+#pragma once
+// The Newmark stages of Ch. 4 for deformable solids, beside the rigid ones (thesis Sec. 4.2,
+// 4.3, 4.6, 4.7; Bridson, Marino, Fedkiw 2003 [28]). Elastic forces are explicit, damping
+// forces implicit (a symmetric positive definite solve by CG, solvers/fluid/krylov.h):
+//  Step I   (advance_deformable_velocity_half): (M - dt/2 D(x^n)) v^{n+1/2} = M v^n + dt/2 f(x^n)
+//  Step IV  (advance_deformable_positions):     x^{n+1} = x^n + dt v^{n+1/2}
+//  Step V   (advance_deformable_velocity):      trapezoid rule in the damping,
+//           v^{n+1} = v^{n+1/2} + dt/2 M^{-1} (f(x^{n+1}) + D (v^{n+1/2} + v^{n+1})/2),
+//           taken as backward Euler over dt/4 to the average u = (v^{n+1/2} + v^{n+1})/2,
+//           (M - dt/4 D) u = M v^{n+1/2} + dt/4 f(x^{n+1}), then extrapolated v^{n+1} = 2u - v^{n+1/2}
+//           (Sec. 4.7: "a backward Euler solve followed by extrapolation", as in [138]).
+// f holds the elastic forces and gravity m g. Without damping Steps I, IV, V are velocity
+// Verlet (symplectic: the energy oscillates but does not drift). Fixed particles are
+// constrained in both solves by the projection P (zeroing their velocity components), applied to
+// the right-hand side and inside CG so that P A P stays symmetric (Sec. 4.7.3).
+#include <cstdint>
+#include <unordered_map>
+
+#include "components/deformable.h"
+#include "components/rigid_body.h"
+#include "ecs/system.h"
+#include "solvers/deformable/elasticity.h"
+
+namespace monolith {
+
+// The force model of a body, built from its components (rest data, masses, material).
+template <int d>
+solvers::deformable::ForceModel<d> forceModelOf(const Particles<d>& p, const SimplexMesh<d>& mesh, const Elasticity& e);
+
+// Keeps one force model per body (the rest data never changes).
+template <int d>
+class ForceModelCache {
+ public:
+  const solvers::deformable::ForceModel<d>& get(Entity e, const Particles<d>& p, const SimplexMesh<d>& m,
+                                                const Elasticity& el);
+
+ private:
+  std::unordered_map<std::uint64_t, solvers::deformable::ForceModel<d>> models_;
+};
+
+struct ImplicitSolveReport {
+  int iterations = 0;
+  double relativeResidual = 0;
+};
+
+// Solves (M - h D(x)) u = M v + h f with the fixed and bound particles' u prescribed (their
+// current v) and projected out of the solve; u returned in `u`, and D u in `dampingForce` if given.
+template <int d>
+ImplicitSolveReport implicitDampingSolve(const solvers::deformable::ForceModel<d>& fm, const Particles<d>& p,
+                                         const std::vector<double>& f, double h, std::vector<double>& u,
+                                         std::vector<double>* dampingForce = nullptr);
+
+// Elastic forces plus gravity at the particles' current positions (zero on fixed particles).
+template <int d>
+std::vector<double> explicitForces(const solvers::deformable::ForceModel<d>& fm, const Particles<d>& p,
+                                   const Vec<d>& gravity);
+
+template <int d>
+class AdvanceDeformableVelocity final : public System<d> {
+ public:
+  explicit AdvanceDeformableVelocity(Stage s) : stage_(s) {}
+  std::string name() const override {
+    return stage_ == Stage::AdvanceVelocityHalf ? "advance_deformable_velocity_half" : "advance_deformable_velocity";
+  }
+  Stage stage() const override { return stage_; }
+  std::vector<std::string> reads() const override { return {SimplexMesh<d>::kName, Elasticity::kName}; }
+  std::vector<std::string> writes() const override {
+    return {Particles<d>::kName, RigidBody<d>::kName, "diagnostics"};  // bodies: damping on bound particles
+  }
+  bool needed(const World<d>& w) const override { return w.template count<SimplexMesh<d>>() > 0; }
+  void run(World<d>& world, StepContext& ctx) override;
+
+ private:
+  Stage stage_;
+  ForceModelCache<d> cache_;
+};
+
+template <int d>
+class AdvanceDeformablePositions final : public System<d> {
+ public:
+  std::string name() const override { return "advance_deformable_positions"; }
+  Stage stage() const override { return Stage::AdvancePositions; }
+  std::vector<std::string> reads() const override { return {}; }
+  std::vector<std::string> writes() const override { return {Particles<d>::kName}; }
+  bool needed(const World<d>& w) const override { return w.template count<Particles<d>>() > 0; }
+  void run(World<d>& world, StepContext& ctx) override;
+};
+
+// Kinetic, gravitational and elastic energy and the momenta of the particles, added to the
+// standard metrics columns (the rigid bodies' are added by rigid_diagnostics).
+template <int d>
+class DeformableDiagnostics final : public System<d> {
+ public:
+  std::string name() const override { return "deformable_diagnostics"; }
+  Stage stage() const override { return Stage::Diagnostics; }
+  std::vector<std::string> reads() const override {
+    return {Particles<d>::kName, SimplexMesh<d>::kName, Elasticity::kName};
+  }
+  std::vector<std::string> writes() const override { return {"diagnostics"}; }
+  bool needed(const World<d>& w) const override { return w.template count<Particles<d>>() > 0; }
+  void run(World<d>& world, StepContext& ctx) override;
+
+ private:
+  ForceModelCache<d> cache_;
+};
+
+struct DeformableTotals {
+  double kinetic = 0, potential = 0, elastic = 0;
+  Eigen::Vector3d linearMomentum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angularMomentum = Eigen::Vector3d::Zero();
+};
+// Serial in pool and particle order (deterministic). Fixed particles count (their v is zero).
+template <int d>
+DeformableTotals measureDeformableTotals(const World<d>& world);
+
+}  // namespace monolith

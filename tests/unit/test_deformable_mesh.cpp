@@ -1,0 +1,125 @@
+// Built-in mesher and mesh readers (solvers/deformable/simplex_mesh.h): the meshes are valid,
+// have the right volume, and bad input is rejected naming the file, the element and the fault.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "solvers/deformable/simplex_mesh.h"
+
+namespace dm = monolith::solvers::deformable;
+
+namespace {
+
+template <int d>
+double volume(const dm::MeshData<d>& m) {
+  dm::Material mat;
+  mat.density = 1;
+  std::vector<double> X;
+  for (const auto& x : m.x)
+    for (int a = 0; a < d; ++a) X.push_back(x(a));
+  const auto fm = dm::prepareForceModel<d>(X, m.elements, mat);
+  double v = 0;
+  for (double q : fm.restVolume) v += q;
+  return v;
+}
+
+std::string writeFile(const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::temp_directory_path() / "monolith_mesh_tests";
+  std::filesystem::create_directories(dir);
+  const auto path = (dir / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(DeformableMesh, BoxMeshIsValidWithExactVolume) {
+  const auto m3 = dm::boxMesh<3>(Eigen::Vector3d(1.0, 0.5, 0.25), 0.25);
+  EXPECT_EQ(dm::meshProblem(m3), "");
+  EXPECT_EQ(m3.elementCount(), 8 * 4 * 2 * 6);
+  EXPECT_NEAR(volume(m3), 2.0 * 1.0 * 0.5, 1e-12);
+  const auto m2 = dm::boxMesh<2>(Eigen::Vector2d(1.0, 0.5), 0.5);
+  EXPECT_EQ(dm::meshProblem(m2), "");
+  EXPECT_NEAR(volume(m2), 2.0, 1e-12);
+}
+
+// The ball's volume converges to 4/3 pi r^3 as the cells shrink (the cut-cell boundary moved
+// onto the sphere); at h = r/4 within 8 %, at r/8 within 4 %.
+TEST(DeformableMesh, SphereMeshConvergesToBallVolume) {
+  const double r = 0.5, exact = 4.0 / 3.0 * M_PI * r * r * r;
+  const auto coarse = dm::sphereMesh<3>(r, r / 4), fine = dm::sphereMesh<3>(r, r / 8);
+  EXPECT_EQ(dm::meshProblem(coarse), "");
+  EXPECT_EQ(dm::meshProblem(fine), "");
+  const double ec = std::abs(volume(coarse) - exact) / exact, ef = std::abs(volume(fine) - exact) / exact;
+  EXPECT_LT(ec, 0.08);
+  EXPECT_LT(ef, 0.04);
+  EXPECT_LT(ef, ec);
+  const auto disk = dm::sphereMesh<2>(r, r / 8);
+  EXPECT_EQ(dm::meshProblem(disk), "");
+  EXPECT_NEAR(volume(disk), M_PI * r * r, 0.03 * M_PI * r * r);
+}
+
+TEST(DeformableMesh, ProblemsNameElementAndFault) {
+  dm::MeshData<3> m;
+  m.x = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0, 1),
+         Eigen::Vector3d(1, 1, 1)};
+  m.elements = {0, 1, 2, 3, 1, 2, 3, 4};
+  EXPECT_EQ(dm::meshProblem(m), "");
+  m.elements = {0, 1, 2, 3, 1, 3, 2, 4};  // second tetrahedron listed in negative order
+  EXPECT_NE(dm::meshProblem(m).find("element 1: inverted"), std::string::npos) << dm::meshProblem(m);
+  m.x[4] = Eigen::Vector3d(1.0 / 3, 1.0 / 3, 1.0 / 3);  // on the plane of 1, 2, 3
+  m.elements = {0, 1, 2, 3, 1, 2, 3, 4};
+  EXPECT_NE(dm::meshProblem(m).find("element 1: degenerate"), std::string::npos) << dm::meshProblem(m);
+  m.x.push_back(Eigen::Vector3d(5, 5, 5));
+  m.x[4] = Eigen::Vector3d(1, 1, 1);
+  EXPECT_NE(dm::meshProblem(m).find("vertex 5 is used by no element"), std::string::npos);
+  m.x = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0, 1),
+         Eigen::Vector3d(5, 0, 0), Eigen::Vector3d(6, 0, 0), Eigen::Vector3d(5, 1, 0), Eigen::Vector3d(5, 0, 1)};
+  m.elements = {0, 1, 2, 3, 4, 5, 6, 7};
+  EXPECT_NE(dm::meshProblem(m).find("disconnected (2 separate pieces)"), std::string::npos);
+  m.elements = {0, 1, 2, 9};
+  EXPECT_NE(dm::meshProblem(m).find("element 0: vertex index 9 out of range"), std::string::npos);
+}
+
+TEST(DeformableMesh, ReadsGmshV2AndTetgen) {
+  const std::string msh = writeFile("two_tets.msh",
+                                    "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n"
+                                    "1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n$EndNodes\n"
+                                    "$Elements\n3\n1 15 2 0 1 1\n2 4 2 0 1 1 2 3 4\n3 4 2 0 1 2 3 4 5\n$EndElements\n");
+  const auto m = dm::readGmsh<3>(msh);
+  EXPECT_EQ(m.elementCount(), 2);
+  EXPECT_EQ(m.x.size(), 5u);
+  EXPECT_EQ(dm::meshProblem(m), "");
+  const std::string base = writeFile("two_tets.node", "# comment\n5 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n4 1 1 1\n");
+  writeFile("two_tets.ele", "2 4 0\n0 0 1 2 3\n1 1 2 3 4\n");
+  const auto t = dm::readTetgen(base.substr(0, base.size() - 5));
+  EXPECT_EQ(t.elementCount(), 2);
+  EXPECT_EQ(dm::meshProblem(t), "");
+}
+
+TEST(DeformableMesh, BadFilesNameFileAndLine) {
+  const std::string v4 = writeFile("v4.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n");
+  EXPECT_NE(errorOf([&] { dm::readGmsh<3>(v4); }).find("v4.msh: line 2: expected Gmsh format version 2"),
+            std::string::npos);
+  const std::string truncated = writeFile("truncated.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n");
+  EXPECT_NE(errorOf([&] { dm::readGmsh<3>(truncated); }).find("expected 3 nodes, the file ends after 1"),
+            std::string::npos);
+  const std::string missing = writeFile("missing_node.msh",
+                                        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1\n1 0 0 0\n$EndNodes\n"
+                                        "$Elements\n1\n7 4 0 1 2 3 4\n$EndElements\n");
+  EXPECT_NE(errorOf([&] { dm::readGmsh<3>(missing); }).find("line 10: element 7: node 2 is not in $Nodes"),
+            std::string::npos)
+      << errorOf([&] { dm::readGmsh<3>(missing); });
+  EXPECT_NE(errorOf([&] { dm::readGmsh<3>("/nonexistent/x.msh"); }).find("/nonexistent/x.msh: cannot be opened"),
+            std::string::npos);
+}
