@@ -6,6 +6,7 @@ against time, one panel each, into RUN/plots.png (or --out).
 A sweep.csv: --y columns against --x (default: every check error against us_per_step, the
 speed-against-error front), log axes with --logx/--logy; points sharing the other varied values
 are joined by lines. Uses Debian's python3-matplotlib (Agg backend, no display needed).
+A run directory with --frame [TIME]: one frame of its ParaView output drawn by render_frame.py.
 """
 import argparse
 import csv
@@ -116,8 +117,25 @@ def main():
     p.add_argument("--y", action="append", default=[])
     p.add_argument("--logx", action="store_true")
     p.add_argument("--logy", action="store_true")
+    p.add_argument("--frame", nargs="?", const="last", metavar="TIME",
+                   help="render the run's frame nearest TIME (default: the last) instead of plotting metrics")
+    p.add_argument("--field", default="speed", help="with --frame: the fluid field drawn")
+    p.add_argument("--view", default="-35,25", help="with --frame: 3-D camera azimuth,elevation (--view=-35,25)")
     p.add_argument("--out")
     a = p.parse_args()
+    if a.frame is not None:
+        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+        import render_frame
+
+        time = None
+        if a.frame != "last":
+            try:
+                time = float(a.frame)
+            except ValueError:
+                sys.exit("monolith plot: --frame expects a time or nothing, got '%s'" % a.frame)
+        render_frame.main([a.source, "--field", a.field, "--view=" + a.view] +
+                          (["--time", str(time)] if time is not None else []) + (["--out", a.out] if a.out else []))
+        return
     if os.path.isdir(a.source):
         out = a.out or os.path.join(a.source, "plots.png")
         plot_run(a.source, out)

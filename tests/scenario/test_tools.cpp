@@ -299,6 +299,49 @@ TEST(Plot, RunDirectoryAndSweepFrontArePngs) {
   EXPECT_TRUE(contains(bad.err, "no column 'no_such_column'")) << bad.err;
 }
 
+TEST(Plot, FrameOfARunIsAPng) {
+  // `plot RUN --frame` draws the run's last ParaView frame: bodies as shaded surfaces, a 2-D
+  // fluid as a field image; a run without frames and an unknown field are refused.
+  if (std::system("/usr/bin/python3 -c 'import matplotlib, vtk' 2>/dev/null") != 0)
+    GTEST_SKIP() << "python3-matplotlib or python3-vtk9 is not installed (cmake/install-deps.sh installs them)";
+  TempDir tmp;
+  const std::string bodies = (tmp.path() / "bodies").string(), fluid = (tmp.path() / "fluid").string();
+  ASSERT_EQ(run({MONOLITH_CLI, "run", kScenes + "pyramid_10.json", "--out", bodies, "--quiet", "--set", "time.end=0.1"},
+                tmp.logs())
+                .exitCode,
+            0);
+  const CommandResult b = run({MONOLITH_CLI, "plot", bodies, "--frame", "--view=-30,30"}, tmp.logs());
+  ASSERT_EQ(b.exitCode, 0) << b.err;
+  EXPECT_EQ(pngSize(fs::path(bodies) / "frame.png"), std::make_pair(800, 500));
+  EXPECT_GT(fs::file_size(fs::path(bodies) / "frame.png"), 15000u);  // 56 shaded bodies, not an empty canvas
+
+  ASSERT_EQ(run({MONOLITH_CLI, "run", kScenes + "poiseuille.json", "--out", fluid, "--quiet", "--set", "time.end=0.2"},
+                tmp.logs())
+                .exitCode,
+            0);
+  const std::string png = (tmp.path() / "u.png").string();
+  const CommandResult f = run({MONOLITH_CLI, "plot", fluid, "--frame", "0.2", "--field", "vorticity", "--out", png},
+                              tmp.logs());
+  ASSERT_EQ(f.exitCode, 0) << f.err;
+  const auto [w, h] = pngSize(png);
+  EXPECT_EQ(w, 800);
+  EXPECT_GT(h, 200);
+  EXPECT_LT(h, 500);  // the 4 x 1 channel keeps its aspect
+
+  const CommandResult bad = run({MONOLITH_CLI, "plot", fluid, "--frame", "--field", "no_such_field"}, tmp.logs());
+  EXPECT_NE(bad.exitCode, 0);
+  EXPECT_TRUE(contains(bad.err, "unknown field 'no_such_field'")) << bad.err;
+  const std::string bare = (tmp.path() / "bare").string();
+  ASSERT_EQ(run({MONOLITH_CLI, "run", kScenes + "bounce.json", "--out", bare, "--quiet", "--no-frames", "--set",
+                 "time.end=0.01"},
+                tmp.logs())
+                .exitCode,
+            0);
+  const CommandResult none = run({MONOLITH_CLI, "plot", bare, "--frame"}, tmp.logs());
+  EXPECT_NE(none.exitCode, 0);
+  EXPECT_TRUE(contains(none.err, "has no frames")) << none.err;
+}
+
 TEST(Checks, ProbeAndProfileChecksSampleTheFluid) {
   // A uniform stream in a doubly periodic box stays uniform (to rounding): the probe reads u = 1
   // and the profile v = 0.5 everywhere; a wrong reference (u = 2) fails with error 1.
