@@ -32,6 +32,7 @@ const char* kUsage =
     "  monolith sweep --collect DIR   build DIR/sweep.csv from the points run so far (e.g. by Slurm)\n"
     "  monolith bench [SUITE] [--threads 1,2] [--repeat N] [--out DIR]   (default suite: scenarios/bench/default.json)\n"
     "  monolith plot RUN_DIR|SWEEP_CSV [--x COL] [--y COL]... [--logx] [--logy] [--out PNG]\n"
+    "  monolith plot RUN_DIR --frame [TIME] [--field speed|vorticity|pressure|...] [--view=AZ,EL] [--out PNG]\n"
     "  monolith version\n"
     "exit codes: 0 ok, 1 runtime/I-O failure, 2 bad command line, 3 scene/plugin/checkpoint rejected,\n"
     "            4 simulation unstable (stopped by the blow-up guard), 5 a scene check failed (run --check)\n";
