@@ -161,6 +161,18 @@ def polygon_area(p):
     return 0.5 * np.linalg.norm(n)
 
 
+def ground_bodies(polys):
+    """Bodies drawn as one polygon covering a fifth or more of the scene's extent (ground planes)."""
+    if not polys:
+        return set()
+    span = np.ptp(np.vstack([p for p, _ in polys]), axis=0)
+    scene_area = max(span[0] * span[2], span[0] * span[1], span[1] * span[2], 1e-12)
+    faces_of = {}
+    for p, b in polys:
+        faces_of[b] = faces_of.get(b, 0) + 1
+    return {b for p, b in polys if faces_of[b] == 1 and polygon_area(p) > 0.2 * scene_area}
+
+
 def draw_3d(ax, polys, lines, azimuth, elevation, static=frozenset()):
     az, el = math.radians(azimuth), math.radians(elevation)
     toward_camera = np.array([math.cos(el) * math.sin(az), math.sin(el), math.cos(el) * math.cos(az)])
@@ -174,14 +186,8 @@ def draw_3d(ax, polys, lines, azimuth, elevation, static=frozenset()):
     for p, b in polys:
         centroids.setdefault(b, []).append(p)
     centroids = {b: np.vstack(ps).mean(axis=0) for b, ps in centroids.items()}
-    all_pts = np.vstack([p for p, _ in polys])
-    span = np.ptp(all_pts, axis=0)
-    scene_area = max(span[0] * span[2], span[0] * span[1], span[1] * span[2], 1e-12)
     # A body of one large flat face is the ground: drawn first, not counted in the view's extent.
-    faces_of = {}
-    for p, b in polys:
-        faces_of[b] = faces_of.get(b, 0) + 1
-    ground = {b for p, b in polys if faces_of[b] == 1 and polygon_area(p) > 0.2 * scene_area}
+    ground = ground_bodies(polys)
 
     items = []
     for p, b in polys:
@@ -288,8 +294,12 @@ def render(run, time=None, field="speed", view=(-35.0, 25.0), out=None, title=No
         fig, ax = plt.subplots(figsize=(8.0, 5.0))
         if flat:
             draw_outlines_2d(ax, polys, lines, filled=True)
-            lo, hi = all_pts[:, :2].min(axis=0), all_pts[:, :2].max(axis=0)
-            margin = 0.05 * max(hi - lo)
+            # The view frames the bodies; a ground (one large polygon) is cut at the margin.
+            ground = ground_bodies(polys)
+            shown = [p for p, b in polys + lines if b not in ground] or [p for p, _ in polys + lines]
+            pts = np.vstack(shown)
+            lo, hi = pts[:, :2].min(axis=0), pts[:, :2].max(axis=0)
+            margin = 0.15 * max(hi - lo)
             ax.set_xlim(lo[0] - margin, hi[0] + margin)
             ax.set_ylim(lo[1] - margin, hi[1] + margin)
         else:
