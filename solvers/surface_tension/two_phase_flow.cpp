@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "solvers/advection/eno.h"
 #include "solvers/advection/semi_lagrangian.h"
 #include "solvers/surface_tension/level_set_front.h"
 #include "solvers/surface_tension/level_set_tracking.h"
@@ -403,7 +404,8 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
   // u*: advection, gravity, then the coupling faces' normal velocity and the explicit force.
   Eigen::VectorXd u = state.u;
   if (settings.onePhase) extrapolateToAir(layout, D, u);
-  if (settings.advect) u = advectFacesSemiLagrangian(layout, u, dt);
+  if (settings.advection == TwoPhaseAdvection::SemiLagrangian) u = advectFacesSemiLagrangian(layout, u, dt);
+  if (settings.advection == TwoPhaseAdvection::EnoRk3) u = advectFacesEnoRk3(layout, u, dt);
   Eigen::VectorXd ustar(nu);
   for (int q = 0; q < D.gridUnknowns; ++q) {
     const int f = D.unknownFace[q];
@@ -475,12 +477,19 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
   if (settings.levelSetFront) {
     // The level set moves with the grid velocity; the mesh is rebuilt from it and it is
     // redistanced to that mesh.
-    state.phi = advectCellField(layout, state.phi, state.u, dt);
+    if (settings.advection == TwoPhaseAdvection::EnoRk3) {
+      const Eigen::VectorXd phi = Eigen::Map<const Eigen::VectorXd>(state.phi.data(), static_cast<Eigen::Index>(state.phi.size()));
+      const Eigen::VectorXd next = advectScalarEnoRk3(layout, phi, state.u, dt);
+      state.phi.assign(next.data(), next.data() + next.size());
+    } else {
+      state.phi = advectCellField(layout, state.phi, state.u, dt);
+    }
     if (rebuildFront(state, layout, settings, report)) redistanceToFront(layout, state.front, state.phi);
   } else {
     const Eigen::VectorXd v = D.Ht.transpose() * unew;  // H u^{n+1}
     for (int k = 0; k < state.front.pointCount(); ++k) state.front.points[k] += dt * v.segment<2>(2 * k);
-    report.remeshChanges = remeshClosedFront(state.front, settings.minSegment * dx, settings.maxSegment * dx);
+    if (settings.remesh)
+      report.remeshChanges = remeshClosedFront(state.front, settings.minSegment * dx, settings.maxSegment * dx);
   }
   state.time += dt;
   ++state.step;

@@ -43,6 +43,12 @@
 
 namespace monolith::solvers {
 
+// The convective step of the grid velocities (and of a level-set-tracked front's phi): none,
+// semi-Lagrangian (solvers/advection/semi_lagrangian.h; unconditionally stable), or the thesis's
+// third-order Hamilton-Jacobi ENO with TVD RK3 (Sec. 6.3; solvers/advection/eno.h; stable for
+// CFL numbers up to about 1).
+enum class TwoPhaseAdvection { None, SemiLagrangian, EnoRk3 };
+
 struct TwoPhaseSettings {
   double densityInside = 1;   // rho: the phase the front's loops enclose
   double densityOutside = 1;  // rho': ignored in one phase
@@ -51,7 +57,8 @@ struct TwoPhaseSettings {
   double sigma = 0;      // surface tension coefficient
   bool implicitSurfaceTension = true;  // false: the explicit variant, D = C = 0
   Eigen::Vector2d gravity = Eigen::Vector2d::Zero();
-  bool advect = true;  // semi-Lagrangian advection of the velocities
+  TwoPhaseAdvection advection = TwoPhaseAdvection::SemiLagrangian;
+  bool remesh = true;                         // front tracking: remesh after every step (Sec. 6.3.1)
   double minSegment = 0.5, maxSegment = 1.5;  // remeshing bounds, in dx
   CgSettings solve{20000, 1e-12, 0};
   double blowUpSpeed = 1e3;  // the guard: a step whose max speed exceeds this (or is not finite) blew up
