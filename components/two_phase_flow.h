@@ -34,7 +34,8 @@ struct TwoPhaseFlow {
   double minSegment = 0.5, maxSegment = 1.5;     // remeshing bounds in dx
   double blowUpSpeed = 1e3;                      // the guard (m/s)
   double tolerance = 1e-12;                      // CG relative tolerance of (6.33)
-  std::uint8_t levelSetFront = 0;                // 1: the front is rebuilt each step from `phi`
+  std::uint8_t levelSetFront = 0;                // 1: the front is rebuilt each step from `phi`;
+                                                 // 2: and phi follows the mesh moved by H u (implicit update)
 
   // --- state ---
   std::vector<double> u;               // face velocities, MAC layout order

@@ -108,7 +108,8 @@ void parseTwoPhaseFlow(World<d>& world, Entity e, const Config& c) {
       r.finish();
     }
     const Config f = c.child("front");
-    flow.levelSetFront = f.oneOf("tracking", {"front", "level_set"}, "front") == "level_set";
+    const std::string tracking = f.oneOf("tracking", {"front", "level_set", "level_set_implicit"}, "front");
+    flow.levelSetFront = tracking == "front" ? 0 : tracking == "level_set" ? 1 : 2;
     solvers::Front2 front = parseFront(f, flow.dx);
     const Eigen::Vector2d upper = flow.origin + flow.dx * flow.cells.cast<double>();
     for (const auto& x : front.points)

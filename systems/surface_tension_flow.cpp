@@ -59,6 +59,7 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
       s.blowUpSpeed = flow.blowUpSpeed;
       s.solve.relativeTolerance = flow.tolerance;
       s.levelSetFront = flow.levelSetFront != 0;
+      s.levelSetImplicitUpdate = flow.levelSetFront == 2;
 
       const Eigen::Vector2d centroidBefore = solvers::measureFront(state.front).centroid;
       const solvers::TwoPhaseStepReport r = solvers::advanceTwoPhase(state, s, ctx.dt);

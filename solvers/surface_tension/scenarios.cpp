@@ -264,7 +264,8 @@ double stabilityCapillaryDt(int n) {
   return std::sqrt(1000 * dx * dx * dx / (4 * M_PI * 0.0728));
 }
 
-StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps, bool levelSet) {
+StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps, bool levelSet,
+                               bool levelSetImplicitUpdate) {
   const double dx = 0.04 / n;
   const Eigen::Vector2d centre(0.02, 0.02);
   const int points = static_cast<int>(std::lround(2 * M_PI * 0.01 / dx));
@@ -289,6 +290,7 @@ StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, in
   settings.solve.relativeTolerance = 1e-10;
   if (levelSet) {
     settings.levelSetFront = true;
+    settings.levelSetImplicitUpdate = levelSetImplicitUpdate;
     state.phi = signedDistanceToFront(state.layout, state.front);
     state.front = frontFromLevelSet(state.layout, state.phi, CrossingOrder::Fourth);
   }

@@ -102,7 +102,9 @@ struct StabilityCase {
   double capillaryDt = 0, maxSpeed = 0;
   int steps = 0;
 };
-StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps, bool levelSet = false);
+// levelSetImplicitUpdate: the level set follows the mesh moved by H u (TwoPhaseSettings).
+StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps, bool levelSet = false,
+                               bool levelSetImplicitUpdate = false);
 double stabilityCapillaryDt(int n);
 
 }  // namespace monolith::solvers

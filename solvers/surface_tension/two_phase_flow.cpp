@@ -474,7 +474,15 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
     state.pInside[c] = D.insideDof[c] >= 0 ? z[D.insideDof[c]] / dt : 0.0;
     state.pOutside[c] = D.outsideDof[c] >= 0 ? z[D.outsideDof[c]] / dt : 0.0;
   }
-  if (settings.levelSetFront) {
+  if (settings.levelSetFront && settings.levelSetImplicitUpdate) {
+    // phi moves with the Lagrangian velocity H u^{n+1}; the mesh is rebuilt from it and phi is
+    // redistanced to that mesh beyond 2 cells, as below.
+    const Eigen::VectorXd v = D.Ht.transpose() * unew;
+    std::vector<Eigen::Vector2d> velocity(state.front.pointCount());
+    for (int k = 0; k < state.front.pointCount(); ++k) velocity[k] = v.segment<2>(2 * k);
+    moveLevelSetWithFront(layout, state.front, velocity, dt, state.phi);
+    if (rebuildFront(state, layout, settings, report)) redistanceToFront(layout, state.front, state.phi);
+  } else if (settings.levelSetFront) {
     // The level set moves with the grid velocity; the mesh is rebuilt from it and it is
     // redistanced to that mesh.
     if (settings.advection == TwoPhaseAdvection::EnoRk3) {

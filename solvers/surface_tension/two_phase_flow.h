@@ -65,6 +65,12 @@ struct TwoPhaseSettings {
   // Level-set-tracked front (level_set_tracking.h): the front is rebuilt from TwoPhaseState::phi
   // each step and phi, not the points, is advected. Else front tracking.
   bool levelSetFront = false;
+  // Level-set-tracked front, beyond the thesis (its future work, Sec. 6.5): instead of advecting phi
+  // with the grid velocity, move the mesh's points with the coupled solve's Lagrangian velocity
+  // H u^{n+1}, as front tracking does (the update the force derivatives assume, backward-Euler
+  // like), and set phi to the signed distance to the moved mesh. The next step's mesh is rebuilt
+  // from that phi as usual.
+  bool levelSetImplicitUpdate = false;
 };
 
 struct TwoPhaseState {
