@@ -161,6 +161,29 @@ InterfaceDiscretization discretizeInterface(const MacLayout<2>& layout, const Fr
     pieceLength[p.cell] += len;
     D.cutCell[p.cell] = 1;
   }
+  // The node parity above is ambiguous at a node the front passes through (a front point on a grid
+  // node: the node counts as on one side, and a face that only touches the front there gets the
+  // wrong phase). Next to cut cells each stretch of a face between crossings is therefore classified
+  // by the inside test of its midpoint instead.
+  for (int f = 0; f < nf; ++f) {
+    const auto [axis, idx] = layout.faceCoord(f);
+    Index2 lower = idx;
+    lower[axis] -= 1;
+    const bool nearCut = (idx[axis] < n[axis] && D.cutCell[layout.cellIndex(idx)]) ||
+                         (lower[axis] >= 0 && D.cutCell[layout.cellIndex(lower)]);
+    if (!nearCut) continue;
+    const Eigen::Vector2d start = layout.origin + dx * idx.cast<double>();
+    Eigen::Vector2d along = Eigen::Vector2d::Zero();
+    along[1 - axis] = dx;
+    double last = 0, length = 0;
+    std::vector<double> ends = placed.faceCrossings[f];
+    ends.push_back(1.0);
+    for (double t : ends) {
+      if (t > last && insideFront(front, start + 0.5 * (last + t) * along)) length += t - last;
+      last = t;
+    }
+    D.insideLength[f] = length * dx;
+  }
   // Pressure unknowns. An uncut cell's phase is its left face's (all its faces are uncut).
   D.insideDof.assign(nc, -1);
   D.outsideDof.assign(nc, -1);
