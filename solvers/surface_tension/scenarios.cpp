@@ -1,6 +1,7 @@
 #include "solvers/surface_tension/scenarios.h"
 
 #include "solvers/surface_tension/front_metrics.h"
+#include "solvers/surface_tension/pressure_jump.h"
 
 #include <algorithm>
 #include <cmath>
@@ -262,6 +263,46 @@ RisingBubbleRun runRisingBubble(int n, double endTime, double sampleEvery, doubl
 double stabilityCapillaryDt(int n) {
   const double dx = 0.04 / n;
   return std::sqrt(1000 * dx * dx * dx / (4 * M_PI * 0.0728));
+}
+
+namespace {
+Front2 stabilityShape(int n, bool ellipse, int refine) {
+  const double dx = 0.04 / n;
+  const Eigen::Vector2d centre(0.02, 0.02);
+  const int points = refine * static_cast<int>(std::lround(2 * M_PI * 0.01 / dx));
+  if (!ellipse) return perturbedCircle(centre, 0.01, 0, 0, points);
+  std::vector<Eigen::Vector2d> x;
+  for (int k = 0; k < points; ++k) {
+    const double theta = (k + 0.5) * 2 * M_PI / points;
+    x.push_back(centre + Eigen::Vector2d(0.011 * std::cos(theta), 0.009 * std::sin(theta)));
+  }
+  return closedPolyline(x);
+}
+}  // namespace
+
+StabilityCase runPressureJumpStabilityCase(int n, double dt, bool ellipse, int steps) {
+  const double dx = 0.04 / n;
+  PressureJumpState state;
+  state.layout = MacLayout<2>(Eigen::Vector2i(n, n), dx);
+  state.u = Eigen::VectorXd::Zero(state.layout.totalFaces());
+  state.phi = signedDistanceToFront(state.layout, stabilityShape(n, ellipse, 16), 6);
+  PressureJumpSettings settings;
+  settings.density = 1000;
+  settings.sigma = 0.0728;
+  settings.blowUpSpeed = 1.0;
+  const double area0 = enclosedArea(frontFromLevelSet(state.layout, state.phi, CrossingOrder::Fourth));
+  StabilityCase r;
+  r.capillaryDt = stabilityCapillaryDt(n);
+  for (int i = 0; i < steps; ++i) {
+    const PressureJumpReport report = advancePressureJump(state, settings, dt);
+    r.maxSpeed = std::max(r.maxSpeed, report.maxSpeed);
+    if (report.blewUp || std::abs(report.area / area0 - 1) > 0.2) {
+      r.stable = false;
+      break;
+    }
+  }
+  r.steps = state.step;
+  return r;
 }
 
 StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps, bool levelSet,

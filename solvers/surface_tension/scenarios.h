@@ -106,5 +106,7 @@ struct StabilityCase {
 StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps, bool levelSet = false,
                                bool levelSetImplicitUpdate = false);
 double stabilityCapillaryDt(int n);
+// The same case with the pressure jump scheme (pressure_jump.h), phi the distance to the shape.
+StabilityCase runPressureJumpStabilityCase(int n, double dt, bool ellipse, int steps);
 
 }  // namespace monolith::solvers

@@ -137,7 +137,7 @@ int main(int argc, char** argv) {
                   std::log2(std::abs(a.bottom - b.bottom) / std::abs(b.bottom - c.bottom)));
     }
   } else if (mode == "stability_csv") {
-    // stability_csv circle|ellipse ft_explicit|ft_implicit|ls_explicit|ls_implicit|ls_implicit_update STEPS N...: one CSV row
+    // stability_csv circle|ellipse ft_explicit|ft_implicit|ls_explicit|ls_implicit|ls_implicit_update|pressure_jump STEPS N...: one CSV row
     // per (N, dt multiple), for tests/bench/plot_stability_map.py.
     const bool ellipse = argc > 2 && std::string(argv[2]) == "ellipse";
     const std::string scheme = argc > 3 ? argv[3] : "ft_implicit";
@@ -147,7 +147,9 @@ int main(int argc, char** argv) {
     for (int n : sizes(argc, argv, 5, {16, 32, 64}))
       for (double m : {0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0}) {
         const auto start = std::chrono::steady_clock::now();
-        const StabilityCase r = runStabilityCase(n, m * stabilityCapillaryDt(n), implicit, ellipse, steps, ls, update);
+        const StabilityCase r = scheme == "pressure_jump"
+                                    ? runPressureJumpStabilityCase(n, m * stabilityCapillaryDt(n), ellipse, steps)
+                                    : runStabilityCase(n, m * stabilityCapillaryDt(n), implicit, ellipse, steps, ls, update);
         std::printf("%s,%s,%d,%g,%.6g,%d,%d,%.4g,%.2f\n", ellipse ? "ellipse" : "circle", scheme.c_str(), n, m,
                     m * stabilityCapillaryDt(n), r.stable ? 1 : 0, r.steps, r.maxSpeed, seconds(start));
         std::fflush(stdout);
