@@ -132,6 +132,20 @@ TEST(SurfaceTensionScenes, ValidationNamesFilePathAndExpectation) {
       "front": { "shape": "circle", "centre": [0.9, 0.5], "radius": 0.2 } })");
   EXPECT_NE(outside.exitCode, 0);
   EXPECT_NE(outside.err.find("strictly inside the domain"), std::string::npos) << outside.err;
+  const CommandResult advection = validate("adv.json", "{" + base + R"("density_outside": 1, "advection": "weno",
+      "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2 } })");
+  EXPECT_NE(advection.exitCode, 0);
+  EXPECT_NE(advection.err.find("two_phase_flow.advection"), std::string::npos) << advection.err;
+  EXPECT_NE(advection.err.find("eno_rk3"), std::string::npos) << advection.err;
+  const CommandResult tracking = validate("track.json", "{" + base + R"("density_outside": 1,
+      "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, "tracking": "particles" } })");
+  EXPECT_NE(tracking.exitCode, 0);
+  EXPECT_NE(tracking.err.find("two_phase_flow.front.tracking"), std::string::npos) << tracking.err;
+  EXPECT_NE(tracking.err.find("level_set_implicit"), std::string::npos) << tracking.err;
+  // The options of this page are accepted.
+  const CommandResult options = validate("ok.json", "{" + base + R"("density_outside": 1, "advection": "eno_rk3",
+      "remesh": false, "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, "tracking": "level_set_implicit" } })");
+  EXPECT_EQ(options.exitCode, 0) << options.err;
   const CommandResult threeD = validate("3d.json", R"({"cells": [4, 4, 4], "domain_max": [1, 1, 1]})", 3);
   EXPECT_NE(threeD.exitCode, 0);
   EXPECT_NE(threeD.err.find("2-D only"), std::string::npos) << threeD.err;
