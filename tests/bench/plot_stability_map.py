@@ -35,7 +35,7 @@ def main():
         if r[1] not in schemes:
             schemes.append(r[1])
     schemes.sort(key=lambda s: list(LABELS).index(s) if s in LABELS else 99)
-    fig, axes = plt.subplots(1, len(shapes), figsize=(6.5 * len(shapes), 5.5), squeeze=False)
+    fig, axes = plt.subplots(1, len(shapes), figsize=(6.5 * len(shapes), 6.5), squeeze=False)
     for ax, shape in zip(axes[0], shapes):
         ns = sorted({int(r[2]) for r in rows if r[0] == shape})
         width = 0.8 / max(1, len(schemes))
@@ -47,18 +47,21 @@ def main():
                 x = ns.index(int(r[2])) + offset
                 y = float(r[3])
                 stable = r[5] == "1"
-                ax.scatter([x], [y], marker="o" if stable else "x", s=40 if stable else 50,
-                           facecolors="none" if stable else COLOURS.get(scheme, "k"),
-                           edgecolors=COLOURS.get(scheme, "k"), linewidths=1.5)
+                colour = COLOURS.get(scheme, "k")
+                if stable:
+                    ax.scatter([x], [y], marker="o", s=40, facecolors="none", edgecolors=colour, linewidths=1.5)
+                else:
+                    ax.scatter([x], [y], marker="x", s=50, c=colour, linewidths=1.5)
             ax.scatter([], [], marker="s", color=COLOURS.get(scheme, "k"), label=LABELS.get(scheme, scheme))
         ax.set_yscale("log", base=2)
         ax.invert_yaxis()  # smaller dt at the top, as in the thesis's figures
         ax.set_xticks(range(len(ns)))
+        ax.set_xlim(-0.5, len(ns) - 0.5)
         ax.set_xticklabels([f"N = {n}\n(dx = {0.04 / n * 1e3:.2f} mm)" for n in ns])
         ax.set_ylabel("dt / explicit capillary limit sqrt(rho dx^3 / (4 pi sigma))")
         ax.set_title(f"{shape}: o stable for 500 steps, x unstable")
         ax.grid(True, axis="y", alpha=0.3)
-        ax.legend(loc="lower left", fontsize=8)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3, fontsize=8)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
 
