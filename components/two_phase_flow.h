@@ -30,6 +30,7 @@ struct TwoPhaseFlow {
   std::uint8_t implicitSurfaceTension = 1;       // 0: the explicit variant, D = C = 0
   VecD gravity = VecD::Zero();
   std::uint8_t advect = 1;                       // 0 none, 1 semi-Lagrangian, 2 ENO/RK3
+  double advectionCfl = 0;                       // ENO/RK3: substeps of at most this CFL (0: one step)
   std::uint8_t remesh = 1;                       // front tracking: remesh every step
   double minSegment = 0.5, maxSegment = 1.5;     // remeshing bounds in dx
   double blowUpSpeed = 1e3;                      // the guard (m/s)
@@ -62,6 +63,7 @@ struct TwoPhaseFlow {
     visit("implicit", implicitSurfaceTension);
     visit("gravity", gravity);
     visit("advect", advect);
+    visit("advection_cfl", advectionCfl);
     visit("remesh", remesh);
     visit("min_segment", minSegment);
     visit("max_segment", maxSegment);

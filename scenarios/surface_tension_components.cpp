@@ -93,6 +93,7 @@ void parseTwoPhaseFlow(World<d>& world, Entity e, const Config& c) {
     flow.gravity = g;
     const std::string advection = c.oneOf("advection", {"semi_lagrangian", "eno_rk3", "none"}, "semi_lagrangian");
     flow.advect = advection == "none" ? 0 : advection == "eno_rk3" ? 2 : 1;
+    flow.advectionCfl = c.number("advection_cfl", 0.0, Bound::NonNegative);
     flow.blowUpSpeed = c.number("blow_up_speed", 1e3, Bound::Positive);
     flow.tolerance = c.number("tolerance", 1e-12, Bound::Positive);
     if (c.has("remesh") && c.raw()["remesh"].is_boolean()) {

@@ -54,6 +54,7 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
                     : flow.advect == 2 ? solvers::TwoPhaseAdvection::EnoRk3
                                        : solvers::TwoPhaseAdvection::SemiLagrangian;
       s.remesh = flow.remesh != 0;
+      s.advectionCfl = flow.advectionCfl;
       s.minSegment = flow.minSegment;
       s.maxSegment = flow.maxSegment;
       s.blowUpSpeed = flow.blowUpSpeed;

@@ -165,7 +165,7 @@ OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTi
 }
 
 RisingBubbleStability runRisingBubbleStability(int n, double dt, bool implicit, int steps, TwoPhaseAdvection advection,
-                                               bool levelSet) {
+                                               bool levelSet, double advectionCfl) {
   const double dx = 1.0 / n;
   const int points = static_cast<int>(std::lround(2 * M_PI * 0.2 / dx));
   TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(n, 2 * n), dx),
@@ -180,6 +180,7 @@ RisingBubbleStability runRisingBubbleStability(int n, double dt, bool implicit, 
   settings.blowUpSpeed = 0.1;
   settings.solve.relativeTolerance = 1e-10;
   settings.advection = advection;
+  settings.advectionCfl = advectionCfl;
   if (levelSet) {
     settings.levelSetFront = true;
     state.phi = signedDistanceToFront(state.layout, perturbedCircle(Eigen::Vector2d(0.5, 0.5), 0.2, 0, 0, 16 * points));

@@ -382,6 +382,13 @@ void extrapolateToAir(const MacLayout<2>& layout, const InterfaceDiscretization&
 }  // namespace
 
 namespace {
+// ENO/RK3 is stable up to CFL ~1: with a CFL bound, the step is split into that many substeps.
+int advectionSubsteps(const MacLayout<2>& layout, const Eigen::VectorXd& u, double dt, double cflBound) {
+  if (!(cflBound > 0) || u.size() == 0) return 1;
+  const double cfl = u.cwiseAbs().maxCoeff() * dt / layout.dx;
+  return std::max(1, static_cast<int>(std::ceil(cfl / cflBound)));
+}
+
 // The level set's mesh; a level set so distorted that its marching-squares segments no longer
 // chain into curves (two segments leaving one crossing) is a blow-up, reported as such.
 bool rebuildFront(TwoPhaseState& state, const MacLayout<2>& layout, const TwoPhaseSettings& settings,
@@ -428,7 +435,10 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
   Eigen::VectorXd u = state.u;
   if (settings.onePhase) extrapolateToAir(layout, D, u);
   if (settings.advection == TwoPhaseAdvection::SemiLagrangian) u = advectFacesSemiLagrangian(layout, u, dt);
-  if (settings.advection == TwoPhaseAdvection::EnoRk3) u = advectFacesEnoRk3(layout, u, dt);
+  if (settings.advection == TwoPhaseAdvection::EnoRk3) {
+    const int substeps = advectionSubsteps(layout, u, dt, settings.advectionCfl);
+    for (int k = 0; k < substeps; ++k) u = advectFacesEnoRk3(layout, u, dt / substeps);
+  }
   Eigen::VectorXd ustar(nu);
   for (int q = 0; q < D.gridUnknowns; ++q) {
     const int f = D.unknownFace[q];
@@ -510,7 +520,9 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
     // redistanced to that mesh.
     if (settings.advection == TwoPhaseAdvection::EnoRk3) {
       const Eigen::VectorXd phi = Eigen::Map<const Eigen::VectorXd>(state.phi.data(), static_cast<Eigen::Index>(state.phi.size()));
-      const Eigen::VectorXd next = advectScalarEnoRk3(layout, phi, state.u, dt);
+      Eigen::VectorXd next = phi;
+      const int substeps = advectionSubsteps(layout, state.u, dt, settings.advectionCfl);
+      for (int k = 0; k < substeps; ++k) next = advectScalarEnoRk3(layout, next, state.u, dt / substeps);
       state.phi.assign(next.data(), next.data() + next.size());
     } else {
       state.phi = advectCellField(layout, state.phi, state.u, dt);

@@ -58,6 +58,10 @@ struct TwoPhaseSettings {
   bool implicitSurfaceTension = true;  // false: the explicit variant, D = C = 0
   Eigen::Vector2d gravity = Eigen::Vector2d::Zero();
   TwoPhaseAdvection advection = TwoPhaseAdvection::SemiLagrangian;
+  // ENO/RK3 only: 0 advects in one step whatever the CFL number (as the thesis, whose ENO runs are
+  // CFL-limited); > 0 splits the advection into substeps of at most this CFL number (the surface
+  // tension step stays one step).
+  double advectionCfl = 0;
   bool remesh = true;                         // front tracking: remesh after every step (Sec. 6.3.1)
   double minSegment = 0.5, maxSegment = 1.5;  // remeshing bounds, in dx
   CgSettings solve{20000, 1e-12, 0};

@@ -338,3 +338,13 @@ TEST(SurfaceTensionStability, LevelSetCurvatureOfACircle) {
     EXPECT_NEAR(kappa[c] * r, 1.0, 0.01);
   }
 }
+
+TEST(SurfaceTensionRisingBubble, EnoRk3LevelSetInCflSubsteps) {
+  // The level-set-tracked bubble with ENO/RK3 at 40 x 80, dt = 3 s: the advection split into
+  // substeps of CFL <= 0.9 (one surface-tension step) keeps the level set's mesh closed and the
+  // speed bounded over 8 steps.
+  const RisingBubbleStability r = runRisingBubbleStability(40, 3.0, true, 8, TwoPhaseAdvection::EnoRk3, true, 0.9);
+  EXPECT_TRUE(r.stable) << r.reason;
+  EXPECT_LT(r.maxSpeed, 0.02);
+  EXPECT_LT(std::abs(r.areaChange), 0.05);
+}
