@@ -29,7 +29,7 @@
 //    H = (H^T)^T interpolates coupling-face normal velocities to the particles (normal only);
 //  * C: per segment, C_{k,k} = -C_{k,k+1} = dt sqrt(sigma / l) n^T (C^T C = -dt D, D the normal-only
 //    force derivative); the explicit variant drops the C H rows (D = C = 0).
-// Time step: advection of the grid face velocities (semi-Lagrangian), gravity, the explicit
+// Time step: advection of the grid face velocities (semi-Lagrangian or ENO/RK3), gravity, the explicit
 // force, the solve, then the front moves with x^{n+1} = x^n + dt H u^{n+1} and is remeshed.
 // Walls bound the domain on all sides (normal velocity 0, no-slip for the viscous rows).
 #include <Eigen/Core>
