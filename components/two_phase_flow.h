@@ -29,11 +29,14 @@ struct TwoPhaseFlow {
   double sigma = 0;
   std::uint8_t implicitSurfaceTension = 1;       // 0: the explicit variant, D = C = 0
   VecD gravity = VecD::Zero();
-  std::uint8_t advect = 1;                       // semi-Lagrangian advection of the velocities
+  std::uint8_t advect = 1;                       // 0 none, 1 semi-Lagrangian, 2 ENO/RK3
+  double advectionCfl = 0;                       // ENO/RK3: substeps of at most this CFL (0: one step)
+  std::uint8_t remesh = 1;                       // front tracking: remesh every step
   double minSegment = 0.5, maxSegment = 1.5;     // remeshing bounds in dx
   double blowUpSpeed = 1e3;                      // the guard (m/s)
   double tolerance = 1e-12;                      // CG relative tolerance of (6.33)
-  std::uint8_t levelSetFront = 0;                // 1: the front is rebuilt each step from `phi`
+  std::uint8_t levelSetFront = 0;                // 1: the front is rebuilt each step from `phi`;
+                                                 // 2: and phi follows the mesh moved by H u (implicit update)
 
   // --- state ---
   std::vector<double> u;               // face velocities, MAC layout order
@@ -60,6 +63,8 @@ struct TwoPhaseFlow {
     visit("implicit", implicitSurfaceTension);
     visit("gravity", gravity);
     visit("advect", advect);
+    visit("advection_cfl", advectionCfl);
+    visit("remesh", remesh);
     visit("min_segment", minSegment);
     visit("max_segment", maxSegment);
     visit("blow_up_speed", blowUpSpeed);

@@ -91,10 +91,16 @@ void parseTwoPhaseFlow(World<d>& world, Entity e, const Config& c) {
     flow.implicitSurfaceTension = c.oneOf("treatment", {"implicit", "explicit"}, "implicit") == "implicit";
     const Eigen::VectorXd g = c.vector("gravity", Eigen::VectorXd::Zero(2));
     flow.gravity = g;
-    flow.advect = c.oneOf("advection", {"semi_lagrangian", "none"}, "semi_lagrangian") == "semi_lagrangian";
+    const std::string advection = c.oneOf("advection", {"semi_lagrangian", "eno_rk3", "none"}, "semi_lagrangian");
+    flow.advect = advection == "none" ? 0 : advection == "eno_rk3" ? 2 : 1;
+    flow.advectionCfl = c.number("advection_cfl", 0.0, Bound::NonNegative);
     flow.blowUpSpeed = c.number("blow_up_speed", 1e3, Bound::Positive);
     flow.tolerance = c.number("tolerance", 1e-12, Bound::Positive);
-    if (c.has("remesh")) {
+    if (c.has("remesh") && c.raw()["remesh"].is_boolean()) {
+      // "remesh": false keeps the front's points as given (the original driver's static circle).
+      flow.remesh = c.raw()["remesh"].get<bool>() ? 1 : 0;
+      c.markUsed("remesh");
+    } else if (c.has("remesh")) {
       const Config r = c.child("remesh");
       flow.minSegment = r.number("min", 0.5, Bound::Positive);
       flow.maxSegment = r.number("max", 1.5, Bound::Positive);
@@ -103,7 +109,8 @@ void parseTwoPhaseFlow(World<d>& world, Entity e, const Config& c) {
       r.finish();
     }
     const Config f = c.child("front");
-    flow.levelSetFront = f.oneOf("tracking", {"front", "level_set"}, "front") == "level_set";
+    const std::string tracking = f.oneOf("tracking", {"front", "level_set", "level_set_implicit"}, "front");
+    flow.levelSetFront = tracking == "front" ? 0 : tracking == "level_set" ? 1 : 2;
     solvers::Front2 front = parseFront(f, flow.dx);
     const Eigen::Vector2d upper = flow.origin + flow.dx * flow.cells.cast<double>();
     for (const auto& x : front.points)

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "solvers/surface_tension/front_metrics.h"
 #include "solvers/surface_tension/two_phase_flow.h"
 
 namespace monolith {
@@ -49,13 +50,19 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
       s.sigma = flow.sigma;
       s.implicitSurfaceTension = flow.implicitSurfaceTension != 0;
       s.gravity = flow.gravity;
-      s.advect = flow.advect != 0;
+      s.advection = flow.advect == 0   ? solvers::TwoPhaseAdvection::None
+                    : flow.advect == 2 ? solvers::TwoPhaseAdvection::EnoRk3
+                                       : solvers::TwoPhaseAdvection::SemiLagrangian;
+      s.remesh = flow.remesh != 0;
+      s.advectionCfl = flow.advectionCfl;
       s.minSegment = flow.minSegment;
       s.maxSegment = flow.maxSegment;
       s.blowUpSpeed = flow.blowUpSpeed;
       s.solve.relativeTolerance = flow.tolerance;
       s.levelSetFront = flow.levelSetFront != 0;
+      s.levelSetImplicitUpdate = flow.levelSetFront == 2;
 
+      const Eigen::Vector2d centroidBefore = solvers::measureFront(state.front).centroid;
       const solvers::TwoPhaseStepReport r = solvers::advanceTwoPhase(state, s, ctx.dt);
 
       flow.u.assign(state.u.data(), state.u.data() + state.u.size());
@@ -76,6 +83,15 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
       out.set("front_area", r.area);
       out.set("front_area_drift", flow.initialArea != 0 ? r.area / flow.initialArea - 1 : 0.0);
       out.set("front_points", static_cast<double>(state.front.pointCount()));
+      // Sec. 6.4.5's measures: the top and bottom of the front on the vertical line through its
+      // centroid, the centroid, its velocity over the step, and the circularity 2 sqrt(pi A) / L.
+      const solvers::FrontShape shape = solvers::measureFront(state.front);
+      out.set("front_top", shape.top);
+      out.set("front_bottom", shape.bottom);
+      out.set("front_centroid_x", shape.centroid.x());
+      out.set("front_centroid_y", shape.centroid.y());
+      out.set("front_rise_velocity", (shape.centroid.y() - centroidBefore.y()) / ctx.dt);
+      out.set("front_circularity", shape.circularity);
       out.set("front_remesh_changes", static_cast<double>(r.remeshChanges));
       out.set("fluid_solver_iterations", r.solve.iterations);
       out.set("fluid_solver_relative_residual", r.solve.relativeResidual());

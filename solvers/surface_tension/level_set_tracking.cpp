@@ -57,6 +57,37 @@ std::vector<double> advectCellField(const MacLayout<2>& layout, const std::vecto
   return out;
 }
 
+void moveLevelSetWithFront(const MacLayout<2>& layout, const Front2& front, const std::vector<Eigen::Vector2d>& velocity,
+                           double dt, std::vector<double>& phi, double band) {
+  const double reach = band * layout.dx;
+  std::vector<double> best(layout.cellCount(), reach), speed(layout.cellCount(), 0.0);
+  std::vector<char> found(layout.cellCount(), 0);
+  for (const auto& e : front.elements) {
+    const Eigen::Vector2d a = front.points[e[0]], b = front.points[e[1]], edge = b - a;
+    const double length = edge.norm();
+    if (!(length > 0)) continue;
+    const Eigen::Vector2d normal(edge.y() / length, -edge.x() / length);  // outward: R t
+    const Eigen::Vector2d lo = (a.cwiseMin(b) - layout.origin) / layout.dx - Eigen::Vector2d::Constant(band + 1);
+    const Eigen::Vector2d hi = (a.cwiseMax(b) - layout.origin) / layout.dx + Eigen::Vector2d::Constant(band + 1);
+    const int i0 = std::max(0, static_cast<int>(std::floor(lo.x()))), i1 = std::min(layout.cells.x() - 1, static_cast<int>(hi.x()));
+    const int j0 = std::max(0, static_cast<int>(std::floor(lo.y()))), j1 = std::min(layout.cells.y() - 1, static_cast<int>(hi.y()));
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const int c = layout.cellIndex(Eigen::Vector2i(i, j));
+        const Eigen::Vector2d x = layout.cellCenter(Eigen::Vector2i(i, j));
+        const double t = std::clamp((x - a).dot(edge) / edge.squaredNorm(), 0.0, 1.0);
+        const double distance = (x - (a + t * edge)).norm();
+        if (distance >= best[c] && found[c]) continue;
+        if (distance > reach) continue;
+        best[c] = distance;
+        found[c] = 1;
+        speed[c] = ((1 - t) * velocity[e[0]] + t * velocity[e[1]]).dot(normal);
+      }
+  }
+  for (int c = 0; c < layout.cellCount(); ++c)
+    if (found[c]) phi[c] -= dt * speed[c];
+}
+
 void redistanceToFront(const MacLayout<2>& layout, const Front2& front, std::vector<double>& phi, double band, double keep) {
   const std::vector<double> distance = bandDistance(layout, front, band);
   for (int c = 0; c < layout.cellCount(); ++c)

@@ -19,6 +19,15 @@ namespace monolith::solvers {
 std::vector<double> advectCellField(const MacLayout<2>& layout, const std::vector<double>& phi, const Eigen::VectorXd& u,
                                     double dt);
 
+// The implicit level-set update (beyond the thesis; its Sec. 6.5 future work): every cell within
+// `band` dx of the front takes the normal speed of its closest point on the front, the point
+// velocities `velocity` (one per front point, e.g. H u^{n+1}) interpolated linearly along the segment
+// and projected on its outward normal V, and phi -= dt V (phi is a signed distance, |grad phi| = 1).
+// The zero level set then moves as the front's points do, to first order, without the inward drift of
+// redistancing to the chords.
+void moveLevelSetWithFront(const MacLayout<2>& layout, const Front2& front, const std::vector<Eigen::Vector2d>& velocity,
+                           double dt, std::vector<double>& phi, double band = 5);
+
 // Signed distance to `front` (negative inside, sign taken from `phi`) for the cells between `keep`
 // and `band` cells from it.
 void redistanceToFront(const MacLayout<2>& layout, const Front2& front, std::vector<double>& phi, double band = 5,

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "solvers/advection/eno.h"
 #include "solvers/advection/semi_lagrangian.h"
 #include "solvers/surface_tension/level_set_front.h"
 #include "solvers/surface_tension/level_set_tracking.h"
@@ -159,6 +160,29 @@ InterfaceDiscretization discretizeInterface(const MacLayout<2>& layout, const Fr
     centroid[p.cell] += len * (a + 0.5 * (p.alpha + p.beta) * e);
     pieceLength[p.cell] += len;
     D.cutCell[p.cell] = 1;
+  }
+  // The node parity above is ambiguous at a node the front passes through (a front point on a grid
+  // node: the node counts as on one side, and a face that only touches the front there gets the
+  // wrong phase). Next to cut cells each stretch of a face between crossings is therefore classified
+  // by the inside test of its midpoint instead.
+  for (int f = 0; f < nf; ++f) {
+    const auto [axis, idx] = layout.faceCoord(f);
+    Index2 lower = idx;
+    lower[axis] -= 1;
+    const bool nearCut = (idx[axis] < n[axis] && D.cutCell[layout.cellIndex(idx)]) ||
+                         (lower[axis] >= 0 && D.cutCell[layout.cellIndex(lower)]);
+    if (!nearCut) continue;
+    const Eigen::Vector2d start = layout.origin + dx * idx.cast<double>();
+    Eigen::Vector2d along = Eigen::Vector2d::Zero();
+    along[1 - axis] = dx;
+    double last = 0, length = 0;
+    std::vector<double> ends = placed.faceCrossings[f];
+    ends.push_back(1.0);
+    for (double t : ends) {
+      if (t > last && insideFront(front, start + 0.5 * (last + t) * along)) length += t - last;
+      last = t;
+    }
+    D.insideLength[f] = length * dx;
   }
   // Pressure unknowns. An uncut cell's phase is its left face's (all its faces are uncut).
   D.insideDof.assign(nc, -1);
@@ -358,6 +382,13 @@ void extrapolateToAir(const MacLayout<2>& layout, const InterfaceDiscretization&
 }  // namespace
 
 namespace {
+// ENO/RK3 is stable up to CFL ~1: with a CFL bound, the step is split into that many substeps.
+int advectionSubsteps(const MacLayout<2>& layout, const Eigen::VectorXd& u, double dt, double cflBound) {
+  if (!(cflBound > 0) || u.size() == 0) return 1;
+  const double cfl = u.cwiseAbs().maxCoeff() * dt / layout.dx;
+  return std::max(1, static_cast<int>(std::ceil(cfl / cflBound)));
+}
+
 // The level set's mesh; a level set so distorted that its marching-squares segments no longer
 // chain into curves (two segments leaving one crossing) is a blow-up, reported as such.
 bool rebuildFront(TwoPhaseState& state, const MacLayout<2>& layout, const TwoPhaseSettings& settings,
@@ -403,7 +434,11 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
   // u*: advection, gravity, then the coupling faces' normal velocity and the explicit force.
   Eigen::VectorXd u = state.u;
   if (settings.onePhase) extrapolateToAir(layout, D, u);
-  if (settings.advect) u = advectFacesSemiLagrangian(layout, u, dt);
+  if (settings.advection == TwoPhaseAdvection::SemiLagrangian) u = advectFacesSemiLagrangian(layout, u, dt);
+  if (settings.advection == TwoPhaseAdvection::EnoRk3) {
+    const int substeps = advectionSubsteps(layout, u, dt, settings.advectionCfl);
+    for (int k = 0; k < substeps; ++k) u = advectFacesEnoRk3(layout, u, dt / substeps);
+  }
   Eigen::VectorXd ustar(nu);
   for (int q = 0; q < D.gridUnknowns; ++q) {
     const int f = D.unknownFace[q];
@@ -472,15 +507,32 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
     state.pInside[c] = D.insideDof[c] >= 0 ? z[D.insideDof[c]] / dt : 0.0;
     state.pOutside[c] = D.outsideDof[c] >= 0 ? z[D.outsideDof[c]] / dt : 0.0;
   }
-  if (settings.levelSetFront) {
+  if (settings.levelSetFront && settings.levelSetImplicitUpdate) {
+    // phi moves with the Lagrangian velocity H u^{n+1}; the mesh is rebuilt from it and phi is
+    // redistanced to that mesh beyond 2 cells, as below.
+    const Eigen::VectorXd v = D.Ht.transpose() * unew;
+    std::vector<Eigen::Vector2d> velocity(state.front.pointCount());
+    for (int k = 0; k < state.front.pointCount(); ++k) velocity[k] = v.segment<2>(2 * k);
+    moveLevelSetWithFront(layout, state.front, velocity, dt, state.phi);
+    if (rebuildFront(state, layout, settings, report)) redistanceToFront(layout, state.front, state.phi);
+  } else if (settings.levelSetFront) {
     // The level set moves with the grid velocity; the mesh is rebuilt from it and it is
     // redistanced to that mesh.
-    state.phi = advectCellField(layout, state.phi, state.u, dt);
+    if (settings.advection == TwoPhaseAdvection::EnoRk3) {
+      const Eigen::VectorXd phi = Eigen::Map<const Eigen::VectorXd>(state.phi.data(), static_cast<Eigen::Index>(state.phi.size()));
+      Eigen::VectorXd next = phi;
+      const int substeps = advectionSubsteps(layout, state.u, dt, settings.advectionCfl);
+      for (int k = 0; k < substeps; ++k) next = advectScalarEnoRk3(layout, next, state.u, dt / substeps);
+      state.phi.assign(next.data(), next.data() + next.size());
+    } else {
+      state.phi = advectCellField(layout, state.phi, state.u, dt);
+    }
     if (rebuildFront(state, layout, settings, report)) redistanceToFront(layout, state.front, state.phi);
   } else {
     const Eigen::VectorXd v = D.Ht.transpose() * unew;  // H u^{n+1}
     for (int k = 0; k < state.front.pointCount(); ++k) state.front.points[k] += dt * v.segment<2>(2 * k);
-    report.remeshChanges = remeshClosedFront(state.front, settings.minSegment * dx, settings.maxSegment * dx);
+    if (settings.remesh)
+      report.remeshChanges = remeshClosedFront(state.front, settings.minSegment * dx, settings.maxSegment * dx);
   }
   state.time += dt;
   ++state.step;

@@ -29,7 +29,7 @@
 //    H = (H^T)^T interpolates coupling-face normal velocities to the particles (normal only);
 //  * C: per segment, C_{k,k} = -C_{k,k+1} = dt sqrt(sigma / l) n^T (C^T C = -dt D, D the normal-only
 //    force derivative); the explicit variant drops the C H rows (D = C = 0).
-// Time step: advection of the grid face velocities (semi-Lagrangian), gravity, the explicit
+// Time step: advection of the grid face velocities (semi-Lagrangian or ENO/RK3), gravity, the explicit
 // force, the solve, then the front moves with x^{n+1} = x^n + dt H u^{n+1} and is remeshed.
 // Walls bound the domain on all sides (normal velocity 0, no-slip for the viscous rows).
 #include <Eigen/Core>
@@ -43,6 +43,12 @@
 
 namespace monolith::solvers {
 
+// The convective step of the grid velocities (and of a level-set-tracked front's phi): none,
+// semi-Lagrangian (solvers/advection/semi_lagrangian.h; unconditionally stable), or the thesis's
+// third-order Hamilton-Jacobi ENO with TVD RK3 (Sec. 6.3; solvers/advection/eno.h; stable for
+// CFL numbers up to about 1).
+enum class TwoPhaseAdvection { None, SemiLagrangian, EnoRk3 };
+
 struct TwoPhaseSettings {
   double densityInside = 1;   // rho: the phase the front's loops enclose
   double densityOutside = 1;  // rho': ignored in one phase
@@ -51,13 +57,24 @@ struct TwoPhaseSettings {
   double sigma = 0;      // surface tension coefficient
   bool implicitSurfaceTension = true;  // false: the explicit variant, D = C = 0
   Eigen::Vector2d gravity = Eigen::Vector2d::Zero();
-  bool advect = true;  // semi-Lagrangian advection of the velocities
+  TwoPhaseAdvection advection = TwoPhaseAdvection::SemiLagrangian;
+  // ENO/RK3 only: 0 advects in one step whatever the CFL number (as the thesis, whose ENO runs are
+  // CFL-limited); > 0 splits the advection into substeps of at most this CFL number (the surface
+  // tension step stays one step).
+  double advectionCfl = 0;
+  bool remesh = true;                         // front tracking: remesh after every step (Sec. 6.3.1)
   double minSegment = 0.5, maxSegment = 1.5;  // remeshing bounds, in dx
   CgSettings solve{20000, 1e-12, 0};
   double blowUpSpeed = 1e3;  // the guard: a step whose max speed exceeds this (or is not finite) blew up
   // Level-set-tracked front (level_set_tracking.h): the front is rebuilt from TwoPhaseState::phi
   // each step and phi, not the points, is advected. Else front tracking.
   bool levelSetFront = false;
+  // Level-set-tracked front, beyond the thesis (its future work, Sec. 6.5): instead of advecting phi
+  // with the grid velocity, move the mesh's points with the coupled solve's Lagrangian velocity
+  // H u^{n+1}, as front tracking does (the update the force derivatives assume, backward-Euler
+  // like), and set phi to the signed distance to the moved mesh. The next step's mesh is rebuilt
+  // from that phi as usual.
+  bool levelSetImplicitUpdate = false;
 };
 
 struct TwoPhaseState {

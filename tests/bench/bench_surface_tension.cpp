@@ -42,14 +42,31 @@ int main(int argc, char** argv) {
       }
     }
   } else if (mode == "static") {
+    // Options among the sizes: points=P (front points; default the original driver's 2^k at about
+    // dx / 4; one_per_dx: one point per dx of arc), remesh, rho_out=R.
     const bool one = argc > 2 && (std::string(argv[2]) == "one" || std::string(argv[2]) == "one_ls");
     const bool ls = argc > 2 && std::string(argv[2]).find("_ls") != std::string::npos;
-    std::printf("static circle, %s phase, %s, implicit, t = 5, dt = 0.2 dx\n"
+    int points = 0;
+    bool remesh = false;
+    double rhoOut = 1e4;
+    std::vector<int> ns;
+    for (int i = 3; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (a.rfind("points=", 0) == 0) points = std::atoi(a.c_str() + 7);
+      else if (a == "one_per_dx") points = -1;
+      else if (a == "remesh") remesh = true;
+      else if (a.rfind("rho_out=", 0) == 0) rhoOut = std::atof(a.c_str() + 8);
+      else ns.push_back(std::atoi(a.c_str()));
+    }
+    if (ns.empty()) ns = {20, 40, 80};
+    std::printf("static circle, %s phase, %s, implicit, t = 5, dt = 0.2 dx, front points %s%s, rho_out %g\n"
                 "| 1/dx | L1(u) | Linf(u) | pressure jump | jump error | steps | CG its (last) | wall s |\n|---|---|---|---|---|---|---|---|\n",
-                one ? "one" : "two", ls ? "level-set front" : "front tracking");
-    for (int n : sizes(argc, argv, 3, {20, 40, 80})) {
+                one ? "one" : "two", ls ? "level-set front" : "front tracking",
+                points == 0 ? "2^k at about dx/4" : points < 0 ? "one per dx" : std::to_string(points).c_str(), remesh ? ", remeshed" : "", rhoOut);
+    for (int n : ns) {
       const auto start = std::chrono::steady_clock::now();
-      const StaticCircleResult r = runStaticCircle(n, one, true, 5.0, ls);
+      const int p = points >= 0 ? points : static_cast<int>(std::lround(2 * M_PI * 0.25 * n));
+      const StaticCircleResult r = runStaticCircle(n, one, true, 5.0, ls, p, remesh, rhoOut);
       std::printf("| %d | %.3e | %.3e | %.5f | %.2e | %d | %d | %.1f |\n", n, r.l1, r.linf, r.pressureJump,
                   std::abs(r.pressureJump - 4.0) / 4.0, r.steps, r.lastIterations, seconds(start));
       std::fflush(stdout);
@@ -67,20 +84,79 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
       }
   } else if (mode == "rising_stability") {
+    // rising_stability [N] [sl|eno|eno_sub] [front|ls] [dt...]: both variants at each dt, to t = 90 s.
+    // eno_sub: ENO/RK3 in substeps of CFL <= 0.9.
     const int n = argc > 2 ? std::atoi(argv[2]) : 80;
-    std::printf("rising bubble stability (Sec. 6.4.4: %dx%d, rho 1e4/1e3, mu 1, sigma 0.5, g -8e-4), to t = 90 s, semi-Lagrangian\n"
-                "| dt | variant | stable | steps | max speed | capillary dt | dt / capillary | area drift | blow-up | wall s |\n|---|---|---|---|---|---|---|---|---|---|\n",
-                n, 2 * n);
-    for (double dt : std::vector<double>{3.0, 7.0}) {
+    const bool eno = argc > 3 && std::string(argv[3]).rfind("eno", 0) == 0;
+    const double advectionCfl = argc > 3 && std::string(argv[3]) == "eno_sub" ? 0.9 : 0.0;
+    const bool ls = argc > 4 && std::string(argv[4]) == "ls";
+    std::vector<double> dts;
+    for (int i = 5; i < argc; ++i) dts.push_back(std::atof(argv[i]));
+    if (dts.empty()) dts = {3.0, 7.0};
+    std::printf("rising bubble stability (Sec. 6.4.4: %dx%d, rho 1e4/1e3, mu 1, sigma 0.5, g -8e-4), to t = 90 s, %s, %s\n"
+                "| dt | variant | stable | steps | max speed | max CFL | capillary dt | dt / capillary | area drift | blow-up | wall s |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|\n",
+                n, 2 * n, eno ? (advectionCfl > 0 ? "ENO/RK3 in substeps of CFL <= 0.9" : "ENO/RK3") : "semi-Lagrangian",
+                ls ? "level-set front" : "front tracking");
+    for (double dt : dts) {
       for (bool implicit : {true, false}) {
         const auto start = std::chrono::steady_clock::now();
-        const RisingBubbleStability r = runRisingBubbleStability(n, dt, implicit, static_cast<int>(std::lround(90 / dt)));
-        std::printf("| %g | %s | %s | %d | %.3e | %.4f | %.1f | %.3f | %s | %.1f |\n", dt, implicit ? "implicit" : "explicit",
-                    r.stable ? "yes" : "no", r.steps, r.maxSpeed, r.capillaryDt, dt / r.capillaryDt, r.areaChange, r.reason.c_str(),
-                    seconds(start));
+        const RisingBubbleStability r =
+            runRisingBubbleStability(n, dt, implicit, static_cast<int>(std::lround(90 / dt)),
+                                     eno ? TwoPhaseAdvection::EnoRk3 : TwoPhaseAdvection::SemiLagrangian, ls, advectionCfl);
+        std::printf("| %g | %s | %s | %d | %.3e | %.2f | %.4f | %.1f | %.3f | %s | %.1f |\n", dt, implicit ? "implicit" : "explicit",
+                    r.stable ? "yes" : "no", r.steps, r.maxSpeed, r.maxSpeed * dt * n, r.capillaryDt, dt / r.capillaryDt, r.areaChange,
+                    r.reason.c_str(), seconds(start));
         std::fflush(stdout);
       }
     }
+  } else if (mode == "rising_bubble") {
+    // rising_bubble [sl|eno] [front|ls] [endTime] [N...]: Sec. 6.4.5, top and bottom of the bubble
+    // on x = 0 against time at each resolution, then the observed orders at the end time.
+    const bool eno = argc > 2 && std::string(argv[2]) == "eno";
+    const bool ls = argc > 3 && std::string(argv[3]) == "ls";
+    const double endTime = argc > 4 ? std::atof(argv[4]) : 0.05;
+    const std::vector<int> ns = sizes(argc, argv, 5, {20, 40, 80});
+    std::vector<RisingBubbleRun> runs;
+    for (int n : ns) {
+      const auto start = std::chrono::steady_clock::now();
+      runs.push_back(runRisingBubble(n, endTime, endTime / 10, 2.0, eno ? TwoPhaseAdvection::EnoRk3 : TwoPhaseAdvection::SemiLagrangian, ls));
+      const RisingBubbleRun& r = runs.back();
+      std::printf("\n%dx%d, %s, %s, dt %.3g s (%.1f x capillary), %d steps, %s, max speed %.3f m/s, wall %.1f s\n"
+                  "| t (s) | top (m) | bottom (m) | centroid y (m) | rise velocity (m/s) | circularity | area drift |\n|---|---|---|---|---|---|---|\n",
+                  n, 3 * n / 2, eno ? "ENO/RK3" : "semi-Lagrangian", ls ? "level-set front" : "front tracking", r.dt,
+                  r.dt / r.capillaryDt, r.steps, r.stable ? "stable" : r.reason.c_str(), r.maxSpeed, seconds(start));
+      for (const auto& s : r.samples)
+        std::printf("| %.4f | %.5e | %.5e | %.5e | %.4f | %.4f | %+.2e |\n", s.time, s.top, s.bottom, s.centroidY, s.riseVelocity,
+                    s.circularity, s.areaDrift);
+      std::fflush(stdout);
+    }
+    // Observed order from three successive resolutions at the end time: log2 |e(h) - e(h/2)| / |e(h/2) - e(h/4)|.
+    for (std::size_t i = 0; i + 2 < runs.size(); ++i) {
+      if (runs[i].samples.empty() || runs[i + 1].samples.empty() || runs[i + 2].samples.empty()) continue;
+      const auto &a = runs[i].samples.back(), &b = runs[i + 1].samples.back(), &c = runs[i + 2].samples.back();
+      std::printf("order at t = %.4f from N = %d, %d, %d: top %.2f, bottom %.2f\n", c.time, ns[i], ns[i + 1], ns[i + 2],
+                  std::log2(std::abs(a.top - b.top) / std::abs(b.top - c.top)),
+                  std::log2(std::abs(a.bottom - b.bottom) / std::abs(b.bottom - c.bottom)));
+    }
+  } else if (mode == "stability_csv") {
+    // stability_csv circle|ellipse ft_explicit|ft_implicit|ls_explicit|ls_implicit|ls_implicit_update|pressure_jump STEPS N...: one CSV row
+    // per (N, dt multiple), for tests/bench/plot_stability_map.py.
+    const bool ellipse = argc > 2 && std::string(argv[2]) == "ellipse";
+    const std::string scheme = argc > 3 ? argv[3] : "ft_implicit";
+    const int steps = argc > 4 ? std::atoi(argv[4]) : 500;
+    const bool implicit = scheme.find("implicit") != std::string::npos, ls = scheme.rfind("ls", 0) == 0;
+    const bool update = scheme == "ls_implicit_update";
+    for (int n : sizes(argc, argv, 5, {16, 32, 64}))
+      for (double m : {0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0}) {
+        const auto start = std::chrono::steady_clock::now();
+        const StabilityCase r = scheme == "pressure_jump"
+                                    ? runPressureJumpStabilityCase(n, m * stabilityCapillaryDt(n), ellipse, steps)
+                                    : runStabilityCase(n, m * stabilityCapillaryDt(n), implicit, ellipse, steps, ls, update);
+        std::printf("%s,%s,%d,%g,%.6g,%d,%d,%.4g,%.2f\n", ellipse ? "ellipse" : "circle", scheme.c_str(), n, m,
+                    m * stabilityCapillaryDt(n), r.stable ? 1 : 0, r.steps, r.maxSpeed, seconds(start));
+        std::fflush(stdout);
+      }
   } else if (mode == "stability_map") {
     // Figs. 6.6/6.7: o stable for 500 steps, x unstable; rows dt as multiples of the explicit
     // capillary limit at that dx, columns 1/dx.

@@ -7,6 +7,8 @@
 
 #include <cmath>
 
+#include "solvers/surface_tension/front_metrics.h"
+#include "solvers/surface_tension/pressure_jump.h"
 #include "solvers/surface_tension/scenarios.h"
 
 using namespace monolith::solvers;
@@ -144,19 +146,23 @@ TEST(SurfaceTensionDiscretization, ForceDistributionConservesEveryParticlesForce
   EXPECT_EQ(discretizeInterface(layout, front, explicitSettings, 0.01).CH.rows(), 0);  // D = C = 0
 }
 
-TEST(SurfaceTensionStaticCircle, PressureJumpAndParasiticCurrentsOnePhaseAndTwoPhase) {
-  // Tables 6.2/6.3 at 1/dx = 20, t = 5 (500 steps). Measured: two phase L1 2.14e-6, Linf 3.55e-5;
-  // one phase L1 2.27e-6, Linf 1.27e-5 (the thesis's front tracking: 2.8e-7 / 8.3e-7 and
-  // 1.8e-7 / 9.6e-7, see docs/benchmarks_surface_tension.md). The bounds are 1.5x the measured
-  // values; the jump sigma / r = 4 within 1 % (measured 0.19 % / 0.20 %).
+TEST(SurfaceTensionStaticCircle, ParasiticCurrentsAtOrBelowTheThesisOnePhaseAndTwoPhase) {
+  // Tables 6.2/6.3 at 1/dx = 20, t = 5 (500 steps), front tracking with the original driver's front
+  // (2^7 = 128 points, spacing about dx / 4, no remeshing). The thesis's front tracking: one phase L1 1.83e-7, Linf 9.59e-7;
+  // two phase 2.76e-7 / 8.32e-7. Measured: one phase 8.4e-10 / 5.7e-9, two phase 1.2e-8 / 1.1e-7.
+  // The jump sigma / r = 4 within 1 % (measured 0.006 % / 0.005 %).
   for (bool onePhase : {false, true}) {
     const StaticCircleResult r = runStaticCircle(20, onePhase, true, 5.0);
     EXPECT_TRUE(r.stable);
     EXPECT_EQ(r.steps, 500);
     EXPECT_NEAR(r.pressureJump, 4.0, 0.04) << (onePhase ? "one phase" : "two phase");
-    EXPECT_LT(r.l1, 3.5e-6);
-    EXPECT_LT(r.linf, onePhase ? 2e-5 : 5.5e-5);
+    EXPECT_LE(r.l1, onePhase ? 1.83e-7 : 2.76e-7) << (onePhase ? "one phase" : "two phase");
+    EXPECT_LE(r.linf, onePhase ? 9.59e-7 : 8.32e-7) << (onePhase ? "one phase" : "two phase");
   }
+  // With one point per dx of arc and remeshing (31 points here) the same run is 8-40x above the
+  // thesis (measured two phase 2.1e-6 / 3.6e-5): the segment-angle error above, not a bug.
+  const StaticCircleResult coarse = runStaticCircle(20, false, true, 1.0, false, 31, true);
+  EXPECT_GT(coarse.linf, 8.32e-7);
 }
 
 TEST(SurfaceTensionOscillatingCircle, PeriodAndProbeAtCoarseResolution) {
@@ -226,4 +232,119 @@ TEST(SurfaceTensionStaticCircle, LevelSetTrackedFrontOnePhaseAndTwoPhase) {
     EXPECT_LT(r.l1, onePhase ? 2.6e-7 : 6.8e-7);
     EXPECT_LT(r.linf, onePhase ? 1.7e-6 : 8.5e-6);
   }
+}
+
+TEST(SurfaceTensionFront, ShapeMeasuresOfASquare) {
+  // The unit square about (2, 3): area 1, length 4, centroid (2, 3), top 3.5 and bottom 2.5 on the
+  // line x = 2, circularity 2 sqrt(pi) / 4.
+  const Front2 square = closedPolyline({{1.5, 2.5}, {2.5, 2.5}, {2.5, 3.5}, {1.5, 3.5}});
+  const FrontShape s = measureFront(square);
+  EXPECT_NEAR(s.area, 1.0, 1e-14);
+  EXPECT_NEAR(s.length, 4.0, 1e-14);
+  EXPECT_NEAR(s.centroid.x(), 2.0, 1e-14);
+  EXPECT_NEAR(s.centroid.y(), 3.0, 1e-14);
+  EXPECT_NEAR(s.top, 3.5, 1e-14);
+  EXPECT_NEAR(s.bottom, 2.5, 1e-14);
+  EXPECT_NEAR(s.circularity, std::sqrt(M_PI) / 2, 1e-14);
+}
+
+TEST(SurfaceTensionRisingBubble, EnoRk3ImplicitStableAt3s) {
+  // Sec. 6.4.4 with the thesis's ENO/RK3 advection at 40 x 80, dt = 3 s (18x the capillary limit
+  // here), 10 steps: the implicit variant stays bounded by the rise speed (measured max 1.2e-2 m/s
+  // over 30 steps, CFL 1.5).
+  const RisingBubbleStability r = runRisingBubbleStability(40, 3.0, true, 10, TwoPhaseAdvection::EnoRk3);
+  EXPECT_TRUE(r.stable) << r.reason;
+  EXPECT_LT(r.maxSpeed, 0.02);
+  EXPECT_LT(std::abs(r.areaChange), 0.1);
+}
+
+TEST(SurfaceTensionRisingBubble, AirBubbleInWaterAcceleratesAndFlattens) {
+  // Sec. 6.4.5 at 20 x 30 cells to t = 0.01 s (5 steps of 2e-3 s). From rest, the bubble's centroid
+  // accelerates at most at the unbounded potential-flow value g (rho_w - rho_a) / (rho_w + rho_a)
+  // (walls 3 radii away add mass); measured 6.1 m/s^2 over the first step. Its bottom rises faster
+  // than its top (the bubble flattens), so the circularity falls; the area stays within 1 %.
+  const RisingBubbleRun run = runRisingBubble(20, 0.01, 0.002);
+  ASSERT_TRUE(run.stable) << run.reason;
+  ASSERT_EQ(run.samples.size(), 6u);
+  const double g = 9.8 * (1000 - 1.226) / (1000 + 1.226);
+  const double acceleration = run.samples[1].riseVelocity / run.samples[1].time;
+  EXPECT_GT(acceleration, 0.5 * g);
+  EXPECT_LT(acceleration, g);
+  const auto &first = run.samples.front(), &last = run.samples.back();
+  EXPECT_GT(last.top, first.top);
+  EXPECT_GT(last.bottom - first.bottom, last.top - first.top);
+  EXPECT_LT(last.circularity, first.circularity);
+  EXPECT_GT(last.riseVelocity, run.samples[1].riseVelocity);
+  for (const auto& s : run.samples) EXPECT_LT(std::abs(s.areaDrift), 0.01) << "t = " << s.time;
+}
+
+TEST(SurfaceTensionStability, ImplicitLevelSetUpdateClosesTheLevelSetGap) {
+  // Sec. 6.4.6's ellipse (Fig. 6.7) at N = 32, dt = 32x the explicit capillary limit, 500 steps.
+  // The level set advected with the grid velocity is unstable there even with implicit surface
+  // tension (measured: the guard fires at step 45); moving phi with the coupled solve's Lagrangian
+  // velocity H u (the implicit level-set update of Sec. 6.5's future work) keeps it stable, as front
+  // tracking is (measured stable to 128x).
+  const double dt = 32 * stabilityCapillaryDt(32);
+  const StabilityCase advected = runStabilityCase(32, dt, true, true, 500, true, false);
+  EXPECT_FALSE(advected.stable);
+  const StabilityCase updated = runStabilityCase(32, dt, true, true, 500, true, true);
+  EXPECT_TRUE(updated.stable);
+  EXPECT_EQ(updated.steps, 500);
+  EXPECT_LT(updated.maxSpeed, 0.05);
+}
+
+TEST(SurfaceTensionDiscretization, FrontThroughAGridNodeKeepsThePhases) {
+  // The original driver's circle puts points on the axes through the centre; at 1/dx = 20 four of
+  // them sit on grid nodes. A cell that the front touches only at such a corner must keep its own
+  // phase (it was once classified by the node's ambiguous parity: a 3.7e-5 jet after one step in two
+  // phases). One step of the two-phase static circle: measured max speed 2.1e-9.
+  const double dx = 0.05;
+  TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(20, 20), dx),
+                                          perturbedCircle(Eigen::Vector2d(0.5, 0.5), 0.25, 0, 0, 128, 0.0));
+  TwoPhaseSettings settings = staticCircleSettings(false, true);
+  settings.remesh = false;
+  const InterfaceDiscretization D = discretizeInterface(state.layout, state.front, settings, 0.2 * dx);
+  const int corner = state.layout.cellIndex(Eigen::Vector2i(15, 10));  // touched at its lower-left node
+  EXPECT_FALSE(D.cutCell[corner]);
+  EXPECT_LT(D.insideDof[corner], 0);
+  EXPECT_GE(D.outsideDof[corner], 0);
+  const TwoPhaseStepReport r = advanceTwoPhase(state, settings, 0.2 * dx);
+  EXPECT_LT(r.maxSpeed, 1e-8);
+}
+
+TEST(SurfaceTensionStability, PressureJumpSchemeIsExplicitlyLimited) {
+  // The comparison scheme of Figs. 6.6/6.7 (pressure_jump.h) on Sec. 6.4.6's circle at N = 32:
+  // stable for 200 steps at 2x the explicit capillary limit (measured max speed 6.2e-4 m/s, the drop
+  // at rest up to parasitic currents), unstable at 8x within a few steps (measured: step 5), like
+  // the explicit front-tracked variant.
+  const StabilityCase slow = runPressureJumpStabilityCase(32, 2 * stabilityCapillaryDt(32), false, 200);
+  EXPECT_TRUE(slow.stable);
+  EXPECT_LT(slow.maxSpeed, 2e-3);
+  const StabilityCase fast = runPressureJumpStabilityCase(32, 8 * stabilityCapillaryDt(32), false, 500);
+  EXPECT_FALSE(fast.stable);
+  EXPECT_LT(fast.steps, 50);
+}
+
+TEST(SurfaceTensionStability, LevelSetCurvatureOfACircle) {
+  // kappa = 1 / r from the signed distance of a circle, r = 10 dx: within 1 % at the cells near it.
+  const MacLayout<2> layout(Eigen::Vector2i(40, 40), 0.025);
+  std::vector<double> phi(layout.cellCount());
+  for (int c = 0; c < layout.cellCount(); ++c)
+    phi[c] = (layout.cellCenter(layout.cellCoord(c)) - Eigen::Vector2d(0.5, 0.5)).norm() - 0.25;
+  const std::vector<double> kappa = levelSetCurvature(layout, phi);
+  for (int c = 0; c < layout.cellCount(); ++c) {
+    if (std::abs(phi[c]) > layout.dx) continue;
+    const double r = phi[c] + 0.25;
+    EXPECT_NEAR(kappa[c] * r, 1.0, 0.01);
+  }
+}
+
+TEST(SurfaceTensionRisingBubble, EnoRk3LevelSetInCflSubsteps) {
+  // The level-set-tracked bubble with ENO/RK3 at 40 x 80, dt = 3 s: the advection split into
+  // substeps of CFL <= 0.9 (one surface-tension step) keeps the level set's mesh closed and the
+  // speed bounded over 8 steps.
+  const RisingBubbleStability r = runRisingBubbleStability(40, 3.0, true, 8, TwoPhaseAdvection::EnoRk3, true, 0.9);
+  EXPECT_TRUE(r.stable) << r.reason;
+  EXPECT_LT(r.maxSpeed, 0.02);
+  EXPECT_LT(std::abs(r.areaChange), 0.05);
 }
