@@ -315,6 +315,13 @@ TEST(Articulation, BadJointsAreRefusedAtTheirJsonPath) {
   refuse(R"({ "type": "fixed", "parent": "floor", "child": "a", "anchor": [0, 0, 0] })", "entities[5].joint", R"(,
       { "name": "k", "joint": { "type": "fixed", "parent": "world", "child": "b", "anchor": [1, 0, 0] } },
       { "name": "l", "joint": { "type": "fixed", "parent": "a", "child": "b", "anchor": [0.5, 0, 0] } })");
+  // Loops of other joints whose rows repeat: two parallel hinges on the world hold "a" twice
+  // (4 of the second's 5 rows repeat the first's), a ball joint beside a fixed one repeats 3.
+  refuse(R"({ "type": "revolute", "parent": "world", "child": "a", "anchor": [0, 0, 0], "axis": [0, 0, 1] })",
+         "entities[4].joint", R"(,
+      { "name": "k", "joint": { "type": "revolute", "parent": "world", "child": "a", "anchor": [0.5, 0, 0], "axis": [0, 0, 1] } })");
+  refuse(R"({ "type": "fixed", "parent": "a", "child": "b", "anchor": [0.5, 0, 0] })", "entities[4].joint", R"(,
+      { "name": "k", "joint": { "type": "spherical", "parent": "b", "child": "a", "anchor": [0.5, 0, 0] } })");
   refuse(R"({ "type": "spherical", "parent": "a", "child": "b", "anchor": [0.5, 0, 0] })", "entities[5].articulation", R"(,
       { "name": "s1", "articulation": {} }, { "name": "s2", "articulation": {} })");
 }
