@@ -246,8 +246,8 @@ Scene load(const Options& o) {
     if (!entity.contains("rigid_body")) fail(path + ".rigid_body: every entity must be a rigid body here");
     if (entity.contains("joint")) {
       const json& j = entity["joint"];
-      refuseOtherKeys(j, {"type", "parent", "anchor"}, path + ".joint", "Bullet");
       if (j.value("type", "") != "spherical") fail(path + ".joint.type: only spherical joints (point-to-point) run in Bullet here");
+      refuseOtherKeys(j, {"type", "parent", "anchor"}, path + ".joint", "Bullet");
       if (!j.contains("anchor")) fail(path + ".joint.anchor: a world anchor is needed here");
       const std::string parent = j.value("parent", "world");
       int p = -1;
