@@ -3,14 +3,18 @@
 // eps ramps to 1 over the sweeps (early sweeps remove only part of the approach velocity, the
 // last one is fully inelastic). The candidate positions are x^n + dt v^{n+1/2}. Not clamped
 // (Sec. 2.3.2: clamping this split state against (x^n, v^n) makes resting stacks jitter).
+#include "components/joint.h"
 #include "systems/rigid_contact.h"
 
 namespace monolith {
 
 template <int d>
-void Contact<d>::run(World<d>&, StepContext& ctx) {
+void Contact<d>::run(World<d>& world, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (ws.bodies.empty()) return;
+  // Joint post-stabilization (Step II.2) and PD (Step III.2) ran since collisions unpacked.
+  if constexpr (d == 3)
+    if (world.template count<Joint>() > 0) ws.reloadVelocities();
   ws.updateAllCandidates();
   std::vector<int> impulses(ws.islands.members.size(), 0);
   ws.forEachIsland(
