@@ -103,6 +103,11 @@ struct ArticulationSolver {
   double postTolerance = 1e-10;    // largest joint row velocity left (m/s, rad/s)
   int preIterations = 20;          // Newton sweeps (pairwise) or outer Newton iterations (global)
   double preTolerance = 1e-10;     // largest predicted joint position error left (m, rad)
+  // With colliders: rounds of (pre-stabilization, contact sweeps) after Step III's first contact
+  // sweeps, so that contact has the last word and the joints close on what it leaves (Sec. 4.5
+  // processes contact and pre-stabilization together); 0: pre-stabilization once, after shock
+  // propagation.
+  int contactRounds = 5;
 
   template <class V>
   void visitFields(V& visit) {
@@ -113,6 +118,7 @@ struct ArticulationSolver {
     visit("post_tolerance", postTolerance);
     visit("pre_iterations", preIterations);
     visit("pre_tolerance", preTolerance);
+    visit("contact_rounds", contactRounds);
   }
 };
 

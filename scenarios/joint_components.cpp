@@ -8,6 +8,7 @@
 #include "components/kinematic.h"
 #include "components/rigid_body.h"
 #include "ecs/config.h"
+#include "solvers/articulation/joint_constraints.h"
 
 namespace monolith {
 
@@ -159,6 +160,7 @@ void parseArticulation(World<3>& world, Entity e, const Config& c) {
   s.postTolerance = c.number("post_tolerance", s.postTolerance, Bound::Positive);
   s.preIterations = static_cast<int>(c.integer("pre_iterations", s.preIterations, 1, 1000000));
   s.preTolerance = c.number("pre_tolerance", s.preTolerance, Bound::Positive);
+  s.contactRounds = static_cast<int>(c.integer("contact_rounds", s.contactRounds, 0, 1000));
   world.add(e, s);
 }
 
@@ -167,6 +169,52 @@ struct Groups {
   std::vector<int> parent;
   int find(int i) { return parent[i] == i ? i : parent[i] = find(parent[i]); }
 };
+
+// Loops of other joints over-constrain their bodies too when their rows repeat one another (a
+// planar ring of hinges with parallel axes, a spherical joint closing a rigid ring): the
+// Newton of pre-stabilization then asks for corrections no impulse can give, and the global
+// form (App. C.2) diverges. Checked on the rows at the initial poses.
+void refuseRedundantLoops(World<3>& world, const std::string& file, const std::vector<Entity>& created) {
+  std::vector<solvers::ConstraintBody> bodies(1);  // 0: the world
+  std::map<std::uint32_t, int> index;
+  std::vector<solvers::JointDefinition> joints;
+  std::vector<std::size_t> entityOf;
+  auto bodyOf = [&](const std::string& name) {
+    if (name == "world") return 0;
+    const Entity e = *world.find(name);
+    const auto [it, inserted] = index.emplace(e.index, static_cast<int>(bodies.size()));
+    if (inserted) {
+      const RigidBody<3>& b = *world.get<RigidBody<3>>(e);
+      solvers::ConstraintBody c;
+      c.x = b.x;
+      c.q = b.orientation;
+      if (!b.isStatic && !world.get<KinematicMotion<3>>(e)) c.invMass = 1 / b.mass;
+      bodies.push_back(c);
+    }
+    return it->second;
+  };
+  for (std::size_t i = 0; i < created.size(); ++i) {
+    const Joint* j = world.get<Joint>(created[i]);
+    if (!j) continue;
+    solvers::JointDefinition d;
+    d.type = static_cast<solvers::JointKind>(j->type);
+    d.parent = bodyOf(j->parent);
+    d.child = bodyOf(j->child);
+    d.parentAnchor = j->parentAnchor;
+    d.childAnchor = j->childAnchor;
+    d.parentFrame = j->parentFrame;
+    d.childFrame = j->childFrame;
+    joints.push_back(d);
+    entityOf.push_back(i);
+  }
+  const solvers::RedundantJoint r = solvers::firstRedundantJoint(joints, bodies);
+  if (r.joint < 0) return;
+  const Joint& j = *world.get<Joint>(created[entityOf[r.joint]]);
+  throw SceneError(file, "entities[" + std::to_string(entityOf[r.joint]) + "].joint",
+                   "a joint whose rows the loop it closes does not already impose (such a loop over-constrains its bodies)",
+                   "a " + std::string(jointTypeName(j.type)) + " joint between \"" + j.parent + "\" and \"" + j.child +
+                       "\" closing a loop that already fixes " + std::to_string(r.redundantRows) + " of its rows");
+}
 
 }  // namespace
 
@@ -178,7 +226,7 @@ void registerJointComponents(Registry& r) {
       parseJoint);
   r.addComponentOf<3, ArticulationSolver>(
       "how the scene's joints are solved (one per scene): post_stabilization/pre_stabilization \"pairwise\" or "
-      "\"global\", pre_stabilize, post_iterations, post_tolerance, pre_iterations, pre_tolerance",
+      "\"global\", pre_stabilize, post_iterations, post_tolerance, pre_iterations, pre_tolerance, contact_rounds",
       parseArticulation);
 }
 
@@ -246,6 +294,7 @@ void resolveJoints(World<3>& world, const std::string& file, const std::vector<E
       groups.parent[std::max(a, b)] = std::min(a, b);
     }
   }
+  refuseRedundantLoops(world, file, created);
 }
 
 }  // namespace monolith

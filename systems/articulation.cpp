@@ -236,6 +236,17 @@ bool PreStabilizeJoints::needed(const World<3>& w) const {
 }
 
 void PreStabilizeJoints::run(World<3>& world, StepContext& ctx) {
+  // With colliders and contact rounds, contact ran pre-stabilization between its sweeps.
+  if (world.count<Collider<3>>() > 0 && articulationSettings(world).contactRounds > 0) return;
+  preStabilizeJointVelocities(world, ctx);
+}
+
+int jointContactRounds(const World<3>& world) {
+  return world.count<Joint>() > 0 && articulationSettings(world).preStabilization ? articulationSettings(world).contactRounds
+                                                                                     : 0;
+}
+
+void preStabilizeJointVelocities(World<3>& world, StepContext& ctx) {
   const ArticulationSolver s = articulationSettings(world);
   JointAssembly a(world);
   const double dt = ctx.dt;

@@ -72,6 +72,13 @@ class JointDiagnostics final : public JointSystem {
   void run(World<3>& world, StepContext& ctx) override;
 };
 
+// Pre-stabilization on the bodies' velocities (what pre_stabilize_joints runs), and how many
+// rounds of it Step III's contact interleaves with its sweeps (0 without joints or with
+// pre-stabilization off). Step III.3 of Sec. 4.5 processes contact and pre-stabilization
+// together; with rounds, pre_stabilize_joints itself does nothing in a scene with colliders.
+void preStabilizeJointVelocities(World<3>& world, StepContext& ctx);
+int jointContactRounds(const World<3>& world);
+
 // All the joint systems, sharing one velocity memory.
 std::vector<std::unique_ptr<System<3>>> makeJointSystems();
 

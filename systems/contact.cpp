@@ -3,19 +3,36 @@
 // eps ramps to 1 over the sweeps (early sweeps remove only part of the approach velocity, the
 // last one is fully inelastic). The candidate positions are x^n + dt v^{n+1/2}. Not clamped
 // (Sec. 2.3.2: clamping this split state against (x^n, v^n) makes resting stacks jitter).
+#include "components/joint.h"
+#include "systems/articulation.h"
 #include "systems/rigid_contact.h"
 
 namespace monolith {
 
 template <int d>
-void Contact<d>::run(World<d>&, StepContext& ctx) {
+void Contact<d>::run(World<d>& world, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (ws.bodies.empty()) return;
+  // Joint post-stabilization (Step II.2) and PD (Step III.2) ran since collisions unpacked.
+  if constexpr (d == 3)
+    if (world.template count<Joint>() > 0) ws.reloadVelocities();
   ws.updateAllCandidates();
   std::vector<int> impulses(ws.islands.members.size(), 0);
   ws.forEachIsland(
       [&](int island) { impulses[island] = ws.contactSweeps(island, ImpulseMode::Contact, false, nullptr, nullptr); });
   ws.unpack(false);
+  // Joints (systems/articulation.h): rounds of pre-stabilization, then contact again, so that
+  // contact has the last word and the joints close on what it leaves (Sec. 4.5).
+  if constexpr (d == 3)
+    for (int round = 0, rounds = jointContactRounds(world); round < rounds; ++round) {
+      preStabilizeJointVelocities(world, ctx);
+      ws.reloadVelocities();
+      ws.updateAllCandidates();
+      ws.forEachIsland([&](int island) {
+        impulses[island] += ws.contactSweeps(island, ImpulseMode::Contact, false, nullptr, nullptr);
+      });
+      ws.unpack(false);
+    }
   int total = 0;
   for (int n : impulses) total += n;
   ctx.diagnostics.set("contact_impulses", total);

@@ -364,6 +364,15 @@ typename ContactWorkspace<d>::VecD ContactWorkspace<d>::clampFrameVelocity(const
 }
 
 template <int d>
+void ContactWorkspace<d>::reloadVelocities() {
+  for (ContactBody<d>& b : bodies) {
+    if (b.immovable()) continue;
+    b.v = b.body->v;
+    b.L = b.body->L;
+  }
+}
+
+template <int d>
 void ContactWorkspace<d>::unpack(bool positions) {
   for (ContactBody<d>& b : bodies) {
     if (b.immovable()) continue;

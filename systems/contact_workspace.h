@@ -137,6 +137,10 @@ class ContactWorkspace {
   bool pack(World<d>& world, double dt, bool subtractKick);
   // Writes the working velocities (and positions, if `positions`) back to the components.
   void unpack(bool positions);
+  // The working velocities taken again from the bodies: systems between Step II and Step III
+  // (joint post-stabilization and PD, systems/articulation.h) change the bodies' velocities
+  // after collisions unpacked them.
+  void reloadVelocities();
 
   // Kinetic energy of the bodies of finite mass (the reference state of the energy clamp,
   // Sec. 2.3.2), in the world frame and, when the scene has exactly one kinematic body and it

@@ -212,6 +212,14 @@ struct Scene {
   std::vector<std::unique_ptr<btRigidBody>> bodies;
   std::vector<double> sizes;  // smallest extent of each body (Monolith's minimumSize), inf for a plane
   std::vector<btVector3> start;
+  // Spherical joints (Monolith's "joint" with type spherical and a world anchor) as Bullet
+  // point-to-point constraints; no other joint type is carried over.
+  std::vector<std::unique_ptr<btPoint2PointConstraint>> joints;
+  struct JointPivots {
+    int parent = -1, child = -1;  // body indices, -1: the world
+    btVector3 inParent, inChild;
+  };
+  std::vector<JointPivots> pivots;
 };
 
 Scene load(const Options& o) {
@@ -224,13 +232,32 @@ Scene load(const Options& o) {
   if (root.contains("gravity")) s.gravity = vec3(root["gravity"], o.scene + ": gravity");
   s.time = sceneTime(root, o);
   if (!root.contains("entities") || !root["entities"].is_array()) fail(o.scene + ": entities: expected an array");
+  struct WorldJoint {
+    int parent, child;
+    btVector3 anchor;
+  };
+  std::vector<WorldJoint> names;
   for (std::size_t e = 0; e < root["entities"].size(); ++e) {
     const json& entity = root["entities"][e];
     const std::string path = o.scene + ": entities[" + std::to_string(e) + "]";
     // Anything not listed here (a kinematic motion, forces, a fluid ...) would make Bullet run
     // a different scene: refused.
-    refuseOtherKeys(entity, {"name", "shape", "rigid_body", "collider"}, path, "Bullet");
+    refuseOtherKeys(entity, {"name", "shape", "rigid_body", "collider", "joint"}, path, "Bullet");
     if (!entity.contains("rigid_body")) fail(path + ".rigid_body: every entity must be a rigid body here");
+    if (entity.contains("joint")) {
+      const json& j = entity["joint"];
+      if (j.value("type", "") != "spherical") fail(path + ".joint.type: only spherical joints (point-to-point) run in Bullet here");
+      refuseOtherKeys(j, {"type", "parent", "anchor"}, path + ".joint", "Bullet");
+      if (!j.contains("anchor")) fail(path + ".joint.anchor: a world anchor is needed here");
+      const std::string parent = j.value("parent", "world");
+      int p = -1;
+      if (parent != "world") {
+        for (std::size_t k = 0; k < e; ++k)
+          if (root["entities"][k].value("name", "") == parent) p = static_cast<int>(k);
+        if (p < 0) fail(path + ".joint.parent: the parent must be an earlier entity here");
+      }
+      names.push_back({p, static_cast<int>(e), vec3(j["anchor"], path + ".joint.anchor")});
+    }
     const json& rb = entity["rigid_body"];
     refuseOtherKeys(rb, {"static", "mass", "inertia", "position", "orientation", "velocity", "angular_velocity"},
                     path + ".rigid_body", "Bullet");
@@ -276,6 +303,28 @@ Scene load(const Options& o) {
     s.sizes.push_back(size);
     s.start.push_back(pose.getOrigin());
   }
+  // Joints need every entity to be a body (checked above), so entity index = body index.
+  for (const WorldJoint& j : names) {
+    Scene::JointPivots p;
+    p.parent = j.parent, p.child = j.child;
+    btRigidBody& child = *s.bodies[j.child];
+    p.inChild = child.getCenterOfMassTransform().inverse() * j.anchor;
+    if (j.parent < 0) {
+      p.inParent = j.anchor;
+      s.joints.push_back(std::make_unique<btPoint2PointConstraint>(child, p.inChild));
+    } else {
+      btRigidBody& parent = *s.bodies[j.parent];
+      p.inParent = parent.getCenterOfMassTransform().inverse() * j.anchor;
+      s.joints.push_back(std::make_unique<btPoint2PointConstraint>(parent, child, p.inParent, p.inChild));
+    }
+    s.pivots.push_back(p);
+  }
+  // Monolith's bodies without a collider touch nothing; in a jointed scene (a chain that swings
+  // through itself) Bullet's must not either.
+  if (!names.empty())
+    for (std::size_t e = 0; e < s.bodies.size(); ++e)
+      if (!root["entities"][e].contains("collider"))
+        s.bodies[e]->setCollisionFlags(s.bodies[e]->getCollisionFlags() | btCollisionObject::CF_NO_CONTACT_RESPONSE);
   return s;
 }
 
@@ -298,6 +347,18 @@ int main(int argc, char** argv) {
     scene.bodies[i]->setUserIndex(static_cast<int>(i));
     world.addRigidBody(scene.bodies[i].get());
   }
+  for (auto& j : scene.joints) world.addConstraint(j.get(), true);
+  // The largest distance between a joint's two pivots (m).
+  const auto jointError = [&] {
+    double worst = 0;
+    for (const auto& p : scene.pivots) {
+      const btVector3 a = p.parent < 0 ? p.inParent : scene.bodies[p.parent]->getCenterOfMassTransform() * p.inParent;
+      const btVector3 b = scene.bodies[p.child]->getCenterOfMassTransform() * p.inChild;
+      worst = std::max(worst, double((a - b).length()));
+    }
+    return worst;
+  };
+  double jointErrorMax = 0;
 
   // Kinetic and total (kinetic + gravity's potential) energy of the dynamic bodies.
   const auto energies = [&] {
@@ -328,6 +389,7 @@ int main(int argc, char** argv) {
         penetration = std::max(penetration, -double(manifold->getContactPoint(p).getDistance()) / size);
     }
     highestEnergy = std::max(highestEnergy, energies().second);
+    jointErrorMax = std::max(jointErrorMax, jointError());
   }
   double drift = 0;
   int dynamic = 0;
@@ -338,6 +400,7 @@ int main(int argc, char** argv) {
     drift = std::max(drift, double((b.getCenterOfMassPosition() - scene.start[i]).length()));
   }
   const double kinetic = energies().first;
+  for (auto& j : scene.joints) world.removeConstraint(j.get());
   for (auto& b : scene.bodies) world.removeRigidBody(b.get());
 
   std::printf("| engine | scene | bodies | dt | steps | solver iterations | sleeping | us/step | max drift | final KE | "
@@ -346,5 +409,8 @@ int main(int argc, char** argv) {
               btGetVersion(), sizeof(btScalar), fileName(o.scene).c_str(), dynamic, 1 / scene.time.dt, steps, o.iterations,
               o.sleep ? "on" : "off", 1e6 * wall / steps, drift, kinetic, penetration,
               energyRise(highestEnergy, initialEnergy).c_str(), o.ccd ? "on" : "off");
+  if (!scene.joints.empty())
+    std::printf("\n%zu point-to-point joints: max joint error %.3e m, energy end - start %.4g J\n", scene.joints.size(),
+                jointErrorMax, energies().second - initialEnergy);
   return 0;
 }

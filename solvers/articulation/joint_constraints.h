@@ -102,6 +102,19 @@ ProjectionReport projectPairwise(const std::vector<JointRows>& joints, const std
 ProjectionReport projectGlobal(const std::vector<JointRows>& joints, const std::vector<Vector6d>& targets,
                                std::vector<ConstraintBody>& bodies, int maxIterations, double tolerance);
 
+// The first joint (in order) that closes a loop whose rows depend on the rows of the joints
+// before it -- a loop that over-constrains its bodies, such as a ring of fixed joints, a planar
+// ring of hinges with parallel axes, or a spherical joint closing a rigid ring -- with how many
+// of its rows are redundant; -1 when there is none. Bodies of zero inverse mass (static,
+// kinematic, the world) are one immovable node. Rows of revolute limits are left out (they
+// are one-sided and come and go). Only joints that close a loop are tested: a joint that adds a
+// body to a tree never repeats a row.
+struct RedundantJoint {
+  int joint = -1;
+  int redundantRows = 0;
+};
+RedundantJoint firstRedundantJoint(const std::vector<JointDefinition>& joints, const std::vector<ConstraintBody>& bodies);
+
 // Where a body will be after Step IV with its current velocity (the caller's own rule).
 using PosePredictor = std::function<void(int body, const ConstraintBody&, Eigen::Vector3d& x, Eigen::Quaterniond& q)>;
 

@@ -145,3 +145,29 @@ TEST(JointConstraints, PreStabilizationClosesThePredictedPoses) {
     EXPECT_LT(r.errorAfter, 1e-12) << (global ? "global" : "pairwise");
   }
 }
+
+// A ring of four bars in the xy plane: with hinges about z at its corners the ring's out-of-plane
+// rows repeat (3 of the closing hinge's 5: a planar loop), with ball joints none do, and a tree
+// (the same joints without the closing one) never repeats a row.
+TEST(JointConstraints, RedundantLoopsAreFoundAtTheJointThatClosesThem) {
+  std::vector<ConstraintBody> bodies(5);  // 0: the world (unused), 1..4 the bars
+  const Eigen::Vector3d corner[4] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  for (int k = 0; k < 4; ++k) {
+    bodies[k + 1].x = 0.5 * (corner[k] + corner[(k + 1) % 4]);
+    bodies[k + 1].invMass = 1;
+    bodies[k + 1].invInertia = Eigen::Matrix3d::Identity();
+  }
+  auto ring = [&](JointKind type, int joints) {
+    std::vector<JointDefinition> out;
+    for (int k = 0; k < joints; ++k)
+      out.push_back(closedJoint(type, bodies, 1 + (k + 3) % 4, 1 + k, corner[k], Eigen::Quaterniond::Identity()));
+    return out;
+  };
+  const RedundantJoint hinges = firstRedundantJoint(ring(JointKind::Revolute, 4), bodies);
+  EXPECT_EQ(hinges.joint, 3);
+  EXPECT_EQ(hinges.redundantRows, 3);
+  EXPECT_EQ(firstRedundantJoint(ring(JointKind::Spherical, 4), bodies).joint, -1);
+  EXPECT_EQ(firstRedundantJoint(ring(JointKind::Revolute, 3), bodies).joint, -1);
+  // Fixed joints all round: the closing one repeats all six rows.
+  EXPECT_EQ(firstRedundantJoint(ring(JointKind::Fixed, 4), bodies).redundantRows, 6);
+}
