@@ -1,6 +1,7 @@
 #include "systems/deformable_dynamics.h"
 
 #include "solvers/deformable/simplex_mesh.h"
+#include "solvers/deformable/stable_step.h"
 #include "solvers/fluid/krylov.h"
 
 namespace monolith {
@@ -147,6 +148,25 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
           for (std::size_t i = 0; i < u.size(); ++i) p.v[i] = 2 * u[i] - p.v[i];
       });
   ctx.diagnostics.max(half ? "deformable_cg_iterations_half" : "deformable_cg_iterations", iterations);
+  if (half) ctx.diagnostics.set("deformable_stable_dt", unitCflDt(world));
+}
+
+template <int d>
+double AdvanceDeformableVelocity<d>::unitCflDt(const World<d>& world) const {
+  double dt = std::numeric_limits<double>::infinity();
+  if (stage_ != Stage::AdvanceVelocityHalf) return dt;  // one of the two stages reports it
+  const auto* pool = world.template findPool<Particles<d>>();
+  if (!pool) return dt;
+  for (std::size_t k = 0; k < pool->size(); ++k) {
+    const Entity e = pool->entities()[k];
+    const Particles<d>& p = pool->components()[k];
+    const auto* mesh = world.template get<SimplexMesh<d>>(e);
+    const auto* el = world.template get<Elasticity>(e);
+    if (!mesh || !el) continue;
+    const auto& fm = cache_.get(e, p, *mesh, *el);
+    dt = std::min(dt, dm::stableStep<d>(fm, el->density, p.x.data(), p.v.data(), p.fixed).value());
+  }
+  return dt;
 }
 
 template <int d>

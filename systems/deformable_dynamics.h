@@ -69,10 +69,13 @@ class AdvanceDeformableVelocity final : public System<d> {
   }
   bool needed(const World<d>& w) const override { return w.template count<SimplexMesh<d>>() > 0; }
   void run(World<d>& world, StepContext& ctx) override;
+  // The explicit-elasticity limit (solvers/deformable/stable_step.h) of the stiffest body: with
+  // "time": {"cfl": c} a frame is split into substeps of at most c times it (Table 4.1).
+  double unitCflDt(const World<d>& world) const override;
 
  private:
   Stage stage_;
-  ForceModelCache<d> cache_;
+  mutable ForceModelCache<d> cache_;  // rest data only: filling it does not change the state
 };
 
 template <int d>
