@@ -179,7 +179,7 @@ void AdvanceDeformablePositions<d>::run(World<d>& world, StepContext& ctx) {
 }
 
 template <int d>
-DeformableTotals measureDeformableTotals(const World<d>& world) {
+DeformableTotals measureDeformableTotals(const World<d>& world, ForceModelCache<d>* cache) {
   DeformableTotals t;
   const auto* pool = world.template findPool<Particles<d>>();
   if (!pool) return t;
@@ -200,14 +200,16 @@ DeformableTotals measureDeformableTotals(const World<d>& world) {
     }
     const auto* mesh = world.template get<SimplexMesh<d>>(e);
     const auto* el = world.template get<Elasticity>(e);
-    if (mesh && el) t.elastic += dm::elasticEnergy<d>(forceModelOf(p, *mesh, *el), p.x.data());
+    if (mesh && el)
+      t.elastic += cache ? dm::elasticEnergy<d>(cache->get(e, p, *mesh, *el), p.x.data())
+                         : dm::elasticEnergy<d>(forceModelOf(p, *mesh, *el), p.x.data());
   }
   return t;
 }
 
 template <int d>
 void DeformableDiagnostics<d>::run(World<d>& world, StepContext& ctx) {
-  const DeformableTotals t = measureDeformableTotals(world);
+  const DeformableTotals t = measureDeformableTotals(world, &cache_);
   auto& out = ctx.diagnostics;
   out.add("kinetic_energy", t.kinetic);
   out.add("potential_energy", t.potential + t.elastic);
@@ -231,7 +233,7 @@ void DeformableDiagnostics<d>::run(World<d>& world, StepContext& ctx) {
   template class AdvanceDeformableVelocity<D>;                                                                  \
   template class AdvanceDeformablePositions<D>;                                                                 \
   template class DeformableDiagnostics<D>;                                                                      \
-  template DeformableTotals measureDeformableTotals<D>(const World<D>&);
+  template DeformableTotals measureDeformableTotals<D>(const World<D>&, ForceModelCache<D>*);
 MONOLITH_INSTANTIATE(2)
 MONOLITH_INSTANTIATE(3)
 #undef MONOLITH_INSTANTIATE

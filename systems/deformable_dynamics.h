@@ -113,7 +113,8 @@ struct DeformableTotals {
   Eigen::Vector3d angularMomentum = Eigen::Vector3d::Zero();
 };
 // Serial in pool and particle order (deterministic). Fixed particles count (their v is zero).
+// `cache`, if given, keeps the force models between calls (else they are rebuilt).
 template <int d>
-DeformableTotals measureDeformableTotals(const World<d>& world);
+DeformableTotals measureDeformableTotals(const World<d>& world, ForceModelCache<d>* cache = nullptr);
 
 }  // namespace monolith
