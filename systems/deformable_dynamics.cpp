@@ -147,6 +147,14 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
         else
           for (std::size_t i = 0; i < u.size(); ++i) p.v[i] = 2 * u[i] - p.v[i];
       });
+  // Free particles without a mesh (single mass points) feel gravity only: both stages add
+  // dt/2 g (Step V's backward Euler over dt/4 plus extrapolation doubles its dt/4).
+  world.template each<Particles<d>>([&](Entity e, Particles<d>& p) {
+    if (world.template has<SimplexMesh<d>>(e)) return;
+    for (int i = 0; i < p.count(); ++i)
+      if (!p.fixed[i])
+        for (int a = 0; a < d; ++a) p.v[d * i + a] += 0.5 * ctx.dt * g(a);
+  });
   ctx.diagnostics.max(half ? "deformable_cg_iterations_half" : "deformable_cg_iterations", iterations);
   if (half) ctx.diagnostics.set("deformable_stable_dt", unitCflDt(world));
 }

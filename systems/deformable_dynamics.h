@@ -67,7 +67,7 @@ class AdvanceDeformableVelocity final : public System<d> {
   std::vector<std::string> writes() const override {
     return {Particles<d>::kName, RigidBody<d>::kName, "diagnostics"};  // bodies: damping on bound particles
   }
-  bool needed(const World<d>& w) const override { return w.template count<SimplexMesh<d>>() > 0; }
+  bool needed(const World<d>& w) const override { return w.template count<Particles<d>>() > 0; }
   void run(World<d>& world, StepContext& ctx) override;
   // The explicit-elasticity limit (solvers/deformable/stable_step.h) of the stiffest body: with
   // "time": {"cfl": c} a frame is split into substeps of at most c times it (Table 4.1).
