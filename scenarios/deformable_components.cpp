@@ -193,6 +193,22 @@ void parseDeformable(World<d>& world, Entity e, const Config& c) {
   world.add(e, el);
 }
 
+// "particle": {"mass", "position", "velocity"}: a single free mass point (no mesh, no elastic
+// forces), in contact with rigid bodies like a deformable body's particles (Fig. 4.8).
+template <int d>
+void parseParticle(World<d>& world, Entity e, const Config& c) {
+  Particles<d> p;
+  const Vec<d> x = c.vector("position", Eigen::VectorXd::Zero(d));
+  const Vec<d> v = c.vector("velocity", Eigen::VectorXd::Zero(d));
+  p.m.push_back(c.number("mass", Bound::Positive));
+  for (int a = 0; a < d; ++a) {
+    p.x.push_back(x(a));
+    p.v.push_back(v(a));
+  }
+  p.fixed.push_back(0);
+  world.add(e, p);
+}
+
 template <class S, class... Args>
 auto single(Args... args) {
   std::vector<std::unique_ptr<System<S::dimension>>> v;
@@ -219,6 +235,9 @@ void registerDeformableComponents(Registry& r) {
         w.template ensurePool<RigidBinding<d>>();
       },
       ""});
+  r.addComponent<d>(ComponentType<d>{"particle", "a single free mass point: mass, position, velocity",
+                                     parseParticle<d>,
+                                     [](World<d>& w) { w.template ensurePool<Particles<d>>(); }, ""});
   r.addComponentOf<d, Particles<d>>("(internal) a deformable body's particles: position, velocity, mass, fixed", nullptr);
   r.addComponentOf<d, SimplexMesh<d>>("(internal) a deformable body's elements and rest positions", nullptr);
   r.addComponentOf<d, Elasticity>("(internal) a deformable body's material", nullptr);

@@ -1,6 +1,7 @@
 #include "systems/deformable_dynamics.h"
 
 #include "solvers/deformable/simplex_mesh.h"
+#include "solvers/deformable/stable_step.h"
 #include "solvers/fluid/krylov.h"
 
 namespace monolith {
@@ -146,7 +147,34 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
         else
           for (std::size_t i = 0; i < u.size(); ++i) p.v[i] = 2 * u[i] - p.v[i];
       });
+  // Free particles without a mesh (single mass points) feel gravity only: both stages add
+  // dt/2 g (Step V's backward Euler over dt/4 plus extrapolation doubles its dt/4).
+  world.template each<Particles<d>>([&](Entity e, Particles<d>& p) {
+    if (world.template has<SimplexMesh<d>>(e)) return;
+    for (int i = 0; i < p.count(); ++i)
+      if (!p.fixed[i])
+        for (int a = 0; a < d; ++a) p.v[d * i + a] += 0.5 * ctx.dt * g(a);
+  });
   ctx.diagnostics.max(half ? "deformable_cg_iterations_half" : "deformable_cg_iterations", iterations);
+  if (half) ctx.diagnostics.set("deformable_stable_dt", unitCflDt(world));
+}
+
+template <int d>
+double AdvanceDeformableVelocity<d>::unitCflDt(const World<d>& world) const {
+  double dt = std::numeric_limits<double>::infinity();
+  if (stage_ != Stage::AdvanceVelocityHalf) return dt;  // one of the two stages reports it
+  const auto* pool = world.template findPool<Particles<d>>();
+  if (!pool) return dt;
+  for (std::size_t k = 0; k < pool->size(); ++k) {
+    const Entity e = pool->entities()[k];
+    const Particles<d>& p = pool->components()[k];
+    const auto* mesh = world.template get<SimplexMesh<d>>(e);
+    const auto* el = world.template get<Elasticity>(e);
+    if (!mesh || !el) continue;
+    const auto& fm = cache_.get(e, p, *mesh, *el);
+    dt = std::min(dt, dm::stableStep<d>(fm, el->density, p.x.data(), p.v.data(), p.fixed).value());
+  }
+  return dt;
 }
 
 template <int d>
@@ -159,7 +187,7 @@ void AdvanceDeformablePositions<d>::run(World<d>& world, StepContext& ctx) {
 }
 
 template <int d>
-DeformableTotals measureDeformableTotals(const World<d>& world) {
+DeformableTotals measureDeformableTotals(const World<d>& world, ForceModelCache<d>* cache) {
   DeformableTotals t;
   const auto* pool = world.template findPool<Particles<d>>();
   if (!pool) return t;
@@ -180,14 +208,16 @@ DeformableTotals measureDeformableTotals(const World<d>& world) {
     }
     const auto* mesh = world.template get<SimplexMesh<d>>(e);
     const auto* el = world.template get<Elasticity>(e);
-    if (mesh && el) t.elastic += dm::elasticEnergy<d>(forceModelOf(p, *mesh, *el), p.x.data());
+    if (mesh && el)
+      t.elastic += cache ? dm::elasticEnergy<d>(cache->get(e, p, *mesh, *el), p.x.data())
+                         : dm::elasticEnergy<d>(forceModelOf(p, *mesh, *el), p.x.data());
   }
   return t;
 }
 
 template <int d>
 void DeformableDiagnostics<d>::run(World<d>& world, StepContext& ctx) {
-  const DeformableTotals t = measureDeformableTotals(world);
+  const DeformableTotals t = measureDeformableTotals(world, &cache_);
   auto& out = ctx.diagnostics;
   out.add("kinetic_energy", t.kinetic);
   out.add("potential_energy", t.potential + t.elastic);
@@ -211,7 +241,7 @@ void DeformableDiagnostics<d>::run(World<d>& world, StepContext& ctx) {
   template class AdvanceDeformableVelocity<D>;                                                                  \
   template class AdvanceDeformablePositions<D>;                                                                 \
   template class DeformableDiagnostics<D>;                                                                      \
-  template DeformableTotals measureDeformableTotals<D>(const World<D>&);
+  template DeformableTotals measureDeformableTotals<D>(const World<D>&, ForceModelCache<D>*);
 MONOLITH_INSTANTIATE(2)
 MONOLITH_INSTANTIATE(3)
 #undef MONOLITH_INSTANTIATE

@@ -67,12 +67,15 @@ class AdvanceDeformableVelocity final : public System<d> {
   std::vector<std::string> writes() const override {
     return {Particles<d>::kName, RigidBody<d>::kName, "diagnostics"};  // bodies: damping on bound particles
   }
-  bool needed(const World<d>& w) const override { return w.template count<SimplexMesh<d>>() > 0; }
+  bool needed(const World<d>& w) const override { return w.template count<Particles<d>>() > 0; }
   void run(World<d>& world, StepContext& ctx) override;
+  // The explicit-elasticity limit (solvers/deformable/stable_step.h) of the stiffest body: with
+  // "time": {"cfl": c} a frame is split into substeps of at most c times it (Table 4.1).
+  double unitCflDt(const World<d>& world) const override;
 
  private:
   Stage stage_;
-  ForceModelCache<d> cache_;
+  mutable ForceModelCache<d> cache_;  // rest data only: filling it does not change the state
 };
 
 template <int d>
@@ -110,7 +113,8 @@ struct DeformableTotals {
   Eigen::Vector3d angularMomentum = Eigen::Vector3d::Zero();
 };
 // Serial in pool and particle order (deterministic). Fixed particles count (their v is zero).
+// `cache`, if given, keeps the force models between calls (else they are rebuilt).
 template <int d>
-DeformableTotals measureDeformableTotals(const World<d>& world);
+DeformableTotals measureDeformableTotals(const World<d>& world, ForceModelCache<d>* cache = nullptr);
 
 }  // namespace monolith

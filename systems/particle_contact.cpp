@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <cmath>
+#include <limits>
 
 #include "solvers/collision/collision_impl.h"
 #include "systems/contact_workspace.h"
@@ -203,12 +204,41 @@ void ParticlePushOut<d>::run(World<d>& world, StepContext& ctx) {
 }
 
 template <int d>
+void ParticlePenetration<d>::run(World<d>& world, StepContext& ctx) {
+  const std::vector<BodyView<d>> bodies = bodiesOf(world, shapes_, 0.0, false);
+  double depth = 0, ratio = 0;
+  world.template each<Particles<d>>([&](Entity, Particles<d>& p) {
+    // The deformable body's size: its smallest bounding-box extent (none for a single point).
+    Vec<d> lo = Vec<d>::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (int i = 0; i < p.count(); ++i) {
+      lo = lo.cwiseMin(Vec<d>(Eigen::Map<const Vec<d>>(&p.x[d * i])));
+      hi = hi.cwiseMax(Vec<d>(Eigen::Map<const Vec<d>>(&p.x[d * i])));
+    }
+    const double extent = p.count() > 1 ? (hi - lo).minCoeff() : std::numeric_limits<double>::infinity();
+    for (const BodyView<d>& b : bodies)
+      for (int i = 0; i < p.count(); ++i) {
+        if (p.fixed[i]) continue;
+        double distance;
+        Vec<d> n;
+        if (!distanceTo(b, Vec<d>(Eigen::Map<const Vec<d>>(&p.x[d * i])), 0.0, distance, n) || distance >= 0) continue;
+        depth = std::max(depth, -distance);
+        const double bodySize = b.geometry->minimumSize();
+        const double size = bodySize > 0 ? std::min(extent, bodySize) : extent;
+        if (std::isfinite(size)) ratio = std::max(ratio, -distance / size);
+      }
+  });
+  ctx.diagnostics.max("max_penetration", depth);
+  ctx.diagnostics.max("max_penetration_ratio", ratio);
+}
+
+template <int d>
 std::vector<std::unique_ptr<System<d>>> makeParticleContactSystems() {
   auto scratch = std::make_shared<ParticleContactScratch>();
   std::vector<std::unique_ptr<System<d>>> out;
   out.push_back(std::make_unique<ParticleRigidContact<d>>(Stage::Contact, scratch));
   out.push_back(std::make_unique<ParticlePushOut<d>>(scratch));
   out.push_back(std::make_unique<ParticleRigidContact<d>>(Stage::AdvanceVelocity, scratch));
+  out.push_back(std::make_unique<ParticlePenetration<d>>());
   return out;
 }
 
@@ -225,6 +255,8 @@ template class ParticleRigidContact<2>;
 template class ParticleRigidContact<3>;
 template class ParticlePushOut<2>;
 template class ParticlePushOut<3>;
+template class ParticlePenetration<2>;
+template class ParticlePenetration<3>;
 template std::vector<std::unique_ptr<System<2>>> makeParticleContactSystems<2>();
 template std::vector<std::unique_ptr<System<3>>> makeParticleContactSystems<3>();
 template std::vector<std::unique_ptr<System<2>>> makeParticleCollisionSystems<2>();

@@ -101,6 +101,28 @@ class ParticlePushOut final : public System<d> {
   PreparedShapes<d> shapes_;
 };
 
+// After the step: the deepest particle left inside a rigid body (particles are pushed out in
+// Step IV, but a rigid body's own push-out may move it onto them afterwards), as a fraction of
+// the smaller of the body's and the particle's deformable body's size, merged into the
+// standard max_penetration / max_penetration_ratio columns.
+template <int d>
+class ParticlePenetration final : public System<d> {
+ public:
+  std::string name() const override { return "particle_penetration"; }
+  Stage stage() const override { return Stage::Diagnostics; }
+  std::vector<std::string> reads() const override {
+    return {Shape<d>::kName, Collider<d>::kName, RigidBody<d>::kName, Particles<d>::kName};
+  }
+  std::vector<std::string> writes() const override { return {"diagnostics"}; }
+  bool needed(const World<d>& w) const override {
+    return w.template count<Particles<d>>() > 0 && w.template count<Collider<d>>() > 0;
+  }
+  void run(World<d>& world, StepContext& ctx) override;
+
+ private:
+  PreparedShapes<d> shapes_;
+};
+
 // Step III, IV and V systems above sharing one scratch (the registry's "particle_contact").
 template <int d>
 std::vector<std::unique_ptr<System<d>>> makeParticleContactSystems();

@@ -330,11 +330,15 @@ TEST(DeformableScenes, InclineFrictionRigidAndDeformableMatchCoulomb) {
     return Eigen::Vector3d(c / m);
   };
   const RigidBody<3>& box = *sim.world().template get<RigidBody<3>>(*sim.world().find("rigid_box"));
-  const Eigen::Vector3d c0 = centroid(), b0 = box.x;
+  const Particles<3>& point = particlesOf(sim, "particle");
+  const Eigen::Vector3d c0 = centroid(), b0 = box.x, q0(point.x[0], point.x[1], point.x[2]);
   while (!sim.finished()) sim.step();
   const double exact = 0.5 * 9.81 * (0.5 - 0.3 * std::cos(M_PI / 6)) * 4;
   const double deformable = (centroid() - c0).norm(), rigid = (box.x - b0).norm();
-  std::printf("incline: deformable %.4f m, rigid %.4f m, exact %.4f m\n", deformable, rigid, exact);
+  const double single = (Eigen::Vector3d(point.x[0], point.x[1], point.x[2]) - q0).norm();
+  std::printf("incline: deformable %.4f m, rigid %.4f m, particle %.4f m, exact %.4f m\n", deformable, rigid, single,
+              exact);
   EXPECT_NEAR(deformable, exact, 0.02 * exact);
   EXPECT_NEAR(rigid, exact, 0.02 * exact);
+  EXPECT_NEAR(single, exact, 0.02 * exact);
 }
