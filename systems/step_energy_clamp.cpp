@@ -10,9 +10,10 @@
 // The clamp checks the whole step instead. Under gravity alone the Newmark step keeps the
 // energy E = KE - m g.x exactly (Step I's and Step V's half kicks pay for the fall), collision
 // impulses never add kinetic energy, so an island of bodies that only gravity and contact moved
-// must not end the step with more energy than it began with. Where it does, every velocity and
-// angular momentum of the island is scaled by one factor s in [0, 1] with
-// (1 - s^2) KE^{n+1} = rise: the non-penetration rows v_n >= 0 against the static bodies hold
+// must not end the step with more energy than it began with because it was lifted. Where it
+// does, every velocity and angular momentum of the island is scaled by one factor s in [0, 1]
+// with (1 - s^2) KE^{n+1} = min(rise, lift): the non-penetration rows v_n >= 0 against the
+// static bodies hold
 // for the scaled velocities too (they are homogeneous). Only islands that touch a static or
 // sleeping body are clamped (in free flight scaling would change the island's momentum), and
 // only in scenes of rigid bodies alone (particles, fluids and joints exchange energy the island
@@ -67,7 +68,7 @@ int ContactWorkspace<d>::clampStepEnergyGain(World<d>& world, double& removed) {
   // Islands share no finite body: each writes only its own members.
   forEachIsland([&](int island) {
     if (excluded[island] || !grounded[island]) return;
-    double rise = 0, scale = 0, kinetic = 0;
+    double rise = 0, lift = 0, scale = 0, kinetic = 0;
     for (int m : islands.members[island]) {
       const ContactBody<d>& b = bodies[m];
       if (b.infinite()) continue;
@@ -77,9 +78,15 @@ int ContactWorkspace<d>::clampStepEnergyGain(World<d>& world, double& removed) {
       // large potentials).
       const double potential = -b.mass * gravity.dot(b.x0 - stepStart_[m].x);
       rise += k - stepStart_[m].kinetic + potential;
+      lift += potential;
       scale += k + stepStart_[m].kinetic + std::abs(potential);
       kinetic += k;
     }
+    // Only a rise the island's lift accounts for is taken back. A body held where it is by a
+    // contact (or a gap it cannot close in one step) ends every step with Step V's half kick of
+    // kinetic energy that the next collision stage removes (the thesis's own bookkeeping);
+    // taking that back would stop it in the air, short of its support.
+    rise = std::min(rise, lift);
     // Rounding of the sums above is a few ulps of `scale`.
     if (!(rise > 1e-12 * scale) || kinetic <= 0) return;
     const double s = std::sqrt(std::max(0.0, 1.0 - rise / kinetic));
