@@ -111,7 +111,7 @@ struct ContactPairState {
   std::array<double, 3> stageFriction = {0, 0, 0};
   // How the pair's last manifold solve ended, per point in the narrow phase's order: the exact
   // finish starts the next solve of the pair from it (one pass instead of one per point that
-  // turns to sliding). Kept across steps by findPairs.
+  // turns to sliding). Within the step only (findPairs starts it empty).
   struct SolveEnd {
     static constexpr int kPoints = 8;
     std::uint16_t states = 0;        // 2 bits of solvers::contact::PointState per point
