@@ -63,8 +63,12 @@ struct FluidSolverSettings {
   bool cutCells = false;
 };
 
-// Collisions, contact and interpenetration resolution (issue 3; scene "solvers": {"contact":
-// {...}}). Iteration counts are the defaults of the thesis's code (notes 1.4, 1.6, 1.7).
+// Collisions, contact and interpenetration resolution (scene "solvers": {"contact": {...}}).
+// The defaults are the thesis code's schedule (notes 1.4, 1.6, 1.7). `"schedule": "short"`
+// (useShortSchedule, docs/rigid_contact.md) is one contact sweep of one level pass, one
+// shock-propagation pass, exact manifold solves and the step energy clamp: 12-15x cheaper per
+// awake step, but it can stop a falling body in the air above a gap narrower than one step's
+// fall, so it is not the default.
 struct ContactSettings {
   int collisionIterations = 5;       // Gauss-Seidel sweeps over the pairs (Step II)
   int collisionPairIterations = 20;  // impulses per pair per sweep
@@ -72,13 +76,13 @@ struct ContactSettings {
   int contactLevelIterations = 2;    // per level and sweep
   int contactPairIterations = 10;    // Gauss-Seidel sweeps of one pair's manifold solve (measured)
   bool shockPropagation = true;      // GBF 2003 shock propagation after contact
-  int shockLevelIterations = 2;      // the thesis code's (8 were needed before projectFriction)
+  int shockLevelIterations = 2;      // the thesis code's
   int shockPairIterations = 40;      // measured: a 2-D pyramid's joint solves need them (docs/benchmarks.md)
   // Manifold and joint solves end with an exact active-set step once it applies
   // (solvers/contact/manifold_polish.h; not in the thesis, whose sweeps stop at their count).
-  // Off by default: at the thesis's schedule it costs 3-30 % more than it saves on three of
-  // five scenes; on a short schedule it makes the step 3x faster and leaves a standing pyramid
-  // exactly at rest (docs/benchmarks.md, "States remembered, one slide per pass").
+  // Off by default: at the thesis's schedule it costs 3-30 % more than it saves on three of five
+  // scenes; on the short schedule it makes the step 3x faster and leaves a standing pyramid
+  // exactly at rest.
   bool exactManifoldFinish = false;
   bool pushOut = true;               // interpenetration resolution, Sec. 4.6.1 / App. B
   int pushOutLevelIterations = 6;    // thesis code: 2; measured on piles (docs/benchmarks.md, "Six push-out passes")
@@ -100,6 +104,12 @@ struct ContactSettings {
   double pushOutJointOverlap = 0.05;
   bool velocityContact = true;       // second contact step in Step V (Sec. 2.3.2 "Contact Clamping")
   bool energyClamp = true;           // Sec. 2.3.2 for collisions and the second contact step
+  // After Step V, an island of bodies moved only by gravity and contact whose energy (kinetic +
+  // gravity's potential) rose in the step has its velocities scaled down to take the rise back
+  // (not in the thesis, which leaves the first contact step unclamped, Sec. 2.3.2; systems/
+  // step_energy_clamp.cpp). The short schedule needs it: its one inelastic contact pass can lift
+  // a spinning body for the position update without paying for the rise.
+  bool stepEnergyClamp = false;
   // Step II: a pair moving more than half its thinner body's size in the step is tested at its
   // first contact along the motion instead of at the candidate poses (not in the thesis;
   // solvers/collision/swept_contact.h).
@@ -114,6 +124,16 @@ struct ContactSettings {
   bool sleep = false;
   double sleepSpeed = 0.01;          // m/s, at the body's farthest point from its centre of mass
   double sleepTime = 0.5;            // s
+
+  // The short schedule: one contact sweep of one level pass, one shock-propagation pass, manifold
+  // solves finished exactly, and the step energy clamp.
+  void useShortSchedule() {
+    contactIterations = 1;
+    contactLevelIterations = 1;
+    shockLevelIterations = 1;
+    exactManifoldFinish = true;
+    stepEnergyClamp = true;
+  }
 };
 
 // Scene-wide physical settings shared by systems (read-only during a step).

@@ -451,6 +451,8 @@ void parseContactSettings(const Config& c, ContactSettings& s) {
   auto count = [&](const char* key, int& value, int min) {
     value = static_cast<int>(c.integer(key, value, min, 100000));
   };
+  // The schedule first: the keys below adjust it.
+  if (c.oneOf("schedule", {"thesis", "short"}, "thesis") == "short") s.useShortSchedule();
   count("collision_iterations", s.collisionIterations, 0);
   count("collision_pair_iterations", s.collisionPairIterations, 1);
   count("contact_iterations", s.contactIterations, 0);
@@ -470,6 +472,7 @@ void parseContactSettings(const Config& c, ContactSettings& s) {
   s.pushOutJointOverlap = c.number("push_out_joint_overlap", s.pushOutJointOverlap, Bound::NonNegative);
   s.velocityContact = c.boolean("velocity_contact", s.velocityContact);
   s.energyClamp = c.boolean("energy_clamp", s.energyClamp);
+  s.stepEnergyClamp = c.boolean("step_energy_clamp", s.stepEnergyClamp);
   s.sweptCollisions = c.boolean("swept_collisions", s.sweptCollisions);
   s.thickness = c.number("thickness", s.thickness, Bound::NonNegative);
   s.pushOutTolerance = c.number("push_out_tolerance", s.pushOutTolerance, Bound::NonNegative);

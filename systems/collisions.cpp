@@ -13,6 +13,7 @@ void Collisions<d>::run(World<d>& world, StepContext& ctx) {
   if (!ws.pack(world, ctx.dt, /*subtractKick=*/true)) return;
   ws.findPairs();
   const int woken = ws.wakeTouchedSleepers(world);  // sleeping on (systems/sleep.h), else 0
+  if (ws.settings.stepEnergyClamp) ws.rememberStepStart(world);
   const auto energyBefore = ws.readEnergy();
 
   std::vector<int> impulses(ws.islands.members.size(), 0), clamps(ws.islands.members.size(), 0);

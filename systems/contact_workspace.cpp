@@ -477,17 +477,14 @@ void ContactWorkspace<d>::findPairs() {
                                                                : col::BroadPhaseMethod::SweepAndPrune);
   broadPhase_->excludePairs(jointedPairs_);
   const auto& found = broadPhase_->findPairs(boxes_, infinite_);
-  // A fresh state per pair, except how its last manifold solve ended (both lists are sorted).
+  // A fresh state per pair, how its last manifold solve ended included: nothing of the
+  // workspace outlives the step, so a run resumed from a checkpoint (which holds only the
+  // components) continues bitwise as the uninterrupted one.
   std::vector<ContactPairState>& fresh = freshPairs_;
   fresh.assign(found.size(), ContactPairState{});
-  std::size_t old = 0;
   for (std::size_t k = 0; k < found.size(); ++k) {
-    ContactPairState& pair = fresh[k];
-    pair.a = found[k].first;
-    pair.b = found[k].second;
-    while (old < pairs.size() && std::make_pair(pairs[old].a, pairs[old].b) < found[k]) ++old;
-    if (old == pairs.size() || pairs[old].a != pair.a || pairs[old].b != pair.b) continue;
-    pair.end = pairs[old].end;
+    fresh[k].a = found[k].first;
+    fresh[k].b = found[k].second;
   }
   pairs.swap(fresh);
   con::computeIslands(n, found, infinite_, islands);

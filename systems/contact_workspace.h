@@ -111,7 +111,7 @@ struct ContactPairState {
   std::array<double, 3> stageFriction = {0, 0, 0};
   // How the pair's last manifold solve ended, per point in the narrow phase's order: the exact
   // finish starts the next solve of the pair from it (one pass instead of one per point that
-  // turns to sliding). Kept across steps by findPairs.
+  // turns to sliding). Within the step only (findPairs starts it empty).
   struct SolveEnd {
     static constexpr int kPoints = 8;
     std::uint16_t states = 0;        // 2 bits of solvers::contact::PointState per point
@@ -264,6 +264,16 @@ class ContactWorkspace {
   template <class F>
   void forEachIsland(F&& f);
 
+  // The step energy clamp (ContactSettings::stepEnergyClamp; systems/step_energy_clamp.cpp).
+  // At Step II's start: each body's time-n position and kinetic energy, and whether gravity is
+  // the only force on it.
+  void rememberStepStart(World<d>& world);
+  // After Step V's contact: every island whose bodies only gravity and contact moved, that
+  // touches a static or sleeping body and whose energy rose, has its bodies' velocities and
+  // angular momenta scaled by one factor that takes the rise back (all of its kinetic energy
+  // at most). Returns the islands scaled; adds the kinetic energy removed to `removed`.
+  int clampStepEnergyGain(World<d>& world, double& removed);
+
   std::vector<ContactBody<d>> bodies;
   std::vector<ContactPairState> pairs;
   solvers::contact::Islands islands;
@@ -340,6 +350,15 @@ class ContactWorkspace {
   std::vector<IslandSchedule> schedules_;  // per island (islands are recorded and run at once)
   std::vector<int> memberIndex_;           // per body: its position in its island's members
   int kinematicFrameBody_ = -1;            // the scene's one translating kinematic body, or -1 (pack)
+  // rememberStepStart: per body, x^n, its kinetic energy at time n, and whether gravity is the
+  // only force on it (no scripted motion either).
+  struct StepStart {
+    VecD x = VecD::Zero();
+    double kinetic = 0;
+    bool gravityOnly = false;
+  };
+  std::vector<StepStart> stepStart_;
+  bool gravityOnly(World<d>& world, std::size_t i) const;
 
   void ensureGeometry(World<d>& world);
   std::vector<Entity> entities_;

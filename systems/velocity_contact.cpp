@@ -31,7 +31,15 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
       impulses[island] += ws.propagateShock(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
   });
   const auto energyAfter = ws.readEnergy();
+  // The whole step's energy (systems/step_energy_clamp.cpp); measured after the diagnostics
+  // above, which are about this stage's impulses alone.
+  double clampRemoved = 0;
+  const int clampedIslands = s.stepEnergyClamp ? ws.clampStepEnergyGain(world, clampRemoved) : 0;
   ws.unpack(false);
+  if (s.stepEnergyClamp) {
+    ctx.diagnostics.set("step_energy_clamped_islands", clampedIslands);
+    ctx.diagnostics.set("step_energy_clamp_removed", clampRemoved);
+  }
   int total = 0, clampCount = 0;
   for (int n : impulses) total += n;
   for (int n : clamps) clampCount += n;

@@ -156,7 +156,10 @@ constexpr const char* kLateElevator = R"({ "dimension": 3, "time": { "dt": 0.033
 // sleeping box's and wakes it, and the box rides up with it (the elevator test's criterion).
 TEST(Sleep, AKinematicPlatformWakesTheBoxOnItWhenItStartsToMove) {
   const Registry registry = builtins();
-  Simulation<3> sim(parseScene(kLateElevator, "late_elevator.json"), registry);
+  // On the thesis's schedule: on the short one the box comes to rest 4.5 mm above
+  // the platform, stopped in the air by the one fully inelastic contact pass
+  // (docs/rigid_contact.md, "Not done").
+  Simulation<3> sim(parseScene(kLateElevator, "late_elevator.json", {{"solvers.contact.schedule", "thesis"}}), registry);
   double asleepAt14 = -1, wokenAfter = 0, worstRelative = 0;
   while (!sim.finished()) {
     const auto& diag = sim.step();
