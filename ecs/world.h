@@ -85,7 +85,7 @@ struct ContactSettings {
   // exactly at rest.
   bool exactManifoldFinish = false;
   bool pushOut = true;               // interpenetration resolution, Sec. 4.6.1 / App. B
-  int pushOutLevelIterations = 6;    // thesis code: 2; measured on piles (docs/benchmarks.md, "Six push-out passes")
+  int pushOutLevelIterations = 6;    // thesis code: 2; measured on piles (the git history of docs/benchmarks.md ("Six push-out passes"))
   int pushOutBodyIterations = 5;
   // Push-out also separates pairs that Steps II-III never saw interpenetrating (not "processed")
   // but that overlap after Step IV's positions: a body moved by contact or by another push-out

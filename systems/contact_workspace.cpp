@@ -893,12 +893,12 @@ void ContactWorkspace<d>::startOrder(solvers::parallel::OrderedTasks& order, int
   // more to hand over than to run. With the exact finish most manifold solves end before their
   // first sweep, so an update costs less and blocks of 2 hand over better: on 2 threads the
   // short-schedule pyramid_20 step took 17 % less time with 2 than with 4 (16: 19 % more),
-  // while at the defaults and in the 250-sphere pour 2 cost 2-5 % more (docs/benchmarks.md,
-  // "Exact finish before the first sweep"). One thread (or one body): no dependencies needed.
+  // while at the defaults and in the 250-sphere pour 2 cost 2-5 % more (the git history of docs/benchmarks.md
+  // ("Exact finish before the first sweep")). One thread (or one body): no dependencies needed.
   // Nor when the sequence cannot have the blocks OrderedTasks::run needs to share it (a small
   // island): recording the dependencies of tasks that will run in order anyway cost the
-  // falling 250-sphere pour a fifth of its step on 2 threads (docs/benchmarks.md, "Pours on two
-  // threads").
+  // falling 250-sphere pour a fifth of its step on 2 threads (the git history of docs/benchmarks.md ("Pours on two
+  // threads")).
   const int grain = settings.exactManifoldFinish ? 2 : 4;
   const bool shareable = taskBound >= static_cast<std::size_t>(solvers::parallel::OrderedTasks::kMinimumBlocks) *
                                           static_cast<std::size_t>(grain);

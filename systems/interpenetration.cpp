@@ -601,7 +601,7 @@ void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
     // Another round (up to pushOutRounds) works on the bodies of the pairs that
     // - the growth just added and that overlap: a push carried a body past the box the broad
     //   phase knew for it, into a body it was not paired with (the deepest overlaps of the
-    //   4000-sphere pour were of this kind, docs/benchmarks.md "Push-out in rounds");
+    //   4000-sphere pour were of this kind, the git history of docs/benchmarks.md ("Push-out in rounds"));
     // - a later round pushed deeper (a body moved into a neighbour outside that round);
     // - still overlap by more than pushOutRoundOverlap of the smaller body's size (the level
     //   passes did not converge: a jam of thin shards, a pile's compressed cycle).

@@ -5,7 +5,7 @@
 // only move the positions and are then thrown away, so an impulse that turns a spinning body's
 // fall into a rise lifts it without taking the kinetic energy the lift costs: on the short
 // schedule, with one inelastic contact pass, about one random 2-D drop in 600 gained 0.4-1 % of
-// its total energy in one step (docs/benchmarks.md, "The short schedule on random drops").
+// its total energy in one step (the git history of docs/benchmarks.md ("The short schedule on random drops")).
 //
 // The clamp checks the whole step instead. Under gravity alone the Newmark step keeps the
 // energy E = KE - m g.x exactly (Step I's and Step V's half kicks pay for the fall), collision

@@ -222,7 +222,7 @@ void pgsOffsets(PgsPoint<d>& p, const PgsBodies<d>& s) {
 // share of the load, so its disk is small and hit on most steps, and where the slip is tiny and
 // of arbitrary direction (bodies at rest) the guess flipped the friction from sweep to sweep:
 // pyramid_20 needed 8 epsilon-ramped shock propagation passes to stand and collapsed with 1 or
-// 2 (docs/benchmarks.md, "A friction step that cannot overshoot"). Scaling f radially onto the
+// 2 (the git history of docs/benchmarks.md ("A friction step that cannot overshoot")). Scaling f radially onto the
 // disk instead is stable but, with the rotational coupling in Ktt, slides a cube down an incline
 // 7 % too far and 17 cm sideways in 2 s.
 template <int d>

@@ -7,8 +7,8 @@
 // run-time bounds; here the sizes are compile-time constants and the pivots' reciprocals are kept
 // so that the solves multiply. Eigen's LLT calls were 15 % of a short-schedule pyramid_20 step.
 // An L L^T written so made the step about 2 % faster; this L D L^T, which keeps the square
-// roots off the pivots' dependent chain, another 6 % (docs/benchmarks.md, "Exact finish before
-// the first sweep").
+// roots off the pivots' dependent chain, another 6 % (the git history of docs/benchmarks.md ("Exact finish before
+// the first sweep")).
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>

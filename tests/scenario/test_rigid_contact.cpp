@@ -273,8 +273,8 @@ TEST(Pyramid, TenLayersStandAtOneStepPerFrameIn2D) {
 }
 
 namespace {
-// One contact iteration of one level pass and one shock propagation pass (docs/benchmarks.md,
-// "A short schedule"), with the manifold solves finished exactly (manifold_polish.h).
+// One contact iteration of one level pass and one shock propagation pass (the git history of docs/benchmarks.md
+// ("A short schedule")), with the manifold solves finished exactly (manifold_polish.h).
 const std::vector<std::pair<std::string, std::string>> kShortScheduleExact = {
     {"solvers.contact.contact_iterations", "1"},
     {"solvers.contact.contact_level_iterations", "1"},
@@ -385,13 +385,13 @@ TEST(MixedPile, EveryShapeSettlesWithoutEnergyGainOrDeepOverlap) {
   // only pairs Step II had processed were measured, 0.28 % here). Measured that way it is 1.28 %
   // (steps 149-167: a body wedged between two static walls and a neighbour); over 8 runs with
   // dt and gravity changed by 1-3 % it was 0.20-1.28 %, and 0.47-1.49 % with the thesis's
-  // push-out (docs/benchmarks.md, "Overlaps no stage saw"). With the pairs also found again
+  // push-out (the git history of docs/benchmarks.md ("Overlaps no stage saw")). With the pairs also found again
   // where the impulses sent the bodies (growPairs), 0.28 %, and 0.17-0.79 % over those 8 runs;
   // with 6 push-out passes 0.10 % and 0.01-0.36 %.
   EXPECT_LE(runToEndWatching(sim, watch), 0.01);
   // Settled: the energy left at t = 4 s is a snapshot of a chaotic pile, in which a sphere or
   // cylinder may still be rolling off it (no rolling resistance). Over 16 runs with dt and
-  // gravity changed by 1-3 % (docs/benchmarks.md, "Swept collisions") it was 0.002-0.17 J, and
+  // gravity changed by 1-3 % (the git history of docs/benchmarks.md ("Swept collisions")) it was 0.002-0.17 J, and
   // above the 0.02 J this test once asserted in 3 of them -- 1 in 8 for the build that chose
   // that bound too. 0.5 J is 0.17 % of the 286 J the pile starts with.
   double ke = 0;
@@ -737,8 +737,8 @@ TEST(PushOutNewOverlaps, SliverShardsNoLongerSinkThroughEachOther) {
   // (every broad-phase pair) shows; with the new overlaps pushed apart too, it is not.
   // A single run of the chaotic pile moves by factors under any change of rounding (44 % and
   // 1.16 % when this test was written, 0.32-4.7 % for the second since), so this compares the
-  // medians of five runs with gravity changed by up to 1 % (docs/benchmarks.md, "Overlaps no
-  // stage saw", "Six push-out passes" and "Shock propagation's friction"), on the thesis's
+  // medians of five runs with gravity changed by up to 1 % (the git history of docs/benchmarks.md ("Overlaps no
+  // stage saw"), "Six push-out passes" and "Shock propagation's friction"), on the thesis's
   // schedule, where those figures were measured.
   const Registry registry = builtins();
   auto median = [&](bool newOverlaps) {
@@ -785,7 +785,7 @@ SceneSpec randomSliverScene(unsigned seed, bool newOverlaps, const std::string& 
   }
   text << "]}";
   // The thesis's schedule: the push-out figures these drops are asserted against were measured
-  // on it (docs/benchmarks.md, "Six push-out passes").
+  // on it (the git history of docs/benchmarks.md ("Six push-out passes")).
   return parseScene(text.str(), "random_slivers.json",
                     {{"solvers.contact.schedule", "thesis"},
                      {"solvers.contact.push_out_new_overlaps", newOverlaps ? "true" : "false"},
@@ -801,7 +801,7 @@ double randomSliverDrop(unsigned seed, bool newOverlaps, const Registry& registr
 
 TEST(RandomSliverDrops, MostKeepTheirOverlapsShallow) {
   // A chaotic pile gives single runs that any rounding change moves by factors, so this test
-  // asserts the distribution over 12 drops (docs/benchmarks.md, "Six push-out passes").
+  // asserts the distribution over 12 drops (the git history of docs/benchmarks.md ("Six push-out passes")).
   const Registry registry = builtins();
   std::vector<double> on, off;
   for (unsigned seed = 1; seed <= 12; ++seed) {
@@ -907,7 +907,7 @@ TEST(PushOutRounds, TheFirstStepThatNeedsFurtherRoundsEndsShallowerWithThem) {
   // same bitwise; at that step the rounds, kept or undone, must leave the deepest overlap no
   // deeper than one round does, and over the drops they must cut it. (Whole runs cannot be
   // compared: from that step on the piles differ, and any difference moves a chaotic pile's
-  // later overlaps by factors either way -- docs/benchmarks.md, "Push-out in rounds".)
+  // later overlaps by factors either way -- the git history of docs/benchmarks.md ("Push-out in rounds").)
   // Seeds: the first ten of 1-240 whose runs without rounds exceed 5 % (measured 2026-11-27,
   // chosen again 2026-11-28 after shock propagation's friction changed the piles).
   const Registry registry = builtins();
@@ -989,7 +989,7 @@ TEST(EnergyClamp, SliverShardsGainEnergyOnlyWithoutTheClamp) {
   // The thesis's collision test at the candidate poses (swept collisions off): there the split
   // state's lever arms of slivers sunk deep into each other make impulses that gain energy.
   // Swept collisions test the slivers where they first touch instead, and in this scene no
-  // impulse gains energy even without the clamp (docs/benchmarks.md, "Swept collisions").
+  // impulse gains energy even without the clamp (the git history of docs/benchmarks.md ("Swept collisions")).
   const Registry registry = builtins();
   auto run = [&](bool clamp, const char* gravity) {
     const SceneSpec scene = loadScene(kScenes + "sliver_shards.json",
