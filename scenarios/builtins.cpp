@@ -151,6 +151,7 @@ void registerDimension(Registry& r) {
   if constexpr (d == 3) registerJointComponents(r);
   registerSurfaceTensionComponents<d>(r);
   registerDeformableComponents<d>(r);
+  registerFluidCouplingComponent<d>(r);
 
   r.addSystem<d>({"clear_rigid_forces", "zero the force accumulators before each force evaluation",
                   [] { return atBothForceStages<ClearRigidForces<d>, d>(); }, ""});
