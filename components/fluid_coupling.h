@@ -30,6 +30,9 @@ struct FluidCoupling {
   // A coupled deformable body (d numbers per particle, within one step): v^n, the explicit forces
   // f(x^n) (elastic + gravity), the velocity the half-step solve wrote, x^n (Stokes keeps it).
   std::vector<double> particleStart, particleForce, particleHalf, particleStartX;
+  // Scene configuration of a deformable body (not state): the particle whose position is
+  // reported as fsi_<name>_track_x/_y(/_z), -1 for none.
+  int trackParticle = -1;
   template <class V>
   void visitFields(V&) {}
 };

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "components/deformable.h"
@@ -218,8 +219,21 @@ void parseDeformableFluidCoupling(World<d>& world, Entity e, const Config& c, Pa
       for (int a = 0; a < d; ++a) p.v[d * i + a] = v[a];
     }
   }
+  FluidCoupling<d> coupling;
+  // "track": a point; the particle nearest it at the start is reported every step.
+  if (c.has("track")) {
+    const Eigen::VectorXd at = c.vector("track", d);
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < p.count(); ++i) {
+      const double dist = (Eigen::Map<const Eigen::Matrix<double, d, 1>>(&p.x[d * i]) - at).norm();
+      if (dist < best) {
+        best = dist;
+        coupling.trackParticle = i;
+      }
+    }
+  }
   c.finish();
-  world.add(e, FluidCoupling<d>{});
+  world.add(e, coupling);
 }
 
 // Two-way coupling: a dynamic rigid_body with a shape the rasterization knows (or a level_set),

@@ -471,6 +471,10 @@ void FluidStructureProjection<d>::run(World<d>& world, StepContext& ctx) {
       for (int i = 0; i < n; ++i) force -= report.structureImpulse[off + d * i + a];
       out.set(prefix + "_force" + axes[a], force / ctx.dt);
     }
+    const int track = world.template get<FluidCoupling<d>>(setup.deformables[k])->trackParticle;
+    if (track >= 0 && track < n)
+      for (int a = 0; a < d; ++a)
+        out.set(prefix + "_track" + axes[a], world.template get<Particles<d>>(setup.deformables[k])->x[d * track + a]);
   }
   for (std::size_t b = 0; b < setup.bodies.size(); ++b) {
     const std::string prefix = "fsi_" + world.name(setup.bodies[b]);
