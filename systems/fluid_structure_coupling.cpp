@@ -157,13 +157,55 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
         break;
       }
   }
+  // A structure smaller than a cell may cover no cell centre, and would then never see the
+  // fluid: it claims the cells around its centre of mass (a rigid body) or its particles (a
+  // deformable body), and moves with the fluid in them as one composite body: the fluid mass
+  // rho_f (claimed volume - body volume) joins the structure's mass (and, about the centre, its
+  // inertia). Gravity accelerates both alike, so v* is unchanged; the pressure on the claimed
+  // cells' faces then carries the buoyancy of the whole claimed volume, which that fluid's weight
+  // cancels: the net force is (m - rho_f V) g as it should be, while the drag is that of a
+  // one-cell body (resolution-limited). The solve keeps every property (SPD, no energy gain).
+  std::vector<double> extraMass(nb + nd, 0.0);
+  std::vector<int> claimed(nb + nd, 0);
+  auto claim = [&](const Vec& x, int structure) {
+    typename solvers::MacLayout<d>::Index cell;
+    for (int a = 0; a < d; ++a) {
+      cell[a] = static_cast<int>(std::floor((x[a] - layout.origin[a]) / layout.dx));
+      if (cell[a] < 0 || cell[a] >= layout.cells[a]) return;
+    }
+    const int c = layout.cellIndex(cell);
+    if (setup.cellBody[c] >= 0 || setup.domain.cells[c] != solvers::CellKind::Fluid) return;
+    setup.cellBody[c] = structure;
+    mask[c] = 1;
+    ++claimed[structure];
+  };
+  const auto* grids = world.template findPool<MacGrid<d>>();
+  const double rhoFluid = fluidDensity(world, grids->entities()[0]);
+  for (int b = 0; b < nb; ++b)
+    if (std::find(setup.cellBody.begin(), setup.cellBody.end(), b) == setup.cellBody.end()) {
+      claim(geometry[b].body().x, b);
+      const Shape<d>* shape = world.template get<Shape<d>>(setup.bodies[b]);
+      double volume = 0;  // the body's own volume (area in 2-D), where the shape gives it simply
+      if (shape && shape->type == ShapeType::Sphere) volume = d == 2 ? M_PI * std::pow(shape->radius, 2) : 4.0 / 3.0 * M_PI * std::pow(shape->radius, 3);
+      if (shape && shape->type == ShapeType::Box) volume = std::pow(2.0, d) * shape->halfExtents.prod();
+      extraMass[b] = std::max(0.0, rhoFluid * (claimed[b] * layout.cellVolume() - volume));
+    }
   for (int k = 0; k < nd; ++k) {
     const std::vector<int> inside = setup.locators[k].cellsInside();
+    bool any = false;
     for (int c = 0; c < layout.cellCount(); ++c)
       if (inside[c] >= 0 && setup.cellBody[c] < 0) {
         setup.cellBody[c] = nb + k;
         mask[c] = 1;
+        any = true;
       }
+    if (!any) {
+      const Particles<d>& p = *world.template get<Particles<d>>(setup.deformables[k]);
+      for (int i = 0; i < p.count(); ++i) claim(Vec(Eigen::Map<const Vec>(&p.x[d * i])), nb + k);
+      double volume = 0;
+      for (double v : setup.models[k]->restVolume) volume += v;
+      extraMass[nb + k] = std::max(0.0, rhoFluid * (claimed[nb + k] * layout.cellVolume() - volume));
+    }
   }
   auto& coupling = setup.coupling;
   coupling.constrainedFaces = solvers::markStructure(setup.domain, mask, viscous);
@@ -222,11 +264,16 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
   for (int b = 0; b < nb; ++b) {
     const RigidBody<d>& body = geometry[b].body();
     const int off = b * ndof;
+    const double mass = body.mass + extraMass[b];
     for (int a = 0; a < d; ++a) {
-      m.emplace_back(off + a, off + a, body.mass);
-      minv.emplace_back(off + a, off + a, 1.0 / body.mass);
+      m.emplace_back(off + a, off + a, mass);
+      minv.emplace_back(off + a, off + a, 1.0 / mass);
     }
-    const InertiaMat<d> I = body.worldInertia(), Iinv = body.worldInverseInertia();
+    InertiaMat<d> I = body.worldInertia(), Iinv = body.worldInverseInertia();
+    if (extraMass[b] > 0) {  // the claimed fluid: a square (cube) of side dx about the centre
+      I += InertiaMat<d>::Identity() * extraMass[b] * layout.dx * layout.dx / 6.0;
+      Iinv = I.inverse();
+    }
     for (int i = 0; i < kAngular(d); ++i)
       for (int j = 0; j < kAngular(d); ++j) {
         m.emplace_back(off + d + i, off + d + j, I(i, j));
@@ -240,10 +287,13 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
     // Lumped particle masses; a fixed particle's M^-1 is 0 (infinite mass: v* stays, at rest).
     const Particles<d>& p = *world.template get<Particles<d>>(setup.deformables[k]);
     const int off = setup.deformableOffset[k];
+    int free = 0;
+    for (int i = 0; i < p.count(); ++i) free += p.fixed[i] ? 0 : 1;
+    const double extra = free > 0 ? extraMass[nb + k] / free : 0.0;  // claimed fluid, spread evenly
     for (int i = 0; i < p.count(); ++i)
       for (int a = 0; a < d; ++a) {
-        m.emplace_back(off + d * i + a, off + d * i + a, p.m[i]);
-        if (!p.fixed[i]) minv.emplace_back(off + d * i + a, off + d * i + a, 1.0 / p.m[i]);
+        m.emplace_back(off + d * i + a, off + d * i + a, p.m[i] + (p.fixed[i] ? 0.0 : extra));
+        if (!p.fixed[i]) minv.emplace_back(off + d * i + a, off + d * i + a, 1.0 / (p.m[i] + extra));
       }
     for (int i = 0; i < d * p.count(); ++i) coupling.velocity[off + i] = p.v[i];
   }
