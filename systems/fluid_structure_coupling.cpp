@@ -531,7 +531,9 @@ void FluidStructureProjection<d>::run(World<d>& world, StepContext& ctx) {
     const int off = static_cast<int>(b) * ndof;
     // The fluid's impulse on the body is -J^T W^T lambda (eq. 5.11).
     const Eigen::VectorXd force = -report.structureImpulse.segment(off, ndof) / ctx.dt;
+    const Eigen::Matrix<double, d, 1> x = world.template get<RigidBody<d>>(setup.bodies[b])->x;
     for (int a = 0; a < d; ++a) {
+      out.set(prefix + "_position" + axes[a], x[a]);
       out.set(prefix + "_velocity" + axes[a], v[off + a]);
       out.set(prefix + "_force" + axes[a], force[a]);
     }

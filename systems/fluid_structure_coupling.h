@@ -22,7 +22,7 @@
 // The structure cells are the cells whose centres lie inside a coupled body (staircase, Sec.
 // 5.4.1); the coupling faces and J = N J_hat R are built afresh at every solve from the bodies'
 // poses (solvers/fluid/structure_coupling.h). Reports per coupled body (entity name N):
-// fsi_N_velocity_x/_y(/_z), fsi_N_angular_velocity(_z or _x/_y/_z), and the fluid's force and
+// fsi_N_position_x/_y(/_z), fsi_N_velocity_x/_y(/_z), fsi_N_angular_velocity(_z or _x/_y/_z), and the fluid's force and
 // torque on it from the coupling impulses, fsi_N_force_x/... = -(J^T W^T lambda)/dt; and per
 // step fsi_solver_iterations, fsi_half_step_iterations, fsi_energy_change (kinetic energy after
 // minus before the full solve, <= 0 up to rounding, Sec. 5.8), fsi_half_step_energy_change.

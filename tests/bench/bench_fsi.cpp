@@ -17,6 +17,8 @@
 //                                   reference grid, observed order
 //   bench_fsi disk [cells=64]       oscillating_disk (Sec. 5.11.6): energies over time, the
 //                                   elastic energy's extrema (the oscillation)
+//   bench_fsi vortex [end=120]      vortex_shedding_spring: the spring-mounted cylinder's
+//                                   cross-stream amplitude and frequency over the last half
 // Every row prints the wall time of its run.
 #include <algorithm>
 #include <chrono>
@@ -210,6 +212,36 @@ void disk(const Registry& registry, int n) {
   std::printf("total energy %.6e -> %.6e J\n", h.front().at("total_energy"), h.back().at("total_energy"));
 }
 
+void vortex(const Registry& registry, double end) {
+  std::vector<std::map<std::string, double>> h;
+  const Run r = runScene(registry, "vortex_shedding_spring.json", {{"time.end", num(end)}}, -1, &h);
+  // Over the second half: mean, half the peak-to-peak of y, and the frequency from the upward
+  // crossings of the mean (linear interpolation between steps).
+  std::vector<double> t, y;
+  for (const auto& m : h)
+    if (m.at("time") >= 0.5 * end) {
+      t.push_back(m.at("time"));
+      y.push_back(m.at("fsi_cylinder_position_y"));
+    }
+  double mean = 0, lo = 1e300, hi = -1e300, xmean = 0;
+  for (double v : y) {
+    mean += v / y.size();
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  for (const auto& m : h)
+    if (m.at("time") >= 0.5 * end) xmean += m.at("fsi_cylinder_position_x") / y.size();
+  std::vector<double> up;
+  for (std::size_t i = 1; i < y.size(); ++i)
+    if (y[i - 1] < mean && y[i] >= mean) up.push_back(t[i - 1] + (mean - y[i - 1]) / (y[i] - y[i - 1]) * (t[i] - t[i - 1]));
+  const double f = up.size() > 1 ? (up.size() - 1) / (up.back() - up.front()) : 0.0;
+  std::printf("%ld steps, %.1f s wall, mean its %.1f, max solve energy change %.3e\n", r.steps, r.seconds, r.meanIterations,
+              r.maxEnergyChange);
+  std::printf("t in [%.1f, %.1f]: mean x %.4f, mean y %.4f, amplitude (half peak-to-peak of y) %.4f D, frequency %.4f Hz "
+              "(%zu upward crossings)\n",
+              0.5 * end, end, xmean, mean, 0.5 * (hi - lo), f, up.size());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -229,8 +261,9 @@ int main(int argc, char** argv) {
     sphere(registry, cells.empty() ? std::vector<int>{16, 24, 32} : cells);
   } else if (mode == "beam") beam(registry, argc > 2 ? std::atoi(argv[2]) : 128, argc > 3 ? std::atoi(argv[3]) : 256);
   else if (mode == "disk") disk(registry, argc > 2 ? std::atoi(argv[2]) : 64);
+  else if (mode == "vortex") vortex(registry, argc > 2 ? std::atof(argv[2]) : 120.0);
   else {
-    std::fprintf(stderr, "usage: bench_fsi channel|cylinder|precond|sphere|beam|disk [finest] ...\n");
+    std::fprintf(stderr, "usage: bench_fsi channel|cylinder|precond|sphere|beam|disk|vortex [finest] ...\n");
     return 2;
   }
   return 0;
