@@ -1,11 +1,13 @@
 #pragma once
 // Two-way fluid-structure coupling (thesis Ch. 5, Sec. 5.4-5.8).
-//  * FluidCoupling<d>, on a dynamic rigid body with a shape: the body and the scene's MAC grid
-//    fluid are solved together in one SPD system (solvers/fluid/fsi_system.h); the fluid pushes
-//    the body and the body pushes the fluid. (fluid_obstacle is the one-way case: static or
+//  * FluidCoupling<d>, on a dynamic rigid body with a shape or on a deformable body: the body and
+//    the scene's MAC grid fluid are solved together in one SPD system (solvers/fluid/fsi_system.h);
+//    the fluid pushes the body and the body pushes the fluid. (fluid_obstacle is the one-way case: static or
 //    scripted bodies, infinite mass.)
 //  * FsiSolver, optional on the fluid's entity: how that system is solved.
 #include <Eigen/Core>
+
+#include <vector>
 
 #include "components/rigid_body.h"
 
@@ -25,6 +27,12 @@ struct FluidCoupling {
   Eigen::Matrix<double, d, 1> startPosition = Eigen::Matrix<double, d, 1>::Zero();
   Orientation<d> startOrientation = RigidBody<d>::identityOrientation();
   bool started = false;
+  // A coupled deformable body (d numbers per particle, within one step): v^n, the explicit forces
+  // f(x^n) (elastic + gravity), the velocity the half-step solve wrote, x^n (Stokes keeps it).
+  std::vector<double> particleStart, particleForce, particleHalf, particleStartX;
+  // Scene configuration of a deformable body (not state): the particle whose position is
+  // reported as fsi_<name>_track_x/_y(/_z), -1 for none.
+  int trackParticle = -1;
   template <class V>
   void visitFields(V&) {}
 };

@@ -6,6 +6,7 @@
 #include "components/forces.h"
 #include "components/rigid_body.h"
 #include "components/shape.h"
+#include "components/spring_mount.h"
 #include "ecs/registry.h"
 #include "scenarios/contact_components.h"
 #include "scenarios/deformable_components.h"
@@ -24,6 +25,7 @@
 #include "systems/kinematic_motion.h"
 #include "systems/rigid_contact.h"
 #include "systems/rigid_forces.h"
+#include "systems/spring_mount.h"
 
 namespace monolith {
 
@@ -117,6 +119,18 @@ void parseRigidBody(World<d>& world, Entity e, const Config& c) {
   if (!b.isStatic) world.add(e, RigidForces<d>{});
 }
 
+// A spring and dashpot from the body to a world anchor (its start position by default).
+template <int d>
+void parseSpringMount(World<d>& world, Entity e, const Config& c) {
+  const RigidBody<d>* body = world.template get<RigidBody<d>>(e);
+  if (!body || body->isStatic) c.fail("spring_mount on an entity with a dynamic \"rigid_body\"", body ? "a static body" : "none");
+  SpringMount<d> m;
+  m.anchor = c.vector("anchor", Eigen::VectorXd(body->x));
+  m.stiffness = c.vector("stiffness", d, Bound::NonNegative);
+  m.damping = c.vector("damping", Eigen::VectorXd::Zero(d), Bound::NonNegative);
+  world.add(e, m);
+}
+
 template <int d>
 void parseExternalForce(World<d>& world, Entity e, const Config& c) {
   ExternalForce<d> f;
@@ -145,18 +159,24 @@ void registerDimension(Registry& r) {
       "rigid body: mass, inertia (or from shape), position, orientation/angle, velocity, angular_velocity, static",
       parseRigidBody<d>);
   r.addComponentOf<d, ExternalForce<d>>("constant world-frame force and torque on a rigid body", parseExternalForce<d>);
+  r.addComponentOf<d, SpringMount<d>>("spring and dashpot to a world anchor on a dynamic rigid body: anchor (default: "
+                                      "its start position), stiffness and damping per axis",
+                                      parseSpringMount<d>);
   r.addComponentOf<d, RigidForces<d>>("(internal) force/torque accumulator of a dynamic rigid body", nullptr);
   registerContactComponents<d>(r);
   registerFluidComponents<d>(r);
   if constexpr (d == 3) registerJointComponents(r);
   registerSurfaceTensionComponents<d>(r);
   registerDeformableComponents<d>(r);
+  registerFluidCouplingComponent<d>(r);
 
   r.addSystem<d>({"clear_rigid_forces", "zero the force accumulators before each force evaluation",
                   [] { return atBothForceStages<ClearRigidForces<d>, d>(); }, ""});
   r.addSystem<d>({"gravity", "m g on dynamic rigid bodies", [] { return atBothForceStages<GravityForce<d>, d>(); }, ""});
   r.addSystem<d>({"external_forces", "constant external force/torque components",
                   [] { return atBothForceStages<ExternalForces<d>, d>(); }, ""});
+  r.addSystem<d>({"spring_mount_forces", "spring_mount: -k (x - anchor) - c v on mounted rigid bodies",
+                  [] { return atBothForceStages<SpringMountForces<d>, d>(); }, ""});
   r.addSystem<d>({"advance_rigid_velocity_half", "Step I (Sec. 4.3): v^{n+1/2} = v^n + dt/2 a(x^n)",
                   [] { return single<RigidHalfKick<d>>(Stage::AdvanceVelocityHalf); }, ""});
   r.addSystem<d>({"script_kinematic_velocity", "kinematic bodies take their scripted velocity at t^{n+1/2}",

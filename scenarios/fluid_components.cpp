@@ -1,8 +1,12 @@
 #include "scenarios/fluid_components.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
+#include "components/deformable.h"
 #include "components/fluid_coupling.h"
 #include "components/fluid_obstacle.h"
 #include "components/kinematic.h"
@@ -44,19 +48,33 @@ SideCondition<d> parseSide(const Config& c) {
   return s;
 }
 
-// Initial face velocities: zero, uniform, or the Taylor-Green vortex (REFERENCES.md:
-// u = A sin x cos y, v = -A cos x sin y; in 3-D times cos z, w = 0).
+// Initial face velocities: zero, uniform, the Taylor-Green vortex (REFERENCES.md:
+// u = A sin x cos y, v = -A cos x sin y; in 3-D times cos z, w = 0), or in 2-D the stream function
+// psi = psi0 sin(k_x x) sin(k_y y) of the oscillating disk (thesis Sec. 5.11.6), u = dpsi/dy,
+// v = -dpsi/dx, taken as differences of psi at the face's corners (discretely divergence free).
 template <int d>
 void initialVelocity(const Config& c, MacGrid<d>& grid, const solvers::MacLayout<d>& layout) {
-  const std::string type = c.oneOf("type", {"zero", "uniform", "taylor_green"}, "zero");
+  const std::string type = c.oneOf("type", {"zero", "uniform", "taylor_green", "stream_function"}, "zero");
   Eigen::Matrix<double, d, 1> uniform = Eigen::Matrix<double, d, 1>::Zero();
   double amplitude = 1;
+  Eigen::VectorXd k = Eigen::VectorXd::Zero(2);
   if (type == "uniform") uniform = c.vector("velocity", d);
   if (type == "taylor_green") amplitude = c.number("amplitude", 1.0);
+  if (type == "stream_function") {
+    if (d != 2) c.failAt("type", "\"stream_function\" in a 2-D scene", "a 3-D scene");
+    amplitude = c.number("psi0");
+    k = c.vector("k", 2);
+  }
+  auto psi = [&](double x, double y) { return amplitude * std::sin(k[0] * x) * std::sin(k[1] * y); };
   for (int f = 0; f < layout.totalFaces(); ++f) {
     const auto [axis, index] = layout.faceCoord(f);
     const Eigen::Matrix<double, d, 1> x = layout.faceCenter(axis, index);
     double value = 0;
+    if (type == "stream_function") {
+      const double h = 0.5 * layout.dx;
+      value = axis == 0 ? (psi(x[0], x[1] + h) - psi(x[0], x[1] - h)) / layout.dx
+                        : -(psi(x[0] + h, x[1]) - psi(x[0] - h, x[1])) / layout.dx;
+    }
     if (type == "uniform") value = uniform[axis];
     if (type == "taylor_green") {
       const double z = d == 3 ? std::cos(x[d - 1]) : 1.0;
@@ -149,9 +167,85 @@ void parseFluidObstacle(World<d>& world, Entity e, const Config& c) {
   world.add(e, FluidObstacle{});
 }
 
-// Two-way coupling: a dynamic rigid_body with a shape the rasterization knows (or a level_set).
+// Linear interpolation of the MAC grid's face velocities at x (each component from its own face
+// lattice, clamped to the grid).
+template <int d>
+Eigen::Matrix<double, d, 1> gridVelocityAt(const MacGrid<d>& grid, const Eigen::Matrix<double, d, 1>& x) {
+  std::array<bool, d> periodic{};
+  for (int a = 0; a < d; ++a) periodic[a] = grid.periodic(a);
+  const solvers::MacLayout<d> layout(grid.cells, grid.dx, grid.origin, periodic);
+  Eigen::Matrix<double, d, 1> out;
+  for (int a = 0; a < d; ++a) {
+    const auto dims = layout.faceDims(a);
+    Eigen::Matrix<int, d, 1> base;
+    Eigen::Matrix<double, d, 1> t;
+    for (int b = 0; b < d; ++b) {
+      const double s = (x[b] - grid.origin[b]) / grid.dx - (b == a ? 0.0 : 0.5);
+      const int last = std::max(0, dims[b] - 2);
+      base[b] = std::clamp(static_cast<int>(std::floor(s)), 0, last);
+      t[b] = dims[b] < 2 ? 0.0 : std::clamp(s - base[b], 0.0, 1.0);
+    }
+    double value = 0;
+    for (int corner = 0; corner < (1 << d); ++corner) {
+      Eigen::Matrix<int, d, 1> f = base;
+      double w = 1;
+      for (int b = 0; b < d; ++b) {
+        const int up = (corner >> b) & 1;
+        f[b] = std::min(f[b] + up, dims[b] - 1);
+        w *= up ? t[b] : 1 - t[b];
+      }
+      value += w * grid.u[layout.faceIndex(a, f)];
+    }
+    out[a] = value;
+  }
+  return out;
+}
+
+// Two-way coupling of a deformable body (its particles and mesh, parsed before this component):
+// "velocity_from_fluid": true starts the particles with the velocity of the fluid around them
+// (the grid's initial_velocity; the grid's entity must come earlier in the file).
+template <int d>
+void parseDeformableFluidCoupling(World<d>& world, Entity e, const Config& c, Particles<d>& p) {
+  if (world.template has<RigidBinding<d>>(e))
+    c.fail("fluid_coupling on a deformable body without \"bind\" (bound particles are not coupled)", "bound particles");
+  if (c.boolean("velocity_from_fluid", false)) {
+    const auto* grids = world.template findPool<MacGrid<d>>();
+    if (!grids || grids->size() == 0)
+      c.failAt("velocity_from_fluid", "a mac_grid entity listed before this one", "none");
+    const MacGrid<d>& grid = grids->components()[0];
+    for (int i = 0; i < p.count(); ++i) {
+      if (p.fixed[i]) continue;
+      const Eigen::Matrix<double, d, 1> v = gridVelocityAt(grid, Eigen::Matrix<double, d, 1>(Eigen::Map<const Eigen::Matrix<double, d, 1>>(&p.x[d * i])));
+      for (int a = 0; a < d; ++a) p.v[d * i + a] = v[a];
+    }
+  }
+  FluidCoupling<d> coupling;
+  // "track": a point; the particle nearest it at the start is reported every step.
+  if (c.has("track")) {
+    const Eigen::VectorXd at = c.vector("track", d);
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < p.count(); ++i) {
+      const double dist = (Eigen::Map<const Eigen::Matrix<double, d, 1>>(&p.x[d * i]) - at).norm();
+      if (dist < best) {
+        best = dist;
+        coupling.trackParticle = i;
+      }
+    }
+  }
+  c.finish();
+  world.add(e, coupling);
+}
+
+// Two-way coupling: a dynamic rigid_body with a shape the rasterization knows (or a level_set),
+// or a deformable body.
 template <int d>
 void parseFluidCoupling(World<d>& world, Entity e, const Config& c) {
+  if (Particles<d>* p = world.template get<Particles<d>>(e); p && !world.template has<RigidBody<d>>(e)) {
+    if (world.template has<FluidObstacle>(e))
+      c.fail("either fluid_obstacle (one-way) or fluid_coupling (two-way) on one entity", "both");
+    parseDeformableFluidCoupling(world, e, c, *p);
+    return;
+  }
   const Shape<d>* shape = world.template get<Shape<d>>(e);
   const bool levelSet = world.template has<LevelSet<d>>(e);
   if (!shape && !levelSet) c.fail("fluid_coupling on an entity with a \"level_set\" or a \"shape\"", "neither");
@@ -201,16 +295,25 @@ void registerFluidComponents(Registry& r) {
       "obstacle in the fluid: the entity's level_set, else its shape (" + ObstacleGeometry<d>::supportedNames() +
           "), at its static or kinematic rigid_body pose",
       parseFluidObstacle<d>);
-  r.addComponentOf<d, FluidCoupling<d>>(
-      "two-way coupling of a dynamic rigid body with the fluid in one SPD solve (thesis Sec. 5.4-5.8): its shape (" +
-          ObstacleGeometry<d>::supportedNames() + ") or level_set",
-      parseFluidCoupling<d>);
   r.addComponentOf<d, FsiSolver>(
       "on the mac_grid entity: the fluid-structure solve's preconditioner (none, block_jacobi, block_exact, schur) and "
       "half_step (Sec. 5.4 steps 1-3)",
       parseFsiSolver<d>);
 }
 
+// After the rigid and deformable components: fluid_coupling reads the entity's rigid_body and
+// shape, or its particles and mesh.
+template <int d>
+void registerFluidCouplingComponent(Registry& r) {
+  r.addComponentOf<d, FluidCoupling<d>>(
+      "two-way coupling of a dynamic rigid body (its shape (" + ObstacleGeometry<d>::supportedNames() +
+          ") or level_set) or of a deformable body (velocity_from_fluid) with the fluid in one SPD solve (thesis Sec. "
+          "5.4-5.8)",
+      parseFluidCoupling<d>);
+}
+
+template void registerFluidCouplingComponent<2>(Registry&);
+template void registerFluidCouplingComponent<3>(Registry&);
 template void registerFluidComponents<2>(Registry&);
 template void registerFluidComponents<3>(Registry&);
 

@@ -6,5 +6,8 @@ namespace monolith {
 
 template <int d>
 void registerFluidComponents(Registry& registry);
+// fluid_coupling, registered after the rigid and deformable components it reads.
+template <int d>
+void registerFluidCouplingComponent(Registry& registry);
 
 }  // namespace monolith

@@ -1,5 +1,7 @@
 #include "systems/deformable_dynamics.h"
 
+#include "components/fluid_coupling.h"
+
 #include "solvers/deformable/simplex_mesh.h"
 #include "solvers/deformable/stable_step.h"
 #include "solvers/fluid/krylov.h"
@@ -132,6 +134,9 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
   int iterations = 0;
   world.template each<Particles<d>, SimplexMesh<d>, Elasticity>(
       [&](Entity e, Particles<d>& p, SimplexMesh<d>& mesh, Elasticity& el) {
+        // A body coupled to a fluid takes its velocity steps in the coupled solve, its damping
+        // inside it (systems/fluid_structure_coupling.h).
+        if (world.template has<FluidCoupling<d>>(e)) return;
         const auto& fm = cache_.get(e, p, mesh, el);
         const std::vector<double> f = explicitForces(fm, p, g);
         std::vector<double> u;

@@ -59,7 +59,7 @@ void writeBody(RigidBody<d>& body, const Eigen::VectorXd& v, int b) {
 // One coupled solve over `dt` of the grid's face velocities `u` (in/out) with setup.coupling.velocity
 // as v* (in) and v^{n+1} (out).
 template <int d>
-solvers::FsiReport coupledSolve(const World<d>& world, RigidCouplingSetup<d>& setup, double rho, double mu, double dt,
+solvers::FsiReport coupledSolve(const World<d>& world, StructureCouplingSetup<d>& setup, double rho, double mu, double dt,
                                 Eigen::VectorXd& u, std::unique_ptr<solvers::FluidOperators<d>>& opsOut) {
   const FluidSolverSettings& settings = world.settings().fluid;
   auto ops = std::make_unique<solvers::FluidOperators<d>>(
@@ -109,21 +109,43 @@ double fluidViscosity(const World<d>& world, Entity grid) {
 }  // namespace
 
 template <int d>
-RigidCouplingSetup<d> buildRigidCoupling(const World<d>& world, const MacGrid<d>& grid, bool viscous) {
+StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const MacGrid<d>& grid, bool viscous,
+                                                 double dt, ForceModelCache<d>& models) {
   using Vec = Eigen::Matrix<double, d, 1>;
-  RigidCouplingSetup<d> setup;
+  StructureCouplingSetup<d> setup;
   setup.domain = fluidDomainOf(grid);
   const auto& layout = setup.domain.layout;
   const auto* pool = world.template findPool<FluidCoupling<d>>();
   std::vector<ObstacleGeometry<d>> geometry;
-  for (Entity e : pool ? pool->entities() : std::vector<Entity>{}) {
+  const int ndof = d + kAngular(d);
+  std::vector<Entity> coupled = pool ? pool->entities() : std::vector<Entity>{};
+  for (Entity e : coupled) {
     const RigidBody<d>* body = world.template get<RigidBody<d>>(e);
     if (!body) continue;
     setup.bodies.push_back(e);
     geometry.emplace_back(world.template get<Shape<d>>(e), world.template get<LevelSet<d>>(e), *body);
   }
   const int nb = static_cast<int>(setup.bodies.size());
-  // Structure cells: centre inside a body (the first listed wins where bodies overlap).
+  int dofs = nb * ndof, dampingRows = 0;
+  for (Entity e : coupled) {
+    const Particles<d>* p = world.template get<Particles<d>>(e);
+    const SimplexMesh<d>* mesh = world.template get<SimplexMesh<d>>(e);
+    const Elasticity* el = world.template get<Elasticity>(e);
+    if (world.template has<RigidBody<d>>(e) || !p || !mesh || !el) continue;
+    setup.deformables.push_back(e);
+    setup.deformableOffset.push_back(dofs);
+    dofs += d * p->count();
+    setup.locators.emplace_back(p->x, mesh->elements, layout);
+    const auto& fm = models.get(e, *p, *mesh, *el);
+    setup.models.push_back(&fm);
+    setup.rotations.push_back(solvers::deformable::dampingRotations<d>(fm, p->x.data()));
+    setup.positions.push_back(p->x);
+    setup.dampingOffset.push_back(dampingRows);
+    dampingRows += fm.dampingRows();
+  }
+  const int nd = static_cast<int>(setup.deformables.size());
+  // Structure cells: centre inside a body or an element (the first listed rigid body wins where
+  // bodies overlap, rigid bodies before deformables).
   setup.cellBody.assign(layout.cellCount(), -1);
   std::vector<std::uint8_t> mask(layout.cellCount(), 0);
   for (int c = 0; c < layout.cellCount(); ++c) {
@@ -135,14 +157,65 @@ RigidCouplingSetup<d> buildRigidCoupling(const World<d>& world, const MacGrid<d>
         break;
       }
   }
+  // A structure smaller than a cell may cover no cell centre, and would then never see the
+  // fluid: it claims the cells around its centre of mass (a rigid body) or its particles (a
+  // deformable body), and moves with the fluid in them as one composite body: the fluid mass
+  // rho_f (claimed volume - body volume) joins the structure's mass (and, about the centre, its
+  // inertia). Gravity accelerates both alike, so v* is unchanged; the pressure on the claimed
+  // cells' faces then carries the buoyancy of the whole claimed volume, which that fluid's weight
+  // cancels: the net force is (m - rho_f V) g as it should be, while the drag is that of a
+  // one-cell body (resolution-limited). The solve keeps every property (SPD, no energy gain).
+  std::vector<double> extraMass(nb + nd, 0.0);
+  std::vector<int> claimed(nb + nd, 0);
+  auto claim = [&](const Vec& x, int structure) {
+    typename solvers::MacLayout<d>::Index cell;
+    for (int a = 0; a < d; ++a) {
+      cell[a] = static_cast<int>(std::floor((x[a] - layout.origin[a]) / layout.dx));
+      if (cell[a] < 0 || cell[a] >= layout.cells[a]) return;
+    }
+    const int c = layout.cellIndex(cell);
+    if (setup.cellBody[c] >= 0 || setup.domain.cells[c] != solvers::CellKind::Fluid) return;
+    setup.cellBody[c] = structure;
+    mask[c] = 1;
+    ++claimed[structure];
+  };
+  const auto* grids = world.template findPool<MacGrid<d>>();
+  const double rhoFluid = fluidDensity(world, grids->entities()[0]);
+  for (int b = 0; b < nb; ++b)
+    if (std::find(setup.cellBody.begin(), setup.cellBody.end(), b) == setup.cellBody.end()) {
+      claim(geometry[b].body().x, b);
+      const Shape<d>* shape = world.template get<Shape<d>>(setup.bodies[b]);
+      double volume = 0;  // the body's own volume (area in 2-D), where the shape gives it simply
+      if (shape && shape->type == ShapeType::Sphere) volume = d == 2 ? M_PI * std::pow(shape->radius, 2) : 4.0 / 3.0 * M_PI * std::pow(shape->radius, 3);
+      if (shape && shape->type == ShapeType::Box) volume = std::pow(2.0, d) * shape->halfExtents.prod();
+      extraMass[b] = std::max(0.0, rhoFluid * (claimed[b] * layout.cellVolume() - volume));
+    }
+  for (int k = 0; k < nd; ++k) {
+    const std::vector<int> inside = setup.locators[k].cellsInside();
+    bool any = false;
+    for (int c = 0; c < layout.cellCount(); ++c)
+      if (inside[c] >= 0 && setup.cellBody[c] < 0) {
+        setup.cellBody[c] = nb + k;
+        mask[c] = 1;
+        any = true;
+      }
+    if (!any) {
+      const Particles<d>& p = *world.template get<Particles<d>>(setup.deformables[k]);
+      for (int i = 0; i < p.count(); ++i) claim(Vec(Eigen::Map<const Vec>(&p.x[d * i])), nb + k);
+      double volume = 0;
+      for (double v : setup.models[k]->restVolume) volume += v;
+      extraMass[nb + k] = std::max(0.0, rhoFluid * (claimed[nb + k] * layout.cellVolume() - volume));
+    }
+  }
   auto& coupling = setup.coupling;
   coupling.constrainedFaces = solvers::markStructure(setup.domain, mask, viscous);
   const int nc = static_cast<int>(coupling.constrainedFaces.size());
-  const int ndof = d + kAngular(d);
 
-  // J = N J_hat R: one sample per (face, adjacent body) at the face centre; a face between two
-  // bodies averages them (alpha = 1/2), else J_hat is the identity (Sec. 5.4.3).
-  std::vector<Eigen::Triplet<double>> jhat, r;
+  // J = N J_hat R: one sample per (face, adjacent rigid body) at the face centre, and one per
+  // particle (R = I there, its rows zero for fixed particles: they are infinitely massive and at
+  // rest); J_hat averages the adjacent structures of a face between two (alpha = 1/2) and holds
+  // the barycentric weights of the particles around the face centre (Sec. 5.4.3).
+  std::vector<Eigen::Triplet<double>> jhat, jhatParticles, r;
   int samples = 0;
   for (int k = 0; k < nc; ++k) {
     const int f = coupling.constrainedFaces[k];
@@ -156,27 +229,51 @@ RigidCouplingSetup<d> buildRigidCoupling(const World<d>& world, const MacGrid<d>
     const auto [axis, fc] = layout.faceCoord(f);
     const Vec x = layout.faceCenter(axis, fc);
     for (int i = 0; i < count; ++i) {
-      const RigidBody<d>& body = geometry[adjacent[i]].body();
-      for (int a = 0; a < d; ++a) jhat.emplace_back(k * d + a, samples * d + a, 1.0 / count);
-      solvers::rigidSampleRows<d>(samples, adjacent[i] * ndof, Vec(x - body.x), r);
-      ++samples;
+      if (adjacent[i] < nb) {
+        const RigidBody<d>& body = geometry[adjacent[i]].body();
+        for (int a = 0; a < d; ++a) jhat.emplace_back(k * d + a, samples * d + a, 1.0 / count);
+        solvers::rigidSampleRows<d>(samples, adjacent[i] * ndof, Vec(x - body.x), r);
+        ++samples;
+        continue;
+      }
+      const int def = adjacent[i] - nb;
+      const solvers::SimplexWeights<d> w = setup.locators[def].weightsAt(x);
+      const int first = (setup.deformableOffset[def] - nb * ndof) / d;  // particle sample of particle 0
+      for (int v = 0; v < d + 1; ++v)
+        for (int a = 0; a < d; ++a)
+          jhatParticles.emplace_back(k * d + a, (first + w.particle[v]) * d + a, w.weight[v] / count);
     }
   }
-  solvers::SparseMatrixR Jhat(nc * d, samples * d), R(samples * d, nb * ndof);
+  const int particleSamples = (dofs - nb * ndof) / d;
+  for (const auto& t : jhatParticles) jhat.emplace_back(t.row(), t.col() + samples * d, t.value());
+  for (int k = 0; k < nd; ++k) {
+    const Particles<d>& p = *world.template get<Particles<d>>(setup.deformables[k]);
+    const int first = (setup.deformableOffset[k] - nb * ndof) / d;
+    for (int i = 0; i < p.count(); ++i)
+      if (!p.fixed[i])
+        for (int a = 0; a < d; ++a) r.emplace_back((samples + first + i) * d + a, setup.deformableOffset[k] + d * i + a, 1.0);
+  }
+  const int allSamples = samples + particleSamples;
+  solvers::SparseMatrixR Jhat(nc * d, allSamples * d), R(allSamples * d, dofs);
   Jhat.setFromTriplets(jhat.begin(), jhat.end());
   R.setFromTriplets(r.begin(), r.end());
   coupling.J = solvers::faceNormalRows(layout, coupling.constrainedFaces) * Jhat * R;
 
   std::vector<Eigen::Triplet<double>> m, minv;
-  coupling.velocity.resize(nb * ndof);
+  coupling.velocity.resize(dofs);
   for (int b = 0; b < nb; ++b) {
     const RigidBody<d>& body = geometry[b].body();
     const int off = b * ndof;
+    const double mass = body.mass + extraMass[b];
     for (int a = 0; a < d; ++a) {
-      m.emplace_back(off + a, off + a, body.mass);
-      minv.emplace_back(off + a, off + a, 1.0 / body.mass);
+      m.emplace_back(off + a, off + a, mass);
+      minv.emplace_back(off + a, off + a, 1.0 / mass);
     }
-    const InertiaMat<d> I = body.worldInertia(), Iinv = body.worldInverseInertia();
+    InertiaMat<d> I = body.worldInertia(), Iinv = body.worldInverseInertia();
+    if (extraMass[b] > 0) {  // the claimed fluid: a square (cube) of side dx about the centre
+      I += InertiaMat<d>::Identity() * extraMass[b] * layout.dx * layout.dx / 6.0;
+      Iinv = I.inverse();
+    }
     for (int i = 0; i < kAngular(d); ++i)
       for (int j = 0; j < kAngular(d); ++j) {
         m.emplace_back(off + d + i, off + d + j, I(i, j));
@@ -186,49 +283,118 @@ RigidCouplingSetup<d> buildRigidCoupling(const World<d>& world, const MacGrid<d>
     const AngularVec<d> w = body.omega();
     for (int i = 0; i < kAngular(d); ++i) coupling.velocity[off + d + i] = w[i];
   }
-  coupling.mass.resize(nb * ndof, nb * ndof);
+  for (int k = 0; k < nd; ++k) {
+    // Lumped particle masses; a fixed particle's M^-1 is 0 (infinite mass: v* stays, at rest).
+    const Particles<d>& p = *world.template get<Particles<d>>(setup.deformables[k]);
+    const int off = setup.deformableOffset[k];
+    int free = 0;
+    for (int i = 0; i < p.count(); ++i) free += p.fixed[i] ? 0 : 1;
+    const double extra = free > 0 ? extraMass[nb + k] / free : 0.0;  // claimed fluid, spread evenly
+    for (int i = 0; i < p.count(); ++i)
+      for (int a = 0; a < d; ++a) {
+        m.emplace_back(off + d * i + a, off + d * i + a, p.m[i] + (p.fixed[i] ? 0.0 : extra));
+        if (!p.fixed[i]) minv.emplace_back(off + d * i + a, off + d * i + a, 1.0 / (p.m[i] + extra));
+      }
+    for (int i = 0; i < d * p.count(); ++i) coupling.velocity[off + i] = p.v[i];
+  }
+  coupling.mass.resize(dofs, dofs);
   coupling.mass.setFromTriplets(m.begin(), m.end());
-  coupling.massInverse.resize(nb * ndof, nb * ndof);
+  coupling.massInverse.resize(dofs, dofs);
   coupling.massInverse.setFromTriplets(minv.begin(), minv.end());
+
+  // C over this solve's dt (C^T C = -dt D), body by body.
+  coupling.dampingRows = dampingRows;
+  if (dampingRows > 0) {
+    auto fms = setup.models;
+    auto rotations = setup.rotations;
+    auto positions = setup.positions;
+    auto offsets = setup.deformableOffset;
+    auto rows = setup.dampingOffset;
+    coupling.damping = [=](const Eigen::VectorXd& v, Eigen::VectorXd& y) {
+      y.setZero(dampingRows);
+      for (std::size_t k = 0; k < fms.size(); ++k)
+        if (fms[k]->dampingRows() > 0)
+          solvers::deformable::applyDampingFactor<d>(*fms[k], rotations[k], positions[k].data(), dt,
+                                                     v.data() + offsets[k], y.data() + rows[k]);
+    };
+    coupling.dampingTranspose = [=](const Eigen::VectorXd& y, Eigen::VectorXd& f) {
+      f.setZero(dofs);
+      for (std::size_t k = 0; k < fms.size(); ++k)
+        if (fms[k]->dampingRows() > 0)
+          solvers::deformable::applyDampingFactorTranspose<d>(*fms[k], rotations[k], positions[k].data(), dt,
+                                                              y.data() + rows[k], f.data() + offsets[k]);
+    };
+  }
   return setup;
 }
+
+namespace {
+
+// Writes the solved structure velocities into the coupled rigid bodies and particles.
+template <int d>
+void writeStructures(World<d>& world, const StructureCouplingSetup<d>& setup) {
+  const Eigen::VectorXd& v = setup.coupling.velocity;
+  for (std::size_t b = 0; b < setup.bodies.size(); ++b)
+    writeBody(*world.template get<RigidBody<d>>(setup.bodies[b]), v, static_cast<int>(b));
+  for (std::size_t k = 0; k < setup.deformables.size(); ++k) {
+    Particles<d>& p = *world.template get<Particles<d>>(setup.deformables[k]);
+    for (std::size_t i = 0; i < p.v.size(); ++i) p.v[i] = v[setup.deformableOffset[k] + static_cast<int>(i)];
+  }
+}
+
+}  // namespace
 
 template <int d>
 void FsiHalfStep<d>::run(World<d>& world, StepContext& ctx) {
   auto& couplings = world.template pool<FluidCoupling<d>>();
+  const bool stokes = world.settings().fluid.advection == FluidSolverSettings::Advection::None;
+  const Eigen::Matrix<double, d, 1> g = world.settings().gravity;
   for (std::size_t i = 0; i < couplings.size(); ++i) {
     FluidCoupling<d>& c = couplings.components()[i];
-    const RigidBody<d>* body = world.template get<RigidBody<d>>(couplings.entities()[i]);
-    if (!body) continue;
-    c.startVelocity = c.halfVelocity = body->v;
-    c.startL = c.halfL = body->L;
-    c.startPosition = body->x;
-    c.startOrientation = body->orientation;
+    const Entity e = couplings.entities()[i];
+    if (const RigidBody<d>* body = world.template get<RigidBody<d>>(e)) {
+      c.startVelocity = c.halfVelocity = body->v;
+      c.startL = c.halfL = body->L;
+      c.startPosition = body->x;
+      c.startOrientation = body->orientation;
+      c.started = true;
+      continue;
+    }
+    // A deformable body (its own Newmark systems skip it): step 1, v^* = v^n + dt/2 M^-1 f(x^n).
+    Particles<d>* p = world.template get<Particles<d>>(e);
+    const SimplexMesh<d>* mesh = world.template get<SimplexMesh<d>>(e);
+    const Elasticity* el = world.template get<Elasticity>(e);
+    if (!p || !mesh || !el) continue;
+    const auto& fm = cache_.get(e, *p, *mesh, *el);
+    c.particleStart = p->v;
+    c.particleStartX = p->x;
+    c.particleForce = explicitForces(fm, *p, g);
+    for (std::size_t k = 0; k < p->v.size(); ++k) p->v[k] += 0.5 * ctx.dt * c.particleForce[k] / p->m[k / d];
+    c.particleHalf = p->v;
     c.started = true;
   }
-  const bool stokes = world.settings().fluid.advection == FluidSolverSettings::Advection::None;
   if (stokes || !fsiSolverOf(world).halfStep) return;
 
   auto& grids = world.template pool<MacGrid<d>>();
   MacGrid<d>& grid = grids.components()[0];
   const Entity fluidEntity = grids.entities()[0];
   const double rho = fluidDensity(world, fluidEntity), mu = fluidViscosity(world, fluidEntity);
-  RigidCouplingSetup<d> setup = buildRigidCoupling(world, grid, mu > 0);
+  StructureCouplingSetup<d> setup = buildStructureCoupling(world, grid, mu > 0, 0.5 * ctx.dt, cache_);
   // u^ = u^n + dt/2 g on the free faces (step 2).
   Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(grid.u.data(), grid.u.size());
-  const Eigen::Matrix<double, d, 1> g = world.settings().gravity;
   for (int f = 0; f < setup.domain.layout.totalFaces(); ++f)
     if (setup.domain.faces[f] == solvers::FaceKind::Free && !insideStructure(setup.domain, f))
       u[f] += 0.5 * ctx.dt * g[setup.domain.layout.faceCoord(f).first];
   std::unique_ptr<solvers::FluidOperators<d>> ops;
   const solvers::FsiReport report = coupledSolve(world, setup, rho, mu, 0.5 * ctx.dt, u, ops);
+  writeStructures(world, setup);
   for (std::size_t b = 0; b < setup.bodies.size(); ++b) {
-    RigidBody<d>& body = *world.template get<RigidBody<d>>(setup.bodies[b]);
-    writeBody(body, setup.coupling.velocity, static_cast<int>(b));
+    const RigidBody<d>& body = *world.template get<RigidBody<d>>(setup.bodies[b]);
     FluidCoupling<d>& c = *world.template get<FluidCoupling<d>>(setup.bodies[b]);
     c.halfVelocity = body.v;
     c.halfL = body.L;
   }
+  for (Entity e : setup.deformables) world.template get<FluidCoupling<d>>(e)->particleHalf = world.template get<Particles<d>>(e)->v;
   ctx.diagnostics.set("fsi_half_step_iterations", report.solve.iterations);
   ctx.diagnostics.set("fsi_half_step_energy_change", report.kineticEnergyAfter - report.kineticEnergyBefore);
 }
@@ -236,30 +402,43 @@ void FsiHalfStep<d>::run(World<d>& world, StepContext& ctx) {
 template <int d>
 void FluidStructureProjection<d>::run(World<d>& world, StepContext& ctx) {
   const bool stokes = world.settings().fluid.advection == FluidSolverSettings::Advection::None;
+  const Eigen::Matrix<double, d, 1> g = world.settings().gravity;
   auto& couplings = world.template pool<FluidCoupling<d>>();
   // v* = v^n + dt/2 (a^n + a^{n+1}) (step 5): the start velocity plus what the rigid stages added
   // after the half-step solve.
   for (std::size_t i = 0; i < couplings.size(); ++i) {
     FluidCoupling<d>& c = couplings.components()[i];
-    RigidBody<d>* body = world.template get<RigidBody<d>>(couplings.entities()[i]);
-    if (!body || !c.started) continue;
-    if (stokes) {
-      body->x = c.startPosition;
-      body->orientation = c.startOrientation;
-    }
-    body->v = c.startVelocity + (body->v - c.halfVelocity);
-    body->L = c.startL + (body->L - c.halfL);
+    const Entity e = couplings.entities()[i];
+    if (!c.started) continue;
     c.started = false;
+    if (RigidBody<d>* body = world.template get<RigidBody<d>>(e)) {
+      if (stokes) {
+        body->x = c.startPosition;
+        body->orientation = c.startOrientation;
+      }
+      body->v = c.startVelocity + (body->v - c.halfVelocity);
+      body->L = c.startL + (body->L - c.halfL);
+      continue;
+    }
+    Particles<d>* p = world.template get<Particles<d>>(e);
+    const SimplexMesh<d>* mesh = world.template get<SimplexMesh<d>>(e);
+    const Elasticity* el = world.template get<Elasticity>(e);
+    if (!p || !mesh || !el) continue;
+    if (stokes) p->x = c.particleStartX;
+    const std::vector<double> f = explicitForces(cache_.get(e, *p, *mesh, *el), *p, g);
+    // v^n + dt/2 M^-1 (f^n + f^{n+1}), plus any contact change since the half-step solve.
+    for (std::size_t k = 0; k < p->v.size(); ++k)
+      p->v[k] = c.particleStart[k] + 0.5 * ctx.dt * (c.particleForce[k] + f[k]) / p->m[k / d] +
+                (p->v[k] - c.particleHalf[k]);
   }
 
   auto& grids = world.template pool<MacGrid<d>>();
   MacGrid<d>& grid = grids.components()[0];
   const Entity fluidEntity = grids.entities()[0];
   const double rho = fluidDensity(world, fluidEntity), mu = fluidViscosity(world, fluidEntity);
-  RigidCouplingSetup<d> setup = buildRigidCoupling(world, grid, mu > 0);
+  StructureCouplingSetup<d> setup = buildStructureCoupling(world, grid, mu > 0, ctx.dt, cache_);
   Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(grid.u.data(), grid.u.size());
   // fluid_gravity added dt g on every face of the grid; take it off the faces inside the bodies.
-  const Eigen::Matrix<double, d, 1> g = world.settings().gravity;
   if (world.template count<MacGrid<d>>() > 0 && g.squaredNorm() > 0)
     for (int f = 0; f < setup.domain.layout.totalFaces(); ++f)
       if (insideStructure(setup.domain, f)) u[f] -= ctx.dt * g[setup.domain.layout.faceCoord(f).first];
@@ -267,10 +446,11 @@ void FluidStructureProjection<d>::run(World<d>& world, StepContext& ctx) {
   const solvers::FsiReport report = coupledSolve(world, setup, rho, mu, ctx.dt, u, ops);
   const auto& layout = setup.domain.layout;
   const int ndof = d + kAngular(d);
-  for (std::size_t b = 0; b < setup.bodies.size(); ++b)
-    writeBody(*world.template get<RigidBody<d>>(setup.bodies[b]), setup.coupling.velocity, static_cast<int>(b));
-  // Faces inside the bodies that are no unknowns carry the body's velocity (what advection and
-  // the next step's u^n see there, as for an obstacle's faces).
+  const int nb = static_cast<int>(setup.bodies.size());
+  writeStructures(world, setup);
+  // Faces inside the structures that are no unknowns carry the structure's velocity (what
+  // advection and the next step's u^n see there, as for an obstacle's faces).
+  const Eigen::VectorXd& v = setup.coupling.velocity;
   for (int f = 0; f < layout.totalFaces(); ++f) {
     if (setup.domain.faces[f] != solvers::FaceKind::Inactive) continue;
     int body = -1;
@@ -280,8 +460,16 @@ void FluidStructureProjection<d>::run(World<d>& world, StepContext& ctx) {
     }
     if (body < 0) continue;
     const auto [axis, fc] = layout.faceCoord(f);
-    const Eigen::Matrix<double, d, 1> r = layout.faceCenter(axis, fc) - world.template get<RigidBody<d>>(setup.bodies[body])->x;
-    const Eigen::VectorXd& v = setup.coupling.velocity;
+    const Eigen::Matrix<double, d, 1> x = layout.faceCenter(axis, fc);
+    if (body >= nb) {
+      const int k = body - nb;
+      const solvers::SimplexWeights<d> w = setup.locators[k].weightsAt(x);
+      double value = 0;
+      for (int i = 0; i < d + 1; ++i) value += w.weight[i] * v[setup.deformableOffset[k] + d * w.particle[i] + axis];
+      u[f] = value;
+      continue;
+    }
+    const Eigen::Matrix<double, d, 1> r = x - world.template get<RigidBody<d>>(setup.bodies[body])->x;
     double w = v[body * ndof + axis];
     if constexpr (d == 2) {
       w += (axis == 0 ? -r.y() : r.x()) * v[body * ndof + 2];
@@ -322,13 +510,30 @@ void FluidStructureProjection<d>::run(World<d>& world, StepContext& ctx) {
   out.set("fsi_energy_change", report.kineticEnergyAfter - report.kineticEnergyBefore);
   out.set("fsi_coupling_faces", setup.coupling.constraintCount());
   static const char* axes[3] = {"_x", "_y", "_z"};
+  if (setup.coupling.dampingRows > 0) out.set("fsi_damping_work", report.dampingWork);
+  for (std::size_t k = 0; k < setup.deformables.size(); ++k) {
+    // The fluid's force on a deformable body: the sum of -J^T W^T lambda over its particles.
+    const std::string prefix = "fsi_" + world.name(setup.deformables[k]);
+    const int off = setup.deformableOffset[k];
+    const int n = world.template get<Particles<d>>(setup.deformables[k])->count();
+    for (int a = 0; a < d; ++a) {
+      double force = 0;
+      for (int i = 0; i < n; ++i) force -= report.structureImpulse[off + d * i + a];
+      out.set(prefix + "_force" + axes[a], force / ctx.dt);
+    }
+    const int track = world.template get<FluidCoupling<d>>(setup.deformables[k])->trackParticle;
+    if (track >= 0 && track < n)
+      for (int a = 0; a < d; ++a)
+        out.set(prefix + "_track" + axes[a], world.template get<Particles<d>>(setup.deformables[k])->x[d * track + a]);
+  }
   for (std::size_t b = 0; b < setup.bodies.size(); ++b) {
     const std::string prefix = "fsi_" + world.name(setup.bodies[b]);
     const int off = static_cast<int>(b) * ndof;
-    const Eigen::VectorXd& v = setup.coupling.velocity;
     // The fluid's impulse on the body is -J^T W^T lambda (eq. 5.11).
     const Eigen::VectorXd force = -report.structureImpulse.segment(off, ndof) / ctx.dt;
+    const Eigen::Matrix<double, d, 1> x = world.template get<RigidBody<d>>(setup.bodies[b])->x;
     for (int a = 0; a < d; ++a) {
+      out.set(prefix + "_position" + axes[a], x[a]);
       out.set(prefix + "_velocity" + axes[a], v[off + a]);
       out.set(prefix + "_force" + axes[a], force[a]);
     }
@@ -354,7 +559,12 @@ double FluidStructureProjection<d>::unitCflDt(const World<d>& world) const {
   for (Entity e : couplings->entities()) {
     const RigidBody<d>* body = world.template get<RigidBody<d>>(e);
     const Shape<d>* shape = world.template get<Shape<d>>(e);
-    if (!body) continue;
+    if (!body) {
+      if (const Particles<d>* p = world.template get<Particles<d>>(e))
+        for (int i = 0; i < p->count(); ++i)
+          speed = std::max(speed, Eigen::Map<const Eigen::Matrix<double, d, 1>>(&p->v[d * i]).norm());
+      continue;
+    }
     double reach = 0;
     if (shape) reach = ObstacleGeometry<d>(shape, world.template get<LevelSet<d>>(e), *body).boundingRadius();
     speed = std::max(speed, body->v.norm() + body->omega().norm() * reach);
@@ -362,8 +572,10 @@ double FluidStructureProjection<d>::unitCflDt(const World<d>& world) const {
   return speed > 0 ? dx / speed : std::numeric_limits<double>::infinity();
 }
 
-template RigidCouplingSetup<2> buildRigidCoupling<2>(const World<2>&, const MacGrid<2>&, bool);
-template RigidCouplingSetup<3> buildRigidCoupling<3>(const World<3>&, const MacGrid<3>&, bool);
+template StructureCouplingSetup<2> buildStructureCoupling<2>(const World<2>&, const MacGrid<2>&, bool, double,
+                                                              ForceModelCache<2>&);
+template StructureCouplingSetup<3> buildStructureCoupling<3>(const World<3>&, const MacGrid<3>&, bool, double,
+                                                              ForceModelCache<3>&);
 template class FsiHalfStep<2>;
 template class FsiHalfStep<3>;
 template class FluidStructureProjection<2>;

@@ -25,12 +25,15 @@ FsiOperator<d>::FsiOperator(const FluidOperators<d>& ops, const StructureCouplin
       np_(ops.pressureCount()),
       nr_(ops.viscousCount()),
       nc_(coupling.constraintCount()),
+      nd_(coupling.dampingRows),
       JT_(coupling.J.transpose()),
       faces_(ops.velocityCount()),
       structure_(coupling.structureCount()) {
   if (coupling.J.rows() != nc_ || coupling.J.cols() != coupling.structureCount() ||
       coupling.massInverse.rows() != coupling.structureCount() || coupling.massInverse.cols() != coupling.structureCount())
     throw std::invalid_argument("FsiOperator: J must be constraints x structure dofs and M^-1 square");
+  if (nd_ > 0 && (!coupling.damping || !coupling.dampingTranspose))
+    throw std::invalid_argument("FsiOperator: damping rows without the damping operator C");
   for (int v : coupling.constrainedVelocities)
     if (v < 0 || v >= ops.velocityCount() || ops.openFraction[v] != 1.0)
       throw std::invalid_argument("FsiOperator: a coupling face must be a whole (uncut) velocity unknown");
@@ -40,7 +43,7 @@ template <int d>
 void FsiOperator<d>::velocityChange(const Eigen::VectorXd& z, Eigen::VectorXd& fluid, Eigen::VectorXd& structure) const {
   const FluidOperators<d>& ops = *ops_;
   const auto p = z.head(np_);
-  const auto lambda = z.tail(nc_);
+  const auto lambda = z.segment(np_ + nr_, nc_);
   fluid.resize(ops.velocityCount());
   applyGradient(ops, p, fluid);
   if (nr_ > 0) {
@@ -51,7 +54,13 @@ void FsiOperator<d>::velocityChange(const Eigen::VectorXd& z, Eigen::VectorXd& f
   const double* binv = ops.faceBetaInv.data();
   parallel::forRows(ops.velocityCount(), [&](int v) { fluid[v] *= binv[v]; });
   for (int k = 0; k < nc_; ++k) fluid[coupling_->constrainedVelocities[k]] -= ops.betaInv * lambda[k];
-  structure = coupling_->massInverse * (JT_ * lambda);
+  Eigen::VectorXd impulse = JT_ * lambda;
+  if (nd_ > 0) {
+    Eigen::VectorXd ct;
+    coupling_->dampingTranspose(z.tail(nd_), ct);
+    impulse += ct;
+  }
+  structure = coupling_->massInverse * impulse;
 }
 
 template <int d>
@@ -65,8 +74,13 @@ void FsiOperator<d>::apply(const Eigen::VectorXd& z, Eigen::VectorXd& out) const
     out.segment(np_, nr_) += z.segment(np_, nr_);
   }
   if (nc_ > 0) {
-    out.tail(nc_) = coupling_->J * structure_;
+    out.segment(np_ + nr_, nc_) = coupling_->J * structure_;
     for (int k = 0; k < nc_; ++k) out[np_ + nr_ + k] -= faces_[coupling_->constrainedVelocities[k]];
+  }
+  if (nd_ > 0) {  // C (B^-1 K^T z)_structure + v_hat
+    Eigen::VectorXd y;
+    coupling_->damping(structure_, y);
+    out.tail(nd_) = y + z.tail(nd_);
   }
 }
 
@@ -81,8 +95,13 @@ Eigen::VectorXd FsiOperator<d>::rightHandSide(const Eigen::VectorXd& uStar, cons
     rhs.segment(np_, nr_) += ops.viscousKnown;
   }
   if (nc_ > 0) {
-    rhs.tail(nc_) = coupling_->J * vStar;
+    rhs.segment(np_ + nr_, nc_) = coupling_->J * vStar;
     for (int k = 0; k < nc_; ++k) rhs[np_ + nr_ + k] -= uStar[coupling_->constrainedVelocities[k]];
+  }
+  if (nd_ > 0) {
+    Eigen::VectorXd y;
+    coupling_->damping(vStar, y);
+    rhs.tail(nd_) = y;
   }
   return rhs;
 }
@@ -173,13 +192,15 @@ void FsiPreconditioner<d>::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) c
     z = r;
     return;
   }
+  const int nd = static_cast<int>(r.size()) - nf_ - nc_;  // damping rows: identity
+  if (nd > 0) z.tail(nd) = r.tail(nd);
   if (kind_ == FsiPreconditionerKind::Schur) {
     const FluidOperators<d>& ops = *ops_;
     const int np = ops.pressureCount(), nr = ops.viscousCount();
     const auto& W = coupling_->constrainedVelocities;
     Eigen::VectorXd y, faces = Eigen::VectorXd::Zero(ops.velocityCount());
     // r_F - A_Fl C^-1 r_l, with A_Fl y = K_F q, q = -beta^-1 W^T y.
-    applyConstraintInverse(r.tail(nc_), y);
+    applyConstraintInverse(r.segment(nf_, nc_), y);
     for (int k = 0; k < nc_; ++k) faces[W[k]] = -b_ * y[k];
     rf_ = r.head(nf_);
     Eigen::VectorXd kq(nf_);
@@ -198,10 +219,10 @@ void FsiPreconditioner<d>::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) c
       applyViscousGradientTranspose(ops, z.segment(np, nr), visc);
       faces += visc;
     }
-    Eigen::VectorXd rl = r.tail(nc_);
+    Eigen::VectorXd rl = r.segment(nf_, nc_);
     for (int k = 0; k < nc_; ++k) rl[k] += b_ * faces[W[k]];
     applyConstraintInverse(rl, y);
-    z.tail(nc_) = y;
+    z.segment(nf_, nc_) = y;
     return;
   }
   rf_ = r.head(nf_);
@@ -209,14 +230,14 @@ void FsiPreconditioner<d>::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) c
   fluid_->apply(rf_, zf_);
   z.head(nf_) = zf_;
   if (nc_ == 0) return;
-  const Eigen::VectorXd rc = r.tail(nc_);
+  const Eigen::VectorXd rc = r.segment(nf_, nc_);
   if (kind_ == FsiPreconditionerKind::BlockJacobi) {
-    z.tail(nc_) = rc.cwiseProduct(constraintInverse_);
+    z.segment(nf_, nc_) = rc.cwiseProduct(constraintInverse_);
     return;
   }
   Eigen::VectorXd y;
   applyConstraintInverse(rc, y);
-  z.tail(nc_) = y;
+  z.segment(nf_, nc_) = y;
 }
 
 template <int d>
@@ -256,7 +277,8 @@ FsiReport fsiProjection(const FluidOperators<d>& ops, StructureCoupling& couplin
   writeVelocities(ops, u, faceVelocities);
   report.kineticEnergyAfter = kineticEnergy(ops, coupling, u, coupling.velocity);
   const int np = ops.pressureCount(), nc = coupling.constraintCount();
-  report.lambda = z.tail(nc);
+  report.lambda = z.segment(np + ops.viscousCount(), nc);
+  if (coupling.dampingRows > 0) report.dampingWork = z.tail(coupling.dampingRows).squaredNorm();
   report.structureImpulse = coupling.J.transpose() * report.lambda;
   report.pressure = Eigen::VectorXd::Zero(ops.domain.layout.cellCount());
   for (int i = 0; i < np; ++i) report.pressure[ops.dofs.pressureToCell[i]] = z[i] / ops.params.dt;

@@ -3,14 +3,15 @@
 //
 //     (K B^-1 K^T + P) z = K w,    w^{n+1} = w - B^-1 K^T z,
 //
-// with w = (u*, v*), B = diag(beta, M), z = (p_hat, u_hat, lambda) and
-//     K = [[G^T, 0], [G_mu, 0], [-W, W J]],   P = diag(0, I, 0)
-// (rigid structures have no internal damping, so the thesis's C rows and v_hat are absent; a
-// damped structure adds them as further rows of K and P without changing the rest). Written out:
+// with w = (u*, v*), B = diag(beta, M), z = (p_hat, u_hat, lambda, v_hat) and
+//     K = [[G^T, 0], [G_mu, 0], [-W, W J], [0, C]],   P = diag(0, I, 0, I)
+// (C: the structure's factored damping, C^T C = -dt D, Sec. 5.5.1; rigid bodies have none, and
+// then v_hat is empty). Written out:
 //     u^{n+1} = u* - beta^-1 (G p_hat + G_mu^T u_hat - W^T lambda)      (eq. 5.8 with viscosity)
-//     v^{n+1} = v* - M^-1 J^T W^T lambda                                  (eq. 5.11)
+//     v^{n+1} = v* - M^-1 (J^T W^T lambda + C^T v_hat)                    (eq. 5.11 with damping)
 // and the rows of the system are G^T u^{n+1} = g (incompressibility), u_hat = G_mu u^{n+1} + h
-// (viscous stresses) and W u^{n+1} = W J v^{n+1} (the coupling constraint, eq. 5.12). With W = 0
+// (viscous stresses), W u^{n+1} = W J v^{n+1} (the coupling constraint, eq. 5.12) and
+// v_hat = C v^{n+1} (backward-Euler damping: M v^{n+1} = M v* + dt D v^{n+1} - ...). With W = 0
 // it is the fluid's (5.31) (spd_systems.h). The right-hand side carries the known boundary terms
 // (g, h) as (5.31) does.
 //
@@ -20,6 +21,7 @@
 //
 // Preconditioners (FsiPreconditionerKind):
 //  * None: plain CG;
+//  Every variant below is the identity on the damping block I + C M^-1 C^T (v_hat).
 //  * BlockJacobi: the fluid's block preconditioner (coupled_preconditioner.h) on (p_hat, u_hat)
 //    and the diagonal of W (beta^-1 + J M^-1 J^T) W^T on lambda;
 //  * BlockExact: the same fluid blocks and the exact inverse of the lambda block,
@@ -64,7 +66,7 @@ class FsiOperator {
   // Keeps references; both must outlive it. The coupling faces must be free velocity unknowns
   // without cut (staircase faces).
   FsiOperator(const FluidOperators<d>& ops, const StructureCoupling& coupling);
-  int size() const { return np_ + nr_ + nc_; }
+  int size() const { return np_ + nr_ + nc_ + nd_; }
   void apply(const Eigen::VectorXd& z, Eigen::VectorXd& out) const;
   // B^-1 K^T z: the fluid part (per velocity unknown) and the structure part.
   void velocityChange(const Eigen::VectorXd& z, Eigen::VectorXd& fluid, Eigen::VectorXd& structure) const;
@@ -77,7 +79,7 @@ class FsiOperator {
  private:
   const FluidOperators<d>* ops_;
   const StructureCoupling* coupling_;
-  int np_, nr_, nc_;
+  int np_, nr_, nc_, nd_;
   SparseMatrixR JT_;  // J^T
   mutable Eigen::VectorXd faces_, structure_;
 };
@@ -116,6 +118,7 @@ struct FsiReport {
   Eigen::VectorXd pressure;     // p = p_hat / dt per cell
   Eigen::VectorXd lambda;       // coupling impulses
   Eigen::VectorXd structureImpulse;  // J^T W^T lambda: minus the fluid's impulse on the structure dofs
+  double dampingWork = 0;            // |v_hat|^2 = -dt v^T D v: energy the damping took (>= 0)
   double kineticEnergyBefore = 0;    // 1/2 u*^T beta u* + 1/2 v*^T M v* (velocity unknowns only)
   double kineticEnergyAfter = 0;
 };

@@ -26,6 +26,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <functional>
 #include <vector>
 
 namespace monolith::solvers {
@@ -37,6 +38,12 @@ struct StructureCoupling {
   SparseMatrixR massInverse;                // M^{-1}
   SparseMatrixR mass;                       // M (kinetic energy of the structure)
   Eigen::VectorXd velocity;                 // v* on input to a solve, v^{n+1} after it
+  // C, the structure's factored damping over the solve's dt (Sec. 5.5.1: C^T C = -dt D, rows of
+  // K = [0, C] in (5.30)); dampingRows == 0: undamped (rigid bodies). Both act on whole
+  // structure vectors: y = C v (dampingRows entries) and f = C^T y (structureCount entries).
+  int dampingRows = 0;
+  std::function<void(const Eigen::VectorXd& v, Eigen::VectorXd& y)> damping;
+  std::function<void(const Eigen::VectorXd& y, Eigen::VectorXd& f)> dampingTranspose;
 
   int constraintCount() const { return static_cast<int>(constrainedVelocities.size()); }
   int structureCount() const { return static_cast<int>(velocity.size()); }

@@ -9,13 +9,25 @@
 //                                   iterations of the coupled solve per step for the four
 //                                   preconditioners (none, block_jacobi, block_exact, schur) against
 //                                   resolution (falling_cylinder, first 5 steps)
+//   bench_fsi sphere [cells=16,24,32]
+//                                   falling_sphere (3-D): terminal velocity against Stokes' law
+//                                   with the Haberman-Sayre wall correction, -0.02880 m/s
+//   bench_fsi beam [finest=128] [reference=256]
+//                                   beam (Sec. 5.11.5): top-right particle at t = 1 s against the
+//                                   reference grid, observed order
+//   bench_fsi disk [cells=64]       oscillating_disk (Sec. 5.11.6): energies over time, the
+//                                   elastic energy's extrema (the oscillation)
+//   bench_fsi vortex [end=120]      vortex_shedding_spring: the spring-mounted cylinder's
+//                                   cross-stream amplitude and frequency over the last half
 // Every row prints the wall time of its run.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scenarios/simulation.h"
@@ -38,14 +50,17 @@ struct Run {
   double maxEnergyChange = -1e300;
 };
 
-Run runScene(const Registry& registry, const std::string& scene, const std::vector<Override>& overrides, long maxSteps = -1) {
+template <int d = 2>
+Run runScene(const Registry& registry, const std::string& scene, const std::vector<Override>& overrides, long maxSteps = -1,
+             std::vector<std::map<std::string, double>>* history = nullptr) {
   const SceneSpec spec = loadScene(std::string(MONOLITH_SOURCE_DIR) + "/scenarios/scenes/" + scene, overrides);
-  Simulation<2> sim(spec, registry, 2);
+  Simulation<d> sim(spec, registry, 2);
   Run r;
   const auto t0 = std::chrono::steady_clock::now();
   double iterations = 0;
   while (!sim.finished() && (maxSteps < 0 || r.steps < maxSteps)) {
     r.last = sim.step();
+    if (history) history->push_back(r.last);
     ++r.steps;
     const double it = r.last.count("fsi_solver_iterations") ? r.last.at("fsi_solver_iterations") : 0;
     iterations += it;
@@ -146,6 +161,87 @@ void preconditioners(const Registry& registry, int finest, double mu) {
     }
 }
 
+
+void sphere(const Registry& registry, const std::vector<int>& cells) {
+  const double exact = -0.02880;  // Stokes 0.05701 m/s times Haberman-Sayre 0.5052 (lambda = 0.25)
+  std::printf("| cells | radius in cells | steps | wall s | v terminal | error |\n|---|---|---|---|---|---|\n");
+  for (int n : cells) {
+    const std::string c = "[" + std::to_string(n) + "," + std::to_string(n) + "," + std::to_string(2 * n) + "]";
+    const Run r = runScene<3>(registry, "falling_sphere.json", {{"entities.fluid.mac_grid.cells", c}});
+    const double v = r.last.at("fsi_sphere_velocity_z");
+    std::printf("| %dx%dx%d | %.1f | %ld | %.1f | %.6f | %.1f %% |\n", n, n, 2 * n, 0.002 / (0.016 / n), r.steps, r.seconds, v,
+                100 * std::abs(v - exact) / std::abs(exact));
+    std::fflush(stdout);
+  }
+}
+
+void beam(const Registry& registry, int finest, int reference) {
+  auto tip = [&](int n, Run& r) {
+    r = runScene(registry, "beam.json", {{"entities.fluid.mac_grid.cells", "[" + std::to_string(n) + "," + std::to_string(n / 2) + "]"}});
+    return std::make_pair(r.last.at("fsi_beam_track_x"), r.last.at("fsi_beam_track_y"));
+  };
+  Run ref;
+  const auto x = tip(reference, ref);
+  std::printf("reference %dx%d: (%.6f, %.6f), %.1f s, mean its %.1f\n", reference, reference / 2, x.first, x.second,
+              ref.seconds, ref.meanIterations);
+  std::printf("| cells | wall s | x | y | distance to reference | order | mean its |\n|---|---|---|---|---|---|---|\n");
+  double previous = -1;
+  for (int n = 32; n <= finest; n *= 2) {
+    Run r;
+    const auto p = tip(n, r);
+    const double e = std::hypot(p.first - x.first, p.second - x.second);
+    std::printf("| %dx%d | %.1f | %.6f | %.6f | %.3e | %s | %.1f |\n", n, n / 2, r.seconds, p.first, p.second, e,
+                previous > 0 ? num(std::log2(previous / e)).substr(0, 5).c_str() : "", r.meanIterations);
+    std::fflush(stdout);
+    previous = e;
+  }
+}
+
+void disk(const Registry& registry, int n) {
+  std::vector<std::map<std::string, double>> h;
+  const Run r = runScene(registry, "oscillating_disk.json",
+                         {{"entities.fluid.mac_grid.cells", "[" + std::to_string(n) + "," + std::to_string(n) + "]"}}, -1, &h);
+  std::printf("%dx%d: %ld steps, %.1f s wall, mean its %.1f, max solve energy change %.3e\n", n, n, r.steps, r.seconds,
+              r.meanIterations, r.maxEnergyChange);
+  for (std::size_t i = 1; i + 1 < h.size(); ++i) {
+    const double e0 = h[i - 1].at("deformable_elastic_energy"), e = h[i].at("deformable_elastic_energy"),
+                 e1 = h[i + 1].at("deformable_elastic_energy");
+    if ((e > e0 && e >= e1) || (e < e0 && e <= e1))
+      std::printf("elastic %s at t = %.3f: %.4e J\n", e > e0 ? "max" : "min", h[i].at("time"), e);
+  }
+  std::printf("total energy %.6e -> %.6e J\n", h.front().at("total_energy"), h.back().at("total_energy"));
+}
+
+void vortex(const Registry& registry, double end) {
+  std::vector<std::map<std::string, double>> h;
+  const Run r = runScene(registry, "vortex_shedding_spring.json", {{"time.end", num(end)}}, -1, &h);
+  // Over the second half: mean, half the peak-to-peak of y, and the frequency from the upward
+  // crossings of the mean (linear interpolation between steps).
+  std::vector<double> t, y;
+  for (const auto& m : h)
+    if (m.at("time") >= 0.5 * end) {
+      t.push_back(m.at("time"));
+      y.push_back(m.at("fsi_cylinder_position_y"));
+    }
+  double mean = 0, lo = 1e300, hi = -1e300, xmean = 0;
+  for (double v : y) {
+    mean += v / y.size();
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  for (const auto& m : h)
+    if (m.at("time") >= 0.5 * end) xmean += m.at("fsi_cylinder_position_x") / y.size();
+  std::vector<double> up;
+  for (std::size_t i = 1; i < y.size(); ++i)
+    if (y[i - 1] < mean && y[i] >= mean) up.push_back(t[i - 1] + (mean - y[i - 1]) / (y[i] - y[i - 1]) * (t[i] - t[i - 1]));
+  const double f = up.size() > 1 ? (up.size() - 1) / (up.back() - up.front()) : 0.0;
+  std::printf("%ld steps, %.1f s wall, mean its %.1f, max solve energy change %.3e\n", r.steps, r.seconds, r.meanIterations,
+              r.maxEnergyChange);
+  std::printf("t in [%.1f, %.1f]: mean x %.4f, mean y %.4f, amplitude (half peak-to-peak of y) %.4f D, frequency %.4f Hz "
+              "(%zu upward crossings)\n",
+              0.5 * end, end, xmean, mean, 0.5 * (hi - lo), f, up.size());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -159,8 +255,15 @@ int main(int argc, char** argv) {
     cylinder(registry, argc > 2 ? std::atoi(argv[2]) : 80, mus, argc > 4 ? std::atof(argv[4]) : 1.0,
              !(argc > 5 && std::string(argv[5]) == "no_stokes"));
   } else if (mode == "precond") preconditioners(registry, argc > 2 ? std::atoi(argv[2]) : 160, argc > 3 ? std::atof(argv[3]) : 0.1);
+  else if (mode == "sphere") {
+    std::vector<int> cells;
+    for (int i = 2; i < argc; ++i) cells.push_back(std::atoi(argv[i]));
+    sphere(registry, cells.empty() ? std::vector<int>{16, 24, 32} : cells);
+  } else if (mode == "beam") beam(registry, argc > 2 ? std::atoi(argv[2]) : 128, argc > 3 ? std::atoi(argv[3]) : 256);
+  else if (mode == "disk") disk(registry, argc > 2 ? std::atoi(argv[2]) : 64);
+  else if (mode == "vortex") vortex(registry, argc > 2 ? std::atof(argv[2]) : 120.0);
   else {
-    std::fprintf(stderr, "usage: bench_fsi channel|cylinder|precond [finest] ...\n");
+    std::fprintf(stderr, "usage: bench_fsi channel|cylinder|precond|sphere|beam|disk|vortex [finest] ...\n");
     return 2;
   }
   return 0;
