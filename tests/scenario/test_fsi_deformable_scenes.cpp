@@ -85,8 +85,11 @@ TEST(FsiBeam, FlowBendsTheBeam) {
   EXPECT_LT(m.at("fsi_beam_track_y"), 0.5);
   EXPECT_GT(drag, 0.0);  // the flow's impulse on the beam points downstream
   const Particles<2>& p = sim.world().pool<Particles<2>>().components()[0];
-  for (int i = 0; i < p.count(); ++i)
-    if (p.fixed[i]) EXPECT_EQ(p.x[2 * i + 1], start.x[2 * i + 1]);
+  for (int i = 0; i < p.count(); ++i) {
+    if (p.fixed[i]) {
+      EXPECT_EQ(p.x[2 * i + 1], start.x[2 * i + 1]);
+    }
+  }
 }
 
 // Sec. 5.8: a fluid grid 30x coarser than the structure's elements. A disk of radius 0.2 in a
