@@ -1,6 +1,6 @@
 #pragma once
 // Sleep<d>: whether a dynamic collider body is asleep (not in the thesis; what Box2D and Bullet
-// call deactivation, issue 3). Present only when the scene sets "solvers": {"contact": {"sleep":
+// call deactivation). Present only when the scene sets "solvers": {"contact": {"sleep":
 // true}}; systems/sleep.h says when a body falls asleep and what wakes it. While asleep a body
 // is held still: the velocity stages skip it and the contact stages treat it as a body of
 // infinite mass at rest, so a settled pile costs a broad phase and nothing else.

@@ -1,5 +1,5 @@
 #pragma once
-// Scene parsers of the geometry and contact components (shape, collider, kinematic) of issue 3.
+// Scene parsers of the geometry and contact components (shape, collider, kinematic).
 #include <string>
 #include <vector>
 

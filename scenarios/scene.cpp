@@ -446,7 +446,7 @@ void parseFluidSolverSettings(const Config& c, FluidSolverSettings& f) {
   c.finish();
 }
 
-// "solvers": {"contact": {...}}: iteration counts and switches of issue 3 (world.h).
+// "solvers": {"contact": {...}}: iteration counts and switches of the contact stages (world.h).
 void parseContactSettings(const Config& c, ContactSettings& s) {
   auto count = [&](const char* key, int& value, int min) {
     value = static_cast<int>(c.integer(key, value, min, 100000));

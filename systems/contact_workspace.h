@@ -1,5 +1,5 @@
 #pragma once
-// The state the rigid collision/contact systems share within one time step (issue 3): the
+// The state the rigid collision/contact systems share within one time step: the
 // colliding bodies packed in pool order, the candidate poses the pair tests use, the pairs found
 // by the broad phase, which of them collisions processed (Step II) and contact touched
 // (Step III), the contact-graph levels and the islands. Nothing in it survives a step except

@@ -1,5 +1,5 @@
 #pragma once
-// Kinematic bodies (issue 3): scripted velocity from the scene, infinite mass in collisions and
+// Kinematic bodies: scripted velocity from the scene, infinite mass in collisions and
 // contact. The velocity of step n is the script's value at t^{n+1/2} (exact for piecewise
 // constant scripts whose breaks fall on step boundaries), set before Step II; the pose is
 // advanced with it in Step IV.

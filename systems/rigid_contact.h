@@ -1,5 +1,5 @@
 #pragma once
-// The rigid collision and contact stages of the Newmark step (thesis Sec. 4.2, issue 3), one
+// The rigid collision and contact stages of the Newmark step (thesis Sec. 4.2), one
 // system per stage, sharing one ContactWorkspace per step:
 //   collisions               Step II  (Sec. 4.4): v^n -> \hat v^n, pairwise Gauss-Seidel, restitution
 //                                     and friction, energy clamp against (x^n, v^n); then

@@ -1,5 +1,5 @@
 // A Monolith rigid-body scene file run in Bullet (Debian's libbullet-dev: single precision, its
-// default sequential-impulse solver), to measure the "popular engine" issue 3 sets its speed goal
+// default sequential-impulse solver), to measure the "popular engine" the contact speed goal is set
 // against on the same machine and the same scene instead of quoting a figure.
 //
 // What carries over from the scene: gravity, dt and end time, and each entity's shape (sphere,
@@ -25,7 +25,7 @@
 // the state the step before produced; sizes as Monolith measures them,
 // solvers/collision/geometry.h) — the columns of bench_rigid_contact's tables — and the
 // largest rise of the total energy (kinetic + gravity's potential) over its initial value after
-// any step, relative to that value (issue 3's rule: at most 0.1 %).
+// any step, relative to that value (the project's rule: at most 0.1 %).
 //
 // usage: compare_bullet SCENE.json [--dt 1/60|SECONDS] [--end SECONDS] [--iterations N] [--sleep] [--ccd]
 //   --ccd: Bullet's continuous collision detection on every dynamic body (off by default, as in

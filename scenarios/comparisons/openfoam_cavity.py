@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Lid-driven cavity in OpenFOAM on the grid `bench_cavity` uses: the finite-volume comparison of
-issue 4 ("report wall time to reach steady state; we will hold it against a widely used
+the fluid requirements ("report wall time to reach steady state; we will hold it against a widely used
 finite-volume code on the same grid").
 
 Writes an OpenFOAM case (unit square, lid speed 1, nu = 1/Re, N x N x 1 cells, the same step

@@ -143,7 +143,7 @@ inline SceneTime sceneTime(const json& root, const CommonOptions& o) {
 
 inline std::string fileName(const std::string& path) { return path.substr(path.find_last_of('/') + 1); }
 
-// The largest rise of the total energy over its initial value: relative (issue 3's rule), or in
+// The largest rise of the total energy over its initial value: relative (the project's 0.1 % rule), or in
 // joules when the initial total is zero (a scene whose bodies start at rest at height 0).
 inline std::string energyRise(double highest, double initial) {
   char text[64];

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the generated rigid-contact scenes of issue 3 (plain Python, no modules needed).
+"""Writes the generated rigid-contact scenes (plain Python, no modules needed).
 
     python3 scenarios/scenes/generate_contact_scenes.py [output_dir] [--pour N ...] [--random SEED ...]
         [--random-2d SEED ...]

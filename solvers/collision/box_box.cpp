@@ -1,4 +1,4 @@
-// Box-box narrow phase (issue 3): separating axes, then face clipping or the edge-edge point,
+// Box-box narrow phase: separating axes, then face clipping or the edge-edge point,
 // and the nearest points of boxes apart by less than the contact margin. Same contracts as FCL's
 // dBoxBox and fcl::distance, which they replace for box pairs (narrow_phase_3d.cpp). In a box
 // pyramid every pair is a box pair, queried ~56 times per step; FCL's general machinery (request

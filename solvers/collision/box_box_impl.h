@@ -1,5 +1,5 @@
 #pragma once
-// Private to solvers/collision: the dedicated box-box narrow phase (issue 3), used instead of
+// Private to solvers/collision: the dedicated box-box narrow phase, used instead of
 // FCL's dBoxBox for box pairs. In a box pyramid every pair is a box pair and the contact stages
 // ask for its manifold ~56 times per pair and step, so this is one of the hot paths.
 #include <vector>

@@ -1,4 +1,4 @@
-// Broad phase (issue 3): pairs of overlapping world boxes, by sweep and prune or by FCL's dynamic
+// Broad phase: pairs of overlapping world boxes, by sweep and prune or by FCL's dynamic
 // AABB tree. Both report exactly the pairs of closed boxes that overlap (every candidate is
 // re-checked on the caller's boxes), sorted, so they agree with each other and with brute force.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// Broad phase (issue 3): candidate pairs of overlapping world bounding boxes.
+// Broad phase: candidate pairs of overlapping world bounding boxes.
 #include <utility>
 #include <vector>
 

@@ -1,4 +1,4 @@
-// A capsule against a polytope (box or convex hull) in closed form (issue 3): the pair's
+// A capsule against a polytope (box or convex hull) in closed form: the pair's
 // penetration depth and its axis exactly, where the general route takes FCL's MPR contact and
 // tilts its axis by a local search (contact_axis.cpp) that stops on a budget.
 //

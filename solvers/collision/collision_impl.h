@@ -1,5 +1,5 @@
 #pragma once
-// Private to solvers/collision (issue 3): what PreparedGeometry keeps besides the user's Geometry,
+// Private to solvers/collision: what PreparedGeometry keeps besides the user's Geometry,
 // and the small geometric queries both narrow phases share. Not part of the public API.
 #include <algorithm>
 #include <array>

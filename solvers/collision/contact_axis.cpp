@@ -1,4 +1,4 @@
-// Contacts on an axis (issue 3), without FCL: given an axis between two convex shapes (FCL's,
+// Contacts on an axis, without FCL: given an axis between two convex shapes (FCL's,
 // a face normal, the nearest points' direction), the depth is the overlap of the shapes'
 // projections on it (exact along the axis: the distance A must move along it to separate), the
 // normal takes the sign of least overlap, and the point lies midway between the touching

@@ -1,5 +1,5 @@
 #pragma once
-// Private to solvers/collision: contacts on an axis between two convex shapes (issue 3), without
+// Private to solvers/collision: contacts on an axis between two convex shapes, without
 // FCL. Used to turn FCL's approximate contacts into exact ones along a chosen axis.
 #include <vector>
 

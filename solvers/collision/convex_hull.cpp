@@ -1,4 +1,4 @@
-// Convex hulls for the Convex geometry type (issue 3): the user gives vertices in any order, the
+// Convex hulls for the Convex geometry type: the user gives vertices in any order, the
 // narrow phase needs the hull's vertices and faces. Inputs are small (up to a few hundred points),
 // so simple O(n^2) algorithms are used; both visit points in a fixed order, so equal inputs give
 // equal hulls.

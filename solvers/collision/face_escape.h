@@ -1,5 +1,5 @@
 #pragma once
-// A way out of a box through one of its faces, for push-out (issue 3). The narrow phase reports
+// A way out of a box through one of its faces, for push-out. The narrow phase reports
 // the direction of least penetration; when a box lies on another static body (a wall standing on
 // the ground plane, its bottom face on the plane), that direction can lead straight into the
 // other body, and no push satisfies both. This finds the least push through a face that does

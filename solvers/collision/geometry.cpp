@@ -1,4 +1,4 @@
-// PreparedGeometry (issue 3): validates a Geometry once and keeps what the narrow phase needs,
+// PreparedGeometry: validates a Geometry once and keeps what the narrow phase needs,
 // the polytope form (box corners, convex hull vertices and face planes) and FCL's copy of the
 // shape, so that no query rebuilds anything.
 #include <fcl/geometry/bvh/BVH_model.h>

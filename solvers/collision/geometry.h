@@ -1,5 +1,5 @@
 #pragma once
-// Collision geometry, entity-free (issue 3). A Geometry<d> is a shape in its body frame; a
+// Collision geometry, entity-free. A Geometry<d> is a shape in its body frame; a
 // Pose<d> places it in the world. The narrow phase (narrow_phase.h) turns two posed geometries
 // into contact points; the broad phase (broad_phase.h) turns world bounding boxes into candidate
 // pairs.

@@ -1,5 +1,5 @@
 #pragma once
-// Static boxes standing on a static half-space or on another static box (issue 3; not in the
+// Static boxes standing on a static half-space or on another static box (not in the
 // thesis). The narrow phase pushes a body out of a box along the direction of least
 // penetration. For a wall standing on the ground plane that can be the wall's bottom face: a
 // small body at the wall's foot that pokes further into the wall sideways than it sticks up out

@@ -1,4 +1,4 @@
-// Narrow phase entry points (issue 3): 2-D goes to the exact routines of narrow_phase_2d.cpp,
+// Narrow phase entry points: 2-D goes to the exact routines of narrow_phase_2d.cpp,
 // 3-D to narrow_phase_3d.cpp (FCL plus exact pairs).
 #include "solvers/collision/narrow_phase.h"
 

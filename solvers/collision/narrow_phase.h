@@ -1,5 +1,5 @@
 #pragma once
-// Narrow phase (issue 3): contact points between two posed geometries.
+// Narrow phase: contact points between two posed geometries.
 // 3-D pairs go through FCL (with libccd for general convex pairs); 2-D pairs use exact 2-D
 // routines (see narrow_phase_2d.cpp). For face contacts the result is a manifold of several
 // points (box resting on a box or plane: its corners / the clipped face polygon), so that a

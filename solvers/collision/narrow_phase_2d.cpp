@@ -1,4 +1,4 @@
-// 2-D narrow phase (issue 3): exact routines, no FCL.
+// 2-D narrow phase: exact routines, no FCL.
 // Disk pairs and half-plane pairs: the feature points (disk centre with its radius, polygon
 // vertices) against the other shape's exact signed distance (shape_queries.cpp). Polygon pairs:
 // the separating axis of least penetration (SAT) picks a reference edge, the other polygon's

@@ -1,4 +1,4 @@
-// 3-D narrow phase (issue 3): which pairs are exact and which go through FCL, and how FCL's
+// 3-D narrow phase: which pairs are exact and which go through FCL, and how FCL's
 // single contact point becomes a manifold.
 //
 // Exact (no FCL): every pair with a half-space (the feature points of the other shape: box and

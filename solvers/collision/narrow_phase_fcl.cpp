@@ -1,4 +1,4 @@
-// FCL glue for the 3-D narrow phase (issue 3).
+// FCL glue for the 3-D narrow phase.
 //
 // FCL 0.7's conventions differ between its algorithms (checked against this build, see
 // tests/unit/test_narrow_phase.cpp): Contact::normal points from o1 to o2 for the shape pairs and

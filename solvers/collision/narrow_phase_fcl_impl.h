@@ -1,5 +1,5 @@
 #pragma once
-// Private to solvers/collision: FCL's 3-D narrow phase behind our contact convention (issue 3).
+// Private to solvers/collision: FCL's 3-D narrow phase behind our contact convention.
 #include <vector>
 
 #include "solvers/collision/collision_impl.h"

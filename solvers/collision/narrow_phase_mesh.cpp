@@ -1,4 +1,4 @@
-// A shape against a triangle mesh (issue 3). A mesh has no inside (it is a surface, meant for
+// A shape against a triangle mesh. A mesh has no inside (it is a surface, meant for
 // static ground and walls), so contacts come from the triangles near the shape (triangle_tree.cpp):
 // a sphere gets the exact closest point of each triangle; other shapes get their feature points
 // above each triangle (inside its prism, along its normal), so that a box resting on a mesh keeps

@@ -1,4 +1,4 @@
-// A global starting axis for the penetration depth of two convex shapes (issue 3): libccd's
+// A global starting axis for the penetration depth of two convex shapes: libccd's
 // GJK + EPA on our exact support points.
 //
 // Why: the penetration depth is the least overlap of the two shapes' projections over all axes,

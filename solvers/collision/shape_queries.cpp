@@ -1,4 +1,4 @@
-// Point queries shared by the 2-D and 3-D narrow phases (issue 3): signed distance from a point to
+// Point queries shared by the 2-D and 3-D narrow phases: signed distance from a point to
 // a shape, the shapes' feature points, and the vertex-in-shape contact test built on them (the
 // thesis's "vertices of A inside the level set of B", with exact polytope distances instead of a
 // sampled level set), plus the manifold clean-up every pair goes through.

@@ -1,5 +1,5 @@
 #pragma once
-// First contact along a time step's motion (not in the thesis; issue 3, docs/architecture.md
+// First contact along a time step's motion (not in the thesis; docs/architecture.md
 // "Swept collisions"). Step II tests pairs at the candidate poses x^n + dt v only (GBF 2003):
 // a body that moves farther than its thickness in one step can be past a thin partner there (a
 // plate dropped at 6 m/s through a 4 cm shelf at dt = 1/30), or so deep inside it that the

@@ -1,4 +1,4 @@
-// Bounding-box tree over a mesh's triangles (issue 3), built once per PreparedGeometry: the mesh
+// Bounding-box tree over a mesh's triangles, built once per PreparedGeometry: the mesh
 // narrow phase asks it for the triangles near a shape before running FCL on each of them. Also
 // finds each triangle's neighbours across its edges.
 // Median splits along the longest axis of the triangle centroids, ties broken by index, so the

@@ -1,5 +1,5 @@
 #pragma once
-// Interpenetration resolution for several bodies at once (issue 3; not in the thesis). The
+// Interpenetration resolution for several bodies at once (not in the thesis). The
 // thesis's push-out (push_out.h, App. B) moves one central body against all the bodies it
 // overlaps, level by level. In a jam -- a body wedged between two others that are themselves
 // pressed against a third or a wall -- each such solve pushes its body into a neighbour the

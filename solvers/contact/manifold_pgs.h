@@ -1,5 +1,5 @@
 #pragma once
-// Projected Gauss-Seidel on one small contact problem (issue 3; docs/architecture.md "One pair
+// Projected Gauss-Seidel on one small contact problem (docs/architecture.md "One pair
 // update"): the points of a pair's manifold, or of one body against its frozen partners in shock
 // propagation, on accumulated impulses (normal >= 0, friction inside the Coulomb disk).
 //

@@ -1,6 +1,6 @@
 #pragma once
 // The exact end of a manifold solve once projected Gauss-Seidel has found which points carry
-// load and which slide (issue 3; docs/architecture.md "One pair update", docs/benchmarks.md
+// load and which slide (docs/architecture.md "One pair update", docs/benchmarks.md
 // "Manifold solves finished exactly" and "Exact finish before the first sweep"). Not in the
 // thesis; scene switch solvers.contact.exact_manifold_finish (off by default).
 //

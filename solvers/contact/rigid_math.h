@@ -1,5 +1,5 @@
 #pragma once
-// Small rigid-body algebra shared by the contact solvers, for d = 2 and 3 (issue 3).
+// Small rigid-body algebra shared by the contact solvers, for d = 2 and 3.
 // In 2-D angular quantities are 1-vectors (about z): r x j is a number and w x r = w (-r_y, r_x).
 #include <Eigen/Core>
 #include <type_traits>

@@ -1,6 +1,6 @@
 #pragma once
 // A fixed sequence of small tasks run on several threads with bitwise the result of running them
-// one after another (issue 3: the Gauss-Seidel sweeps of the contact stages inside one island).
+// one after another (the Gauss-Seidel sweeps of the contact stages inside one island).
 //
 // Each task declares the objects it may change (writes) and those it only looks at (reads).
 // Task k waits for every earlier task that writes an object k touches (read-after-write,

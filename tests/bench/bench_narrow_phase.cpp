@@ -1,4 +1,4 @@
-// Speed of the collision pipeline (issue 3): ns per narrow-phase query for the main shape pairs
+// Speed of the collision pipeline: ns per narrow-phase query for the main shape pairs
 // (each resting/touching, so every query produces contacts; poses jittered by 1e-4 so the loop
 // does not replay one configuration), and us per broad-phase call for N random boxes with both
 // methods.

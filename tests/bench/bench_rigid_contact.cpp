@@ -1,4 +1,4 @@
-// Rigid contact benchmarks (issue 3): speed against error.
+// Rigid contact benchmarks: speed against error.
 //  * pyramid_20 (210 boxes) and pyramid_10 at dt = 1/30 and 1/60 for 10 s, on 1 and 2 threads:
 //    us/step, max drift of any box from its start, final kinetic energy (the issue asks: stand at
 //    1/30 s, drift < 0.05), and whether the 1- and 2-thread states are bitwise equal.
@@ -7,7 +7,7 @@
 //    1- and 2-thread states are bitwise equal.
 //  * mixed_pile (boxes, spheres, capsules, cylinders, octahedra): us/step on 1 and 2 threads,
 //    deepest overlap, final kinetic energy, 1T == 2T.
-//  * goal: issue 3's speed goal, pyramid_20 on the short exact schedule with and without
+//  * goal: the contact speed goal, pyramid_20 on the short exact schedule with and without
 //    sleeping, at 1/30 and 1/60, and whether it stands at 1/30 under 800 us per step.
 //
 // usage: bench_rigid_contact [pyramid|pour|mixed|goal|all, default all] [seconds]
@@ -205,7 +205,7 @@ void goal(const Registry& registry) {
       }
     }
   }
-  std::printf("\nissue 3's goal (stands at 1/30 under 800 us per step): without sleeping %s, with sleeping %s\n",
+  std::printf("\nthe speed goal (stands at 1/30 under 800 us per step): without sleeping %s, with sleeping %s\n",
               met[0] ? "met" : "not met", met[1] ? "met" : "not met");
 }
 

@@ -520,7 +520,7 @@ static void expectStraightAndResumedRunsAgree(const std::string& name, const std
   }
 }
 
-// Contact scenes (issue 3): nothing of the collision/contact systems survives a step except
+// Contact scenes: nothing of the collision/contact systems survives a step except
 // caches, so resuming from a checkpoint must reproduce the straight run bitwise, with a
 // kinematic platform (elevator) and with a stack being scattered (box_stack_scatter).
 TEST(CheckpointRestart, ContactScenesResumeBitwise) {

@@ -1,4 +1,4 @@
-// Rigid collisions, contact and friction (issue 3; thesis Ch. 2.3, 4.2-4.6, App. B), checked on
+// Rigid collisions, contact and friction (thesis Ch. 2.3, 4.2-4.6, App. B), checked on
 // the scene files against closed forms: Coulomb sliding and sticking on an incline, rolling in
 // 2-D, restitution apex ratios, Newton's cradle, a kinematic elevator, frame-rate stacking, and
 // the energy rules of Sec. 2.3.2 (collision impulses and the second contact step never add
@@ -232,7 +232,7 @@ TEST(Elevator, BoxRidesTheKinematicPlatform) {
 namespace {
 
 // Runs a pyramid scene to its end: every box within 0.05 of its start, kinetic energy < 1e-3,
-// no energy gain (issue 3).
+// no energy gain.
 template <int d>
 void expectPyramidStands(const std::string& sceneName, double keBound = 1e-3, double riseBound = -1,
                          double driftBound = 0.05, const std::vector<std::pair<std::string, std::string>>& overrides = {}) {
@@ -1126,7 +1126,7 @@ TEST(MeshGround, SphereAndBoxComeToRestOnAnObjMesh) {
 }
 
 TEST(MeshGround, ADynamicMeshCubeRestsAsTheBoxItBounds) {
-  // A closed triangle mesh as a dynamic body (issue 3: meshes static and dynamic): a unit cube
+  // A closed triangle mesh as a dynamic body (meshes are static or dynamic): a unit cube
   // read from an OBJ file dropped 5 cm onto the ground, a small box dropped onto it off its
   // centre, beside a box-shaped unit cube and small box dropped the same way 6 m away. The mesh
   // cube meets the plane with its vertices, as the box does, and the small box meets the mesh's

@@ -229,7 +229,7 @@ std::vector<Case> cases() {
        {{"entities.ball.rigid_body.mass", "1e999"}}},
       {"set_bad_value", scene3(kBall), "entities[0].rigid_body.mass", {"a positive finite number", "got -3"},
        {{"entities.ball.rigid_body.mass", "-3"}}},
-      // --- collision geometry and contact (issue 3) ------------------------------------------
+      // --- collision geometry and contact ------------------------------------------
       {"collider_without_shape", scene3(R"({ "name": "b", "rigid_body": { "mass": 1, "inertia": [1, 1, 1] }, "collider": {} })"),
        "entities[0].collider", {"a \"shape\" component on the same entity", "no shape"}},
       {"collider_restitution_2",

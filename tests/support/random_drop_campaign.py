@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Runs random drops (generate_contact_scenes.py --random SEED, or --random-2d SEED with
---dimension 2) and flags the ones that break a rule of issue 3: the total energy rising more
+--dimension 2) and flags the ones that break a rule of the contact stages: the total energy rising more
 than 0.1 % above its value after the first step, collision impulses or the second contact step
 adding kinetic energy (1e-12 relative), a deepest overlap over 5 % of the smaller body's size,
 a non-zero exit, a NaN; with --compare-threads N also a final state (summary.json's state_hash)

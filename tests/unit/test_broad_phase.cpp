@@ -1,4 +1,4 @@
-// Broad phase (issue 3): both methods must return exactly the brute-force list of overlapping
+// Broad phase: both methods must return exactly the brute-force list of overlapping
 // closed boxes, sorted, without pairs of two flagged (infinite or static) boxes, in 2-D and 3-D,
 // with unbounded half-space boxes in the mix, over calls whose boxes move or change in number.
 #include "solvers/collision/broad_phase.h"

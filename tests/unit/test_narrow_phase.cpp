@@ -1,4 +1,4 @@
-// Narrow phase and collision geometry (issue 3): contact points, normals and depths checked
+// Narrow phase and collision geometry: contact points, normals and depths checked
 // against closed-form values for every shape pair, the normal convention (out of B towards A,
 // flipped with the argument order), manifolds for face contacts, the margin, validation,
 // determinism and thread safety.
