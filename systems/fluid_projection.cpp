@@ -5,6 +5,7 @@
 
 #include "solvers/fluid/projection.h"
 #include "systems/fluid_domain.h"
+#include "systems/fluid_preconditioner_kind.h"
 
 namespace monolith {
 
@@ -28,21 +29,6 @@ FluidProjection<d>::FluidProjection() : cache_(std::make_unique<Cache>()) {}
 template <int d>
 FluidProjection<d>::~FluidProjection() = default;
 
-namespace {
-solvers::PoissonPreconditionerKind preconditionerKind(FluidSolverSettings::Preconditioner p) {
-  using P = FluidSolverSettings::Preconditioner;
-  using K = solvers::PoissonPreconditionerKind;
-  switch (p) {
-    case P::None: return K::None;
-    case P::Jacobi: return K::Jacobi;
-    case P::IC0: return K::IC0;
-    case P::MIC0: return K::MIC0;
-    case P::Multigrid: return K::Multigrid;
-  }
-  return K::MIC0;
-}
-}  // namespace
-
 template <int d>
 void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
   auto& pool = world.template pool<MacGrid<d>>();
@@ -55,7 +41,7 @@ void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
     // Rebuild the operators only when what they depend on changed (CFL steps change dt; a moving
     // obstacle changes the prescribed face velocities folded into them).
     Cache& c = *cache_;
-    const auto kind = preconditionerKind(settings.preconditioner);
+    const auto kind = poissonPreconditionerKindOf(settings.preconditioner);
     const auto coupledKind = settings.coupledCutCorrection ? solvers::CoupledPreconditionerKind::CutCorrected
                                                            : solvers::CoupledPreconditionerKind::BlockDiagonal;
     if (!c.ops || c.dt != ctx.dt || c.density != rho || c.viscosity != mu || c.solid != grid.solid || c.kind != kind ||

@@ -9,6 +9,7 @@
 #include "components/level_set.h"
 #include "components/shape.h"
 #include "systems/fluid_domain.h"
+#include "systems/fluid_preconditioner_kind.h"
 #include "systems/obstacle_geometry.h"
 
 namespace monolith {
@@ -33,19 +34,6 @@ solvers::FsiPreconditionerKind kindOf(FsiSolver::Preconditioner p) {
   return solvers::FsiPreconditionerKind::BlockExact;
 }
 
-solvers::PoissonPreconditionerKind poissonKind(FluidSolverSettings::Preconditioner p) {
-  using P = FluidSolverSettings::Preconditioner;
-  using K = solvers::PoissonPreconditionerKind;
-  switch (p) {
-    case P::None: return K::None;
-    case P::Jacobi: return K::Jacobi;
-    case P::IC0: return K::IC0;
-    case P::MIC0: return K::MIC0;
-    case P::Multigrid: return K::Multigrid;
-  }
-  return K::MIC0;
-}
-
 // Writes the structure velocity of body b (dofs from b * (d + angular)) into the body.
 template <int d>
 void writeBody(RigidBody<d>& body, const Eigen::VectorXd& v, int b) {
@@ -68,7 +56,7 @@ solvers::FsiReport coupledSolve(const World<d>& world, StructureCouplingSetup<d>
   c.constrainedVelocities.resize(c.constrainedFaces.size());
   for (std::size_t k = 0; k < c.constrainedFaces.size(); ++k)
     c.constrainedVelocities[k] = ops->dofs.faceToVelocity[c.constrainedFaces[k]];
-  const solvers::PoissonPreconditioner<d> pressure(*ops, poissonKind(settings.preconditioner));
+  const solvers::PoissonPreconditioner<d> pressure(*ops, poissonPreconditionerKindOf(settings.preconditioner));
   const solvers::CoupledPreconditioner<d> fluid(*ops, pressure,
                                                 settings.coupledCutCorrection
                                                     ? solvers::CoupledPreconditionerKind::CutCorrected
@@ -76,7 +64,7 @@ solvers::FsiReport coupledSolve(const World<d>& world, StructureCouplingSetup<d>
   solvers::CgSettings cg{settings.maxIterations, settings.tolerance, 0};
   solvers::FsiReport report =
       solvers::fsiProjection(*ops, c, u, cg, &fluid, kindOf(fsiSolverOf(world).preconditioner),
-                             poissonKind(settings.preconditioner));
+                             poissonPreconditionerKindOf(settings.preconditioner));
   opsOut = std::move(ops);
   return report;
 }

@@ -1,0 +1,11 @@
+#pragma once
+// The scene's choice of pressure preconditioner (solvers.fluid.preconditioner) as the solvers'
+// kind: one mapping for the fluid's own projection and the coupled fluid-structure solve.
+#include "ecs/world.h"
+#include "solvers/fluid/poisson_preconditioner.h"
+
+namespace monolith {
+
+solvers::PoissonPreconditionerKind poissonPreconditionerKindOf(FluidSolverSettings::Preconditioner p);
+
+}  // namespace monolith
