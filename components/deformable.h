@@ -53,6 +53,7 @@ struct Elasticity {
   double rayleighAlpha = 0;  // mass-proportional damping (1/s)
   double rayleighBeta = 0;   // stiffness-proportional damping (s)
   double overdamping = 0;    // spring dampers as a fraction of critical damping
+  double altitudeStiffness = 0;  // mass-spring: Young's modulus of the altitude springs (0: none)
   double clamp = 0.3;        // neo-Hookean singular-value clamp ([81])
 
   template <class V>
@@ -65,6 +66,7 @@ struct Elasticity {
     visit("rayleigh_beta", rayleighBeta);
     visit("overdamping", overdamping);
     visit("clamp", clamp);
+    visit("altitude_stiffness", altitudeStiffness);
   }
 };
 

@@ -84,6 +84,9 @@ void parseDeformable(World<d>& world, Entity e, const Config& c) {
   el.rayleighAlpha = c.number("rayleigh_alpha", 0.0, Bound::NonNegative);
   el.rayleighBeta = c.number("rayleigh_beta", 0.0, Bound::NonNegative);
   el.overdamping = c.number("overdamping", 0.0, Bound::NonNegative);
+  el.altitudeStiffness = c.number("altitude_stiffness", 0.0, Bound::NonNegative);
+  if (el.altitudeStiffness > 0 && el.model != 2)
+    c.failAt("altitude_stiffness", "altitude springs only with \"model\": \"springs\"", model);
   el.clamp = c.number("clamp", 0.3, Bound::Positive);
   if (el.clamp >= 1) c.failAt("clamp", "a singular-value clamp below 1", std::to_string(el.clamp));
 
@@ -137,6 +140,9 @@ void parseDeformable(World<d>& world, Entity e, const Config& c) {
   dm::Material mat;
   mat.density = el.density;
   p.m = dm::prepareForceModel<d>(sm.restX, sm.elements, mat).mass;
+  // "particle_mass": every particle the same mass instead (a mass-spring model's lumping, as the
+  // thesis's beam, Sec. 5.11.5).
+  if (c.has("particle_mass")) p.m.assign(mesh.x.size(), c.number("particle_mass", Bound::Positive));
   // "bind": [{"body": NAME, "min": [...], "max": [...]}, ...]: particles inside the world box are
   // hard-bound to the rigid body NAME (listed before this entity); their mass and inertia about
   // the body's centre join a dynamic body's (the shift of its centre of mass is neglected).
@@ -225,7 +231,7 @@ void registerDeformableComponents(Registry& r) {
       "deformable solid: mesh {box {half_extents, edge_length} | sphere {radius, edge_length} | gmsh FILE" +
           std::string(d == 3 ? " | tetgen BASE" : "") +
           "}, model (corotated | neo_hookean | springs), youngs_modulus, poisson_ratio, density, rayleigh_alpha, "
-          "rayleigh_beta, overdamping, clamp, position, " +
+          "rayleigh_beta, overdamping, altitude_stiffness, particle_mass, clamp, position, " +
           std::string(d == 3 ? "orientation" : "angle") + ", velocity, fixed [{min, max}], bind [{body, min, max}]",
       parseDeformable<d>,
       [](World<d>& w) {

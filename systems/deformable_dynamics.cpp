@@ -20,9 +20,10 @@ dm::ForceModel<d> forceModelOf(const Particles<d>& p, const SimplexMesh<d>& mesh
   mat.rayleighAlpha = e.rayleighAlpha;
   mat.rayleighBeta = e.rayleighBeta;
   mat.overdamping = e.overdamping;
+  mat.altitudeStiffness = e.altitudeStiffness;
   mat.clamp = e.clamp;
-  dm::ForceModel<d> fm = dm::prepareForceModel<d>(mesh.restX, mesh.elements, mat);
-  fm.mass = p.m;  // the state's masses are authoritative
+  // The state's masses are authoritative (also for the springs' critical damping).
+  dm::ForceModel<d> fm = dm::prepareForceModel<d>(mesh.restX, mesh.elements, mat, p.m);
   return fm;
 }
 

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include <Eigen/LU>
+#include <Eigen/Geometry>
 #include <Eigen/SVD>
 
 // GCC 12 reports Eigen's JacobiSVD internals as maybe-uninitialized where they are instantiated
@@ -34,6 +35,12 @@ void forEachElement(int n, F&& f) {
 template <int d>
 VecD<d> at(const double* a, int i) {
   return Eigen::Map<const VecD<d>>(a + d * i);
+}
+
+// f_{idx[a]} += s g_a: a force s along an altitude spring's gradient.
+template <int d>
+void addAlongGradient(const int* idx, const VecD<d>* g, double s, double* f) {
+  for (int a = 0; a <= d; ++a) Eigen::Map<VecD<d>>(f + d * idx[a]) += s * g[a];
 }
 
 template <int d>
@@ -104,11 +111,45 @@ VecD<d> diagonalStress(Model m, const Lame& lame, const VecD<d>& s, double clamp
 }
 
 template <int d>
+double signedAltitude(const double* x, const int* idx, VecD<d>* gradient) {
+  const VecD<d> a = at<d>(x, idx[0]), b = at<d>(x, idx[1]);
+  VecD<d> n;
+  VecD<d> bary;  // barycentric coordinates of the projection on the side, for idx[1..d]
+  if constexpr (d == 2) {
+    const VecD<d> e = at<d>(x, idx[2]) - b;
+    const double len2 = e.squaredNorm();
+    if (len2 == 0) {
+      for (int k = 0; k <= d; ++k) gradient[k].setZero();
+      return 0;
+    }
+    n = VecD<d>(-e(1), e(0)) / std::sqrt(len2);
+    const double t = (a - b).dot(e) / len2;
+    bary << 1 - t, t;
+  } else {
+    const VecD<d> e1 = at<d>(x, idx[2]) - b, e2 = at<d>(x, idx[3]) - b;
+    const VecD<d> c = e1.cross(e2);
+    const double area2 = c.squaredNorm();
+    if (area2 == 0) {
+      for (int k = 0; k <= d; ++k) gradient[k].setZero();
+      return 0;
+    }
+    n = c / std::sqrt(area2);
+    // Barycentric coordinates of q = a - h n in the triangle (b, b + e1, b + e2).
+    const VecD<d> r = a - b;
+    const double s1 = r.cross(e2).dot(c) / area2, s2 = e1.cross(r).dot(c) / area2;
+    bary << 1 - s1 - s2, s1, s2;
+  }
+  gradient[0] = n;
+  for (int k = 0; k < d; ++k) gradient[k + 1] = -bary(k) * n;
+  return n.dot(a - b);
+}
+
+template <int d>
 int ForceModel<d>::dampingRows() const {
   int rows = 0;
   if (finiteElements() && rayleighBeta > 0) rows += (d * d + 1) * elementCount();
   if (rayleighAlpha > 0) rows += d * static_cast<int>(mass.size());
-  rows += springCount();
+  rows += springCount() + altitudeCount();
   return rows;
 }
 
@@ -131,6 +172,11 @@ double elasticEnergy(const ForceModel<d>& fm, const double* x) {
   for (int k = 0; k < fm.springCount(); ++k) {
     const double L = (at<d>(x, fm.springs[2 * k + 1]) - at<d>(x, fm.springs[2 * k])).norm();
     E += 0.5 * fm.springK[k] * (L - fm.springRest[k]) * (L - fm.springRest[k]);
+  }
+  for (int k = 0; k < fm.altitudeCount(); ++k) {
+    VecD<d> g[d + 1];
+    const double h = signedAltitude<d>(x, &fm.altitudes[(d + 1) * k], g);
+    E += 0.5 * fm.altitudeK[k] * (h - fm.altitudeRest[k]) * (h - fm.altitudeRest[k]);
   }
   return E;
 }
@@ -157,6 +203,12 @@ void addElasticForces(const ForceModel<d>& fm, const double* x, double* f) {
     Eigen::Map<VecD<d>>(f + d * i) += fi;
     Eigen::Map<VecD<d>>(f + d * j) -= fi;
   }
+  for (int k = 0; k < fm.altitudeCount(); ++k) {
+    VecD<d> g[d + 1];
+    const int* idx = &fm.altitudes[(d + 1) * k];
+    const double h = signedAltitude<d>(x, idx, g);
+    addAlongGradient<d>(idx, g, -fm.altitudeK[k] * (h - fm.altitudeRest[k]), f);
+  }
 }
 
 template <int d>
@@ -174,6 +226,14 @@ std::vector<MatD<d>> dampingRotations(const ForceModel<d>& fm, const double* x) 
 }
 
 namespace {
+
+// dh/dt = sum_a g_a . v_{idx[a]} for an altitude spring's gradient g.
+template <int d>
+double alongGradient(const int* idx, const VecD<d>* g, const double* v) {
+  double r = 0;
+  for (int a = 0; a <= d; ++a) r += g[a].dot(at<d>(v, idx[a]));
+  return r;
+}
 
 template <int d>
 VecD<d> springDirection(const ForceModel<d>& fm, int k, const double* x) {
@@ -209,6 +269,12 @@ void addDampingForces(const ForceModel<d>& fm, const std::vector<MatD<d>>& R, co
     Eigen::Map<VecD<d>>(f + d * i) += fi;
     Eigen::Map<VecD<d>>(f + d * j) -= fi;
   }
+  for (int k = 0; k < fm.altitudeCount(); ++k) {
+    VecD<d> g[d + 1];
+    const int* idx = &fm.altitudes[(d + 1) * k];
+    signedAltitude<d>(x, idx, g);
+    addAlongGradient<d>(idx, g, -fm.altitudeC[k] * alongGradient<d>(idx, g, v), f);
+  }
 }
 
 template <int d>
@@ -238,6 +304,12 @@ void applyDampingFactor(const ForceModel<d>& fm, const std::vector<MatD<d>>& R, 
   for (int k = 0; k < fm.springCount(); ++k) {
     const int i = fm.springs[2 * k], j = fm.springs[2 * k + 1];
     y[row++] = std::sqrt(dt * fm.springC[k]) * springDirection(fm, k, x).dot(at<d>(v, j) - at<d>(v, i));
+  }
+  for (int k = 0; k < fm.altitudeCount(); ++k) {
+    VecD<d> g[d + 1];
+    const int* idx = &fm.altitudes[(d + 1) * k];
+    signedAltitude<d>(x, idx, g);
+    y[row++] = std::sqrt(dt * fm.altitudeC[k]) * alongGradient<d>(idx, g, v);
   }
 }
 
@@ -275,6 +347,12 @@ void applyDampingFactorTranspose(const ForceModel<d>& fm, const std::vector<MatD
     Eigen::Map<VecD<d>>(f + d * i) -= g;
     Eigen::Map<VecD<d>>(f + d * j) += g;
   }
+  for (int k = 0; k < fm.altitudeCount(); ++k) {
+    VecD<d> g[d + 1];
+    const int* idx = &fm.altitudes[(d + 1) * k];
+    signedAltitude<d>(x, idx, g);
+    addAlongGradient<d>(idx, g, std::sqrt(dt * fm.altitudeC[k]) * y[row++], f);
+  }
 }
 
 #define MONOLITH_INSTANTIATE(D)                                                                                   \
@@ -284,6 +362,7 @@ void applyDampingFactorTranspose(const ForceModel<d>& fm, const std::vector<MatD
   template struct ForceModel<D>;                                                                                  \
   template MatD<D> deformationGradient<D>(const ForceModel<D>&, int, const double*);                              \
   template double elasticEnergy<D>(const ForceModel<D>&, const double*);                                          \
+  template double signedAltitude<D>(const double*, const int*, VecD<D>*);                                          \
   template void addElasticForces<D>(const ForceModel<D>&, const double*, double*);                                \
   template std::vector<MatD<D>> dampingRotations<D>(const ForceModel<D>&, const double*);                         \
   template void addDampingForces<D>(const ForceModel<D>&, const std::vector<MatD<D>>&, const double*,             \

@@ -12,7 +12,11 @@
 //    the singular values clamped below at `clamp` in the stress ([81] Sec. 5: the force keeps
 //    pushing a crushed element back instead of blowing up at J -> 0).
 // Mass-spring: edge springs k (|l| - L), damping c (v_rel . n) n with c a fraction of the
-// critical damping 2 sqrt(k m1 m2 / (m1 + m2)) (the over-damping fraction of Sec. 5.11.5).
+// critical damping 2 sqrt(k m1 m2 / (m1 + m2)) (the over-damping fraction of Sec. 5.11.5);
+// optionally altitude springs (Sec. 5.11.5, [102]): in every element, from each particle to its
+// projection on the opposite side, k (h - H) on the signed altitude h, which keeps the element
+// from collapsing or inverting; damped like the edge springs with the effective mass of that
+// relative motion.
 //
 // Damping forces f = D v are linear in v at fixed x, symmetric negative semidefinite, and each
 // applies its factor C with C^T C = -dt D (Sec. 5.5.1):
@@ -20,7 +24,7 @@
 //    (R = U V^T, so rigid motion is not damped) with stress beta (2 mu e + lambda tr(e) I);
 //    its dissipation beta (2 mu |dev e|^2 + (2 mu / d + lambda) tr(e)^2) gives C's d^2 + 1 rows;
 //  * Rayleigh mass damping -alpha m v (d rows per particle);
-//  * spring dampers (one row per spring).
+//  * spring dampers (one row per spring, edge springs first, then altitude springs).
 #include <Eigen/Core>
 #include <Eigen/LU>
 #include <vector>
@@ -65,15 +69,27 @@ struct ForceModel {
   std::vector<double> restVolume;
   std::vector<int> springs;
   std::vector<double> springRest, springK, springC;
+  // Altitude springs: d+1 indices each, the particle first, then the opposite side's d particles
+  // ordered so that the rest altitude is positive; rest altitude, stiffness, damping coefficient.
+  std::vector<int> altitudes;
+  std::vector<double> altitudeRest, altitudeK, altitudeC;
   std::vector<double> mass;     // per particle
 
   int elementCount() const { return static_cast<int>(restVolume.size()); }
   int springCount() const { return static_cast<int>(springRest.size()); }
+  int altitudeCount() const { return static_cast<int>(altitudeRest.size()); }
   bool finiteElements() const { return model != Model::Springs; }
   // Rows of C: (d^2 + 1) per element with stiffness damping, d per particle with mass damping,
   // one per spring with a damper.
   int dampingRows() const;
 };
+
+// Signed distance h of particle idx[0] from the line (2-D) or plane (3-D) through the particles
+// idx[1..d], positive on the side the normal (x2 - x1) rotated by +90 degrees, or
+// (x2 - x1) x (x3 - x1), points to; gradient[a] = dh/dx_{idx[a]} (the particle: the unit normal n;
+// the side's particles: -b_a n with b the barycentric coordinates of the projection).
+template <int d>
+double signedAltitude(const double* x, const int* idx, VecD<d>* gradient);
 
 template <int d>
 MatD<d> deformationGradient(const ForceModel<d>& fm, int e, const double* x);

@@ -356,7 +356,7 @@ MeshData<3> readTetgen(const std::string& base) {
 
 template <int d>
 ForceModel<d> prepareForceModel(const std::vector<double>& restX, const std::vector<int>& elements,
-                                const Material& mat) {
+                                const Material& mat, const std::vector<double>& masses) {
   ForceModel<d> fm;
   fm.model = mat.model;
   fm.lame = Lame::fromYoung(mat.youngsModulus, mat.poissonRatio);
@@ -378,6 +378,7 @@ ForceModel<d> prepareForceModel(const std::vector<double>& restX, const std::vec
     fm.restVolume[e] = Dm.determinant() / factorial(d);
     for (int k = 0; k <= d; ++k) fm.mass[n[k]] += mat.density * fm.restVolume[e] / (d + 1);
   }
+  if (!masses.empty()) fm.mass = masses;
   if (mat.model == Model::Springs) {
     std::vector<std::pair<int, int>> edges;
     for (int e = 0; e < ne; ++e)
@@ -399,6 +400,29 @@ ForceModel<d> prepareForceModel(const std::vector<double>& restX, const std::vec
       fm.springK.push_back(k);
       fm.springC.push_back(mat.overdamping * 2 * std::sqrt(k * mEff));
     }
+    if (mat.altitudeStiffness > 0) {
+      for (int e = 0; e < ne; ++e)
+        for (int a = 0; a <= d; ++a) {
+          int idx[d + 1];
+          idx[0] = elements[(d + 1) * e + a];
+          for (int b = 1, k = 0; b <= d; ++b, ++k) idx[b] = elements[(d + 1) * e + (a + b) % (d + 1)];
+          VecD<d> g[d + 1];
+          double H = signedAltitude<d>(restX.data(), idx, g);
+          if (H < 0) {  // order the side so that the rest altitude is positive
+            std::swap(idx[1], idx[2]);
+            H = signedAltitude<d>(restX.data(), idx, g);
+          }
+          // Critical damping of the altitude in isolation: the effective mass of h is
+          // 1 / sum_a |g_a|^2 / m_a (an edge spring's m1 m2 / (m1 + m2)).
+          double invM = 0;
+          for (int b = 0; b <= d; ++b) invM += g[b].squaredNorm() / fm.mass[idx[b]];
+          const double k = mat.altitudeStiffness * std::pow(H, d - 2);
+          fm.altitudes.insert(fm.altitudes.end(), idx, idx + d + 1);
+          fm.altitudeRest.push_back(H);
+          fm.altitudeK.push_back(k);
+          fm.altitudeC.push_back(mat.overdamping * 2 * std::sqrt(k / invM));
+        }
+    }
   }
   return fm;
 }
@@ -408,7 +432,8 @@ ForceModel<d> prepareForceModel(const std::vector<double>& restX, const std::vec
   template MeshData<D> sphereMesh<D>(double, double);                                                             \
   template std::string meshProblem<D>(const MeshData<D>&);                                                        \
   template MeshData<D> readGmsh<D>(const std::string&);                                                           \
-  template ForceModel<D> prepareForceModel<D>(const std::vector<double>&, const std::vector<int>&, const Material&);
+  template ForceModel<D> prepareForceModel<D>(const std::vector<double>&, const std::vector<int>&, const Material&, \
+                                              const std::vector<double>&);
 MONOLITH_INSTANTIATE(2)
 MONOLITH_INSTANTIATE(3)
 #undef MONOLITH_INSTANTIATE

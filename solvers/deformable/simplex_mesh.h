@@ -51,7 +51,8 @@ MeshData<d> readGmsh(const std::string& path);
 MeshData<3> readTetgen(const std::string& base);
 
 // Lumped masses (density * volume / (d+1) per vertex), rest shape matrices and volumes of
-// the elements, and for the spring model the unique edges of the mesh with their rest lengths.
+// the elements, and for the spring model the unique edges of the mesh with their rest lengths
+// and, with an altitude stiffness, the d+1 altitude springs of every element.
 struct Material {
   Model model = Model::Corotated;
   double density = 1000;
@@ -59,10 +60,13 @@ struct Material {
   double poissonRatio = 0.3;
   double rayleighAlpha = 0, rayleighBeta = 0;
   double overdamping = 0;     // spring damping as a fraction of critical damping
+  double altitudeStiffness = 0;  // Young's modulus of the altitude springs (0: none)
   double clamp = 0.3;
 };
+// `masses` (one per particle), when given, replace the lumped masses, also in the springs'
+// critical damping.
 template <int d>
 ForceModel<d> prepareForceModel(const std::vector<double>& restX, const std::vector<int>& elements,
-                                const Material& material);
+                                const Material& material, const std::vector<double>& masses = {});
 
 }  // namespace monolith::solvers::deformable

@@ -46,6 +46,14 @@ StableStep stableStep(const ForceModel<d>& fm, double density, const double* x, 
       K[fm.springs[2 * k + 1]] += fm.springK[k];
       s.minAltitude = std::min(s.minAltitude, fm.springRest[k]);
     }
+    for (int k = 0; k < fm.altitudeCount(); ++k) {
+      // The altitude spring's stiffness as particle idx[a] feels it: k |dh/dx_a|^2.
+      VecD<d> g[d + 1];
+      const int* idx = &fm.altitudes[(d + 1) * k];
+      signedAltitude<d>(x, idx, g);
+      for (int a = 0; a <= d; ++a) K[idx[a]] += fm.altitudeK[k] * g[a].squaredNorm();
+      s.minAltitude = std::min(s.minAltitude, fm.altitudeRest[k]);
+    }
     for (std::size_t i = 0; i < K.size(); ++i)
       if (!fixed[i] && K[i] > 0) s.elastic = std::min(s.elastic, std::sqrt(2 * fm.mass[i] / K[i]));
   }

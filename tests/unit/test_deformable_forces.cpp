@@ -14,7 +14,8 @@ namespace dm = monolith::solvers::deformable;
 namespace {
 
 template <int d>
-dm::ForceModel<d> model(dm::Model m, const dm::MeshData<d>& mesh, double alpha = 0, double beta = 0, double zeta = 0) {
+dm::ForceModel<d> model(dm::Model m, const dm::MeshData<d>& mesh, double alpha = 0, double beta = 0, double zeta = 0,
+                        double altitude = 0) {
   dm::Material mat;
   mat.model = m;
   mat.youngsModulus = 1e4;
@@ -23,6 +24,7 @@ dm::ForceModel<d> model(dm::Model m, const dm::MeshData<d>& mesh, double alpha =
   mat.rayleighAlpha = alpha;
   mat.rayleighBeta = beta;
   mat.overdamping = zeta;
+  mat.altitudeStiffness = altitude;
   std::vector<double> X;
   for (const auto& x : mesh.x)
     for (int a = 0; a < d; ++a) X.push_back(x(a));
@@ -48,9 +50,12 @@ std::vector<double> deformed(const std::vector<double>& X, unsigned seed, double
 }
 
 template <int d>
-void checkGradient(dm::Model m) {
+void checkGradient(dm::Model m, double altitude = 0) {
   const auto mesh = dm::boxMesh<d>(dm::VecD<d>::Constant(0.5), 0.5);
-  const auto fm = model<d>(m, mesh);
+  const auto fm = model<d>(m, mesh, 0, 0, 0, altitude);
+  if (altitude > 0) {
+    ASSERT_EQ(fm.altitudeCount(), (d + 1) * fm.elementCount());
+  }
   const auto x = deformed<d>(flat(mesh), 7, 0.08);
   std::vector<double> f(x.size(), 0.0);
   dm::addElasticForces<d>(fm, x.data(), f.data());
@@ -74,6 +79,8 @@ void checkGradient(dm::Model m) {
 TEST(DeformableForces, CorotatedForceIsMinusEnergyGradient3d) { checkGradient<3>(dm::Model::Corotated); }
 TEST(DeformableForces, NeoHookeanForceIsMinusEnergyGradient3d) { checkGradient<3>(dm::Model::NeoHookean); }
 TEST(DeformableForces, SpringForceIsMinusEnergyGradient3d) { checkGradient<3>(dm::Model::Springs); }
+TEST(DeformableForces, AltitudeSpringForceIsMinusEnergyGradient2d) { checkGradient<2>(dm::Model::Springs, 2e4); }
+TEST(DeformableForces, AltitudeSpringForceIsMinusEnergyGradient3d) { checkGradient<3>(dm::Model::Springs, 2e4); }
 TEST(DeformableForces, CorotatedForceIsMinusEnergyGradient2d) { checkGradient<2>(dm::Model::Corotated); }
 TEST(DeformableForces, NeoHookeanForceIsMinusEnergyGradient2d) { checkGradient<2>(dm::Model::NeoHookean); }
 
@@ -112,9 +119,9 @@ TEST(DeformableForces, ZeroForceAtRestAndUnderRigidMotion) {
 
 // C^T C = -dt D: u.(C^T C w) against -dt u.(D w) for random u, w, and D symmetric NSD.
 template <int d>
-void checkFactor(dm::Model m) {
+void checkFactor(dm::Model m, double altitude = 0) {
   const auto mesh = dm::boxMesh<d>(dm::VecD<d>::Constant(0.5), 0.35);
-  const auto fm = model<d>(m, mesh, 0.7, 0.02, 0.4);
+  const auto fm = model<d>(m, mesh, 0.7, 0.02, 0.4, altitude);
   const auto x = deformed<d>(flat(mesh), 3, 0.05);
   const auto R = dm::dampingRotations<d>(fm, x.data());
   const double dt = 1e-2;
@@ -149,6 +156,35 @@ void checkFactor(dm::Model m) {
 TEST(DeformableForces, DampingFactorCorotated3d) { checkFactor<3>(dm::Model::Corotated); }
 TEST(DeformableForces, DampingFactorSprings3d) { checkFactor<3>(dm::Model::Springs); }
 TEST(DeformableForces, DampingFactorNeoHookean2d) { checkFactor<2>(dm::Model::NeoHookean); }
+TEST(DeformableForces, DampingFactorAltitudeSprings2d) { checkFactor<2>(dm::Model::Springs, 2e4); }
+TEST(DeformableForces, DampingFactorAltitudeSprings3d) { checkFactor<3>(dm::Model::Springs, 2e4); }
+
+// Altitude springs: no force at rest or under a rigid motion, and an element squashed towards
+// its opposite side is pushed back (the altitude grows again), in 2-D.
+TEST(DeformableForces, AltitudeSpringsRestAndSquash2d) {
+  const auto mesh = dm::boxMesh<2>(Eigen::Vector2d(0.05, 0.25), 0.026);
+  const auto fm = model<2>(dm::Model::Springs, mesh, 0, 0, 2, 400);
+  ASSERT_EQ(fm.altitudeCount(), 3 * fm.elementCount());
+  const Eigen::Matrix2d R = Eigen::Rotation2Dd(0.7).toRotationMatrix();
+  std::vector<double> x = flat(mesh);
+  for (std::size_t p = 0; p < mesh.x.size(); ++p) {
+    Eigen::Map<Eigen::Vector2d> xp(&x[2 * p]);
+    xp = R * mesh.x[p];
+  }
+  std::vector<double> f(x.size(), 0.0);
+  dm::addElasticForces<2>(fm, x.data(), f.data());
+  for (double v : f) EXPECT_LT(std::abs(v), 1e-10);
+  for (int k = 0; k < fm.altitudeCount(); ++k) EXPECT_GT(fm.altitudeRest[k], 0);
+  // Squash the whole body vertically by 10 %: every altitude spring pushes outwards, so the
+  // total elastic energy falls when the squash is undone a little.
+  std::vector<double> xs = flat(mesh);
+  for (std::size_t p = 0; p < mesh.x.size(); ++p) xs[2 * p + 1] *= 0.9;
+  std::vector<double> fs(xs.size(), 0.0);
+  dm::addElasticForces<2>(fm, xs.data(), fs.data());
+  double power = 0;  // the force's power on the motion that undoes the squash
+  for (std::size_t p = 0; p < mesh.x.size(); ++p) power += fs[2 * p + 1] * xs[2 * p + 1];
+  EXPECT_GT(power, 0);
+}
 
 // A crushed element (one vertex pushed through the opposite face) gets a force that moves the
 // vertex back: along +normal of the face it crossed, for both models.
