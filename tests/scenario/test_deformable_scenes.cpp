@@ -342,3 +342,17 @@ TEST(DeformableScenes, InclineFrictionRigidAndDeformableMatchCoulomb) {
   EXPECT_NEAR(rigid, exact, 0.02 * exact);
   EXPECT_NEAR(single, exact, 0.02 * exact);
 }
+
+// Altitude springs belong to the mass-spring model; a particle mass must be positive.
+TEST(DeformableScenes, AltitudeSpringsAndParticleMassInputIsChecked) {
+  std::string e = sceneError(deformableScene(
+      R"({ "mesh": { "box": { "half_extents": [1, 1, 1], "edge_length": 1 } }, "youngs_modulus": 1e5, "altitude_stiffness": 400 })"));
+  EXPECT_NE(e.find("entities[0].deformable.altitude_stiffness"), std::string::npos) << e;
+  EXPECT_NE(e.find("model"), std::string::npos) << e;
+  e = sceneError(deformableScene(
+      R"({ "mesh": { "box": { "half_extents": [1, 1, 1], "edge_length": 1 } }, "model": "springs", "youngs_modulus": 1e5, "particle_mass": -1 })"));
+  EXPECT_NE(e.find("entities[0].deformable.particle_mass"), std::string::npos) << e;
+  EXPECT_EQ(sceneError(deformableScene(
+                R"({ "mesh": { "box": { "half_extents": [1, 1, 1], "edge_length": 1 } }, "model": "springs", "youngs_modulus": 1e5, "altitude_stiffness": 400, "particle_mass": 0.1 })")),
+            "");
+}
