@@ -108,6 +108,10 @@ struct ArticulationSolver {
   // processes contact and pre-stabilization together); 0: pre-stabilization once, after shock
   // propagation.
   int contactRounds = 5;
+  // With colliders: sweeps of the jointed bodies' interpenetration resolution, joints and
+  // contacts together (systems/articulation.h, resolveJointedInterpenetration); 0: push-out's
+  // poses, then the joints closed without regard to contacts.
+  int pushOutContactSweeps = 50;
 
   template <class V>
   void visitFields(V& visit) {
@@ -119,6 +123,7 @@ struct ArticulationSolver {
     visit("pre_iterations", preIterations);
     visit("pre_tolerance", preTolerance);
     visit("contact_rounds", contactRounds);
+    visit("push_out_contact_sweeps", pushOutContactSweeps);
   }
 };
 

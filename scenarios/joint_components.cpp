@@ -161,6 +161,8 @@ void parseArticulation(World<3>& world, Entity e, const Config& c) {
   s.preIterations = static_cast<int>(c.integer("pre_iterations", s.preIterations, 1, 1000000));
   s.preTolerance = c.number("pre_tolerance", s.preTolerance, Bound::Positive);
   s.contactRounds = static_cast<int>(c.integer("contact_rounds", s.contactRounds, 0, 1000));
+  s.pushOutContactSweeps =
+      static_cast<int>(c.integer("push_out_contact_sweeps", s.pushOutContactSweeps, 0, 1000000));
   world.add(e, s);
 }
 
@@ -226,7 +228,8 @@ void registerJointComponents(Registry& r) {
       parseJoint);
   r.addComponentOf<3, ArticulationSolver>(
       "how the scene's joints are solved (one per scene): post_stabilization/pre_stabilization \"pairwise\" or "
-      "\"global\", pre_stabilize, post_iterations, post_tolerance, pre_iterations, pre_tolerance, contact_rounds",
+      "\"global\", pre_stabilize, post_iterations, post_tolerance, pre_iterations, pre_tolerance, contact_rounds, "
+      "push_out_contact_sweeps",
       parseArticulation);
 }
 

@@ -4,6 +4,8 @@
 // (x^{n+1}, v^{n+1}) (Sec. 2.3.2 "Contact Clamping"), so this step never adds kinetic energy.
 #include <algorithm>
 
+#include "components/joint.h"
+#include "systems/articulation.h"
 #include "systems/rigid_contact.h"
 
 namespace monolith {
@@ -30,6 +32,22 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
     if (s.shockPropagation)
       impulses[island] += ws.propagateShock(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
   });
+  // Joints (systems/articulation.h): rounds of post-stabilization, then contact again, so that
+  // neither leaves the other a velocity to undo; post_stabilize_velocities closes the joints last.
+  if constexpr (d == 3)
+    for (int round = 0, rounds = jointContactRounds(world); round < rounds; ++round) {
+      ws.unpack(false);
+      postStabilizeJointVelocities(world, ctx);
+      ws.reloadVelocities();
+      ws.updateAllCandidates();
+      ws.forEachIsland([&](int island) {
+        impulses[island] +=
+            ws.contactSweeps(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
+        if (s.shockPropagation)
+          impulses[island] +=
+              ws.propagateShock(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
+      });
+    }
   const auto energyAfter = ws.readEnergy();
   // The whole step's energy (systems/step_energy_clamp.cpp); measured after the diagnostics
   // above, which are about this stage's impulses alone.

@@ -227,9 +227,10 @@ TEST(Articulation, ContactStartsFromTheJointStagesVelocities) {
 
 // One ragdoll of ragdoll_pile lying on the ground. Contact stops the torso and the thighs' far
 // ends while the hip ends keep falling; pre-stabilization once after contact pulled the torso's
-// hip edge into the ground, push-out lifted it and the joints were closed again, every step:
-// 1.4 cm of joint error after push-out at rest. Rounds of pre-stabilization and contact within
-// Step III (contact_rounds) leave contact the last word, and the joints close on what it leaves.
+// hip edge into the ground, push-out lifted it and the joints were closed again, every step.
+// Rounds of pre-stabilization and contact within Step III (contact_rounds) leave contact the last
+// word, and the joints close on what it leaves: the joint error push-out's own poses would leave
+// at rest falls from 3.2 mm to 0.58 mm.
 TEST(Articulation, ContactRoundsKeepARestingRagdollOutOfThePushOutCycle) {
   const Registry registry = builtins();
   std::ifstream in(kScenes + "ragdoll_pile.json");
@@ -260,8 +261,68 @@ TEST(Articulation, ContactRoundsKeepARestingRagdollOutOfThePushOutCycle) {
     EXPECT_LT(joint, 1e-6);
     return worst;
   };
-  EXPECT_GT(pushOutError(0), 1e-2);
-  EXPECT_LT(pushOutError(5), 5e-3);
+  // Measured 3.2e-3 and 5.8e-4 m (joint error at push-out's own poses).
+  EXPECT_GT(pushOutError(0), 2e-3);
+  EXPECT_LT(pushOutError(5), 1e-3);
+}
+
+// The first ragdolls of ragdoll_pile, so many of its entities (the ground first).
+nlohmann::json ragdollPile(int ragdolls, double end) {
+  std::ifstream in(kScenes + "ragdoll_pile.json");
+  std::string line, text;
+  while (std::getline(in, line))
+    if (line.rfind("//", 0) != 0) text += line + "\n";
+  nlohmann::json scene = nlohmann::json::parse(text);
+  nlohmann::json kept = nlohmann::json::array();
+  for (const auto& e : scene["entities"]) {
+    const std::string name = e["name"];
+    bool keep = name == "ground";
+    for (int k = 0; k < ragdolls; ++k) keep = keep || name.rfind("r" + std::to_string(k) + "_", 0) == 0;
+    if (keep) kept.push_back(e);
+  }
+  scene["entities"] = kept;
+  scene["time"]["end"] = end;
+  scene.erase("checks");
+  return scene;
+}
+
+// Four ragdolls of ragdoll_pile (40 bodies, 36 joints) dropped on each other at dt = 1/30
+// settle with their joints closed, 1 and 2 threads bitwise. They do NOT come to rest: over the
+// last second bodies still slide on the ground by up to a few centimetres (printed). What is
+// asserted is the kinetic energy over that second, under 0.1 J: before Step V's contact took
+// rounds of post-stabilization (systems/velocity_contact.cpp) it stayed at 0.41-0.47 J; it is
+// measured at 0.02-0.05 J. For scale, one step of gravity gives the pile's 80 kg
+// M (g dt)^2 / 2 = 4.3 J.
+TEST(Articulation, ReducedRagdollPileSettlesWithJointsClosedOnAnyThreadCount) {
+  const Registry registry = builtins();
+  const SceneSpec scene = parseScene(ragdollPile(4, 4.0).dump(), "ragdoll_pile_4.json");
+  Simulation<3> one(scene, registry, 1), two(scene, registry, 2);
+  double worstJoint = 0, worstEnergy = 0, pushOutError = 0;
+  std::vector<Eigen::Vector3d> before;
+  auto centres = [&] {
+    std::vector<Eigen::Vector3d> x;
+    for (const auto& b : one.world().pool<RigidBody<3>>().components()) x.push_back(b.x);
+    return x;
+  };
+  while (!one.finished()) {
+    const auto& diag = one.step();
+    two.step();
+    worstJoint = std::max(worstJoint, diag.at("joint_error_max"));
+    if (one.time() > 3.0 - 1e-9) {
+      if (before.empty()) before = centres();
+      worstEnergy = std::max(worstEnergy, diag.at("kinetic_energy"));
+      pushOutError = std::max(pushOutError, diag.at("joint_push_out_error"));
+    }
+  }
+  const std::vector<Eigen::Vector3d> after = centres();
+  double moved = 0;
+  for (std::size_t i = 0; i < after.size(); ++i) moved = std::max(moved, (after[i] - before[i]).norm());
+  std::cout << "[measured] 4 ragdolls, t in [3, 4] s: largest centre motion " << moved << " m, kinetic energy <= "
+            << worstEnergy << " J, joint error at push-out's poses " << pushOutError
+            << " m; joint_error_max (all steps) " << worstJoint << " m\n";
+  EXPECT_LT(worstJoint, 1e-6);  // required < 1e-3 m; the solves close joints to ~1e-9 m
+  EXPECT_LT(worstEnergy, 0.1);
+  EXPECT_EQ(stateHash(one.world()), stateHash(two.world()));
 }
 
 TEST(Articulation, CheckpointOfAJointedSceneResumesBitwise) {
