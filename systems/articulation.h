@@ -96,6 +96,13 @@ template <int d>
 class ContactWorkspace;
 void resolveJointedInterpenetration(World<3>& world, ContactWorkspace<3>& ws, StepContext& ctx);
 
+// Step V, in velocity_contact before its sweeps (systems/joint_contacts.cpp; Sec. 4.7.1/4.7.3:
+// contacts as temporary joints in the constrained solve): the jointed bodies' velocities
+// projected onto their joints and their contacts together (normal rows, friction in the cone;
+// solvers::projectWithContacts), the other bodies held still with their own velocities. Before
+// the sweeps, since after them the contacts carry no normal impulse for friction to lean on.
+void postStabilizeWithContacts(World<3>& world, const ContactWorkspace<3>& ws, StepContext& ctx);
+
 // All the joint systems, sharing one velocity memory.
 std::vector<std::unique_ptr<System<3>>> makeJointSystems();
 

@@ -14,6 +14,10 @@ namespace {
 
 namespace col = solvers::collision;
 
+// Step V's contact points: those within 5 mm (a body falling for one step at dt = 1/30 moves
+// g dt^2 = 11 mm, one resting on another a few micrometres from it).
+constexpr double kStepFiveMargin = 5e-3;
+
 // Per body of `ws`: its body in the assembly if it is jointed and can move, else 0 (the world,
 // held still).
 std::vector<int> assemblyBodies(const JointAssembly& a, const ContactWorkspace<3>& ws) {
@@ -61,6 +65,59 @@ std::vector<solvers::ContactRow> contactRows(const JointAssembly& a, const Conta
 }
 
 }  // namespace
+
+void postStabilizeWithContacts(World<3>& world, const ContactWorkspace<3>& ws, StepContext& ctx) {
+  const ArticulationSolver s = articulationSettings(world);
+  JointAssembly a(world);
+  const std::vector<int> bodyOf = assemblyBodies(a, ws);
+  const double dt = ws.dt;
+  auto poseOf = [&](std::size_t i) {
+    col::Pose<3> p;
+    if (bodyOf[i] > 0) {
+      p.x = a.bodies[bodyOf[i]].x;
+      p.R = a.bodies[bodyOf[i]].q.toRotationMatrix();
+    } else if (ws.bodies[i].still()) {
+      p = ws.bodies[i].candidate;  // a static body's collision pose (grounded_box.h)
+    } else {
+      p.x = ws.bodies[i].x0;
+      p.R = ws.bodies[i].R0;
+    }
+    return p;
+  };
+  // A partner held still in the solve moves with its own velocity at the point.
+  auto pointVelocity = [&](std::size_t i, const Eigen::Vector3d& point) -> Eigen::Vector3d {
+    const ContactBody<3>& b = ws.bodies[i];
+    if (b.still()) return Eigen::Vector3d::Zero();
+    return b.v + b.omega().cross(point - b.x0);
+  };
+  std::vector<solvers::ContactRow> contacts;
+  std::vector<col::ContactPoint<3>> points;
+  col::ContactQuery query;
+  query.margin = kStepFiveMargin;
+  for (const ContactPairState& p : ws.pairs) {
+    if (bodyOf[p.a] == 0 && bodyOf[p.b] == 0) continue;
+    points.clear();
+    col::findContacts(*ws.bodies[p.a].geometry, poseOf(p.a), *ws.bodies[p.b].geometry, poseOf(p.b), query, points);
+    for (const auto& cp : points) {
+      solvers::ContactRow r;
+      r.a = bodyOf[p.a];
+      r.b = bodyOf[p.b];
+      r.point = cp.point;
+      r.normal = cp.normal;
+      // Touching or overlapping: no approach (push-out's business); apart: the gap in one step.
+      r.gain = std::min(0.0, cp.depth / dt);
+      r.friction = std::min(ws.bodies[p.a].friction, ws.bodies[p.b].friction);
+      if (r.a == 0) r.offset += pointVelocity(p.a, cp.point);
+      if (r.b == 0) r.offset -= pointVelocity(p.b, cp.point);
+      contacts.push_back(r);
+    }
+  }
+  const solvers::ProjectionReport r =
+      solvers::projectWithContacts(a.rows(), contacts, a.bodies, s.postIterations, s.postTolerance);
+  a.writeBack();
+  ctx.diagnostics.set("joint_step_v_contacts", static_cast<double>(contacts.size()));
+  ctx.diagnostics.max("joint_post_iterations", r.iterations);
+}
 
 void resolveJointedInterpenetration(World<3>& world, ContactWorkspace<3>& ws, StepContext& ctx) {
   const ArticulationSolver s = articulationSettings(world);

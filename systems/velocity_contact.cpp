@@ -20,6 +20,13 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
   ws.pairs = std::move(pairs);
   const ContactSettings& s = ws.settings;
   const auto energyBefore = ws.readEnergy();
+  // Joints (systems/articulation.h): the jointed bodies' velocities first projected onto their
+  // joints and contacts together (with friction, while the contacts still carry the weight).
+  if constexpr (d == 3)
+    if (jointContactRounds(world) > 0) {
+      postStabilizeWithContacts(world, ws, ctx);
+      ws.reloadVelocities();
+    }
   std::vector<int> impulses(ws.islands.members.size(), 0), clamps(ws.islands.members.size(), 0);
   std::vector<double> change(ws.islands.members.size(), 0.0);
   ws.forEachIsland([&](int island) {
@@ -32,8 +39,8 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
     if (s.shockPropagation)
       impulses[island] += ws.propagateShock(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
   });
-  // Joints (systems/articulation.h): rounds of post-stabilization, then contact again, so that
-  // neither leaves the other a velocity to undo; post_stabilize_velocities closes the joints last.
+  // Then rounds of post-stabilization and contact again, so that neither leaves the other a
+  // velocity to undo; post_stabilize_velocities closes the joints last.
   if constexpr (d == 3)
     for (int round = 0, rounds = jointContactRounds(world); round < rounds; ++round) {
       ws.unpack(false);

@@ -21,6 +21,9 @@ struct ContactRow {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitY();  // unit, out of b towards a
   double gain = 0;  // the least separation the displacements must add along the normal (< 0: may approach)
   double friction = 0;  // Coulomb coefficient: the point's tangential slip is held while |t| <= friction n
+  // The motion of a relative to b at the point that the bodies' own moves leave out (a partner
+  // held still in the solve but moving: its velocity at the point, with the sign of its side).
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
 };
 
 // Displaces the bodies (x + dx, exp(dtheta*) q) so that the joints close: `sweeps` sweeps of
@@ -34,5 +37,13 @@ PreStabilizationReport closeJointsAgainstContacts(const std::vector<JointDefinit
                                                   std::vector<ConstraintBody>& bodies,
                                                   const std::vector<ContactRow>& contacts, int sweeps, bool global,
                                                   int maxIterations, double tolerance);
+
+// Step V (Sec. 4.7.1, 4.7.3: contacts as temporary joints in the constrained solve): the
+// velocities projected onto the joints and the contacts together, by projected Gauss-Seidel;
+// each sweep goes over the contact rows (normal >= gain, friction in the cone), then once over
+// the joints (projectPairwise, the rows set to zero). The impulses' torques are added to the
+// bodies' angularImpulse. Returns the sweeps and the joints' residual after the last one.
+ProjectionReport projectWithContacts(const std::vector<JointRows>& joints, const std::vector<ContactRow>& contacts,
+                                     std::vector<ConstraintBody>& bodies, int sweeps, double tolerance);
 
 }  // namespace monolith::solvers
