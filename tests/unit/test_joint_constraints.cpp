@@ -54,8 +54,8 @@ void checkRowsAreErrorRates(JointKind type) {
   const Eigen::Quaterniond frame(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
   JointDefinition j = closedJoint(type, bodies, 0, 1, Eigen::Vector3d(0.2, -0.1, 0.3), frame);
   // A revolute joint a quarter turn into its free twist; a prismatic one slid along its axis.
-  if (type == JointKind::Revolute) j.childFrame = j.childFrame * Eigen::Quaterniond(Eigen::AngleAxisd(1.3, Eigen::Vector3d::UnitZ()));
-  if (type == JointKind::Prismatic) j.childAnchor += Eigen::Vector3d(0.05, 0.02, 0.4);
+  if (type == JointKind::Revolute || type == JointKind::Twist) j.childFrame = j.childFrame * Eigen::Quaterniond(Eigen::AngleAxisd(1.3, Eigen::Vector3d::UnitZ()));
+  if (type == JointKind::Prismatic || type == JointKind::Twist) j.childAnchor += Eigen::Vector3d(0.05, 0.02, 0.4);
   const JointRows rows = jointRows(j, bodies);
   const Vector6d rates = rowVelocities(rows, bodies);
   const double h = 1e-6;
@@ -89,7 +89,8 @@ double kinetic(const std::vector<ConstraintBody>& bodies) {
 }  // namespace
 
 TEST(JointConstraints, RowsAreTheRatesOfTheJointErrorForEveryType) {
-  for (JointKind t : {JointKind::Fixed, JointKind::Revolute, JointKind::Spherical, JointKind::Prismatic, JointKind::Universal})
+  for (JointKind t : {JointKind::Fixed, JointKind::Revolute, JointKind::Spherical, JointKind::Prismatic,
+                      JointKind::Universal, JointKind::Twist})
     checkRowsAreErrorRates(t);
 }
 
