@@ -30,22 +30,34 @@ std::vector<int> assemblyBodies(const JointAssembly& a, const ContactWorkspace<3
 }
 
 // The contact points, within `margin`, of the pairs with a jointed body that can move: that body
-// at its pose in the assembly, the other bodies where push-out left them. A row asks the
-// displacements to take away the overlap beyond what push-out accepts (`allowed`); a point
-// apart by a gap may approach by it.
+// at its pose in the assembly, the others at their base pose (where push-out left them in Step
+// IV, time n+1 in Step V; a static body's collision pose, grounded_box.h). `gainOf(depth)` is
+// the row's gain. With `partnerMotion`, a partner held still in the solve moves with its own
+// velocity at the point (Step V).
+template <typename GainOf>
 std::vector<solvers::ContactRow> contactRows(const JointAssembly& a, const ContactWorkspace<3>& ws,
-                                             const std::vector<int>& bodyOf, double margin, double allowed) {
+                                             const std::vector<int>& bodyOf, double margin, GainOf&& gainOf,
+                                             bool partnerMotion) {
+  auto poseOf = [&](std::size_t i) {
+    col::Pose<3> p = ws.bodies[i].candidate;
+    if (bodyOf[i] > 0) {
+      p.x = a.bodies[bodyOf[i]].x;
+      p.R = a.bodies[bodyOf[i]].q.toRotationMatrix();
+    } else if (!ws.bodies[i].still()) {
+      p.x = ws.bodies[i].x0;
+      p.R = ws.bodies[i].R0;
+    }
+    return p;
+  };
+  auto pointVelocity = [&](std::size_t i, const Eigen::Vector3d& point) -> Eigen::Vector3d {
+    const ContactBody<3>& b = ws.bodies[i];
+    if (!partnerMotion || b.still()) return Eigen::Vector3d::Zero();
+    return b.v + b.omega().cross(point - b.x0);
+  };
   std::vector<solvers::ContactRow> rows;
   std::vector<col::ContactPoint<3>> points;
   col::ContactQuery query;
   query.margin = margin;
-  auto poseOf = [&](std::size_t i) {
-    if (bodyOf[i] == 0) return ws.bodies[i].candidate;
-    col::Pose<3> p;
-    p.x = a.bodies[bodyOf[i]].x;
-    p.R = a.bodies[bodyOf[i]].q.toRotationMatrix();
-    return p;
-  };
   for (const ContactPairState& p : ws.pairs) {
     if (bodyOf[p.a] == 0 && bodyOf[p.b] == 0) continue;
     points.clear();
@@ -56,8 +68,10 @@ std::vector<solvers::ContactRow> contactRows(const JointAssembly& a, const Conta
       r.b = bodyOf[p.b];
       r.point = cp.point;
       r.normal = cp.normal;
-      r.gain = cp.depth - allowed;
+      r.gain = gainOf(cp.depth);
       r.friction = std::min(ws.bodies[p.a].friction, ws.bodies[p.b].friction);
+      if (r.a == 0) r.offset += pointVelocity(p.a, cp.point);
+      if (r.b == 0) r.offset -= pointVelocity(p.b, cp.point);
       rows.push_back(r);
     }
   }
@@ -71,47 +85,9 @@ void postStabilizeWithContacts(World<3>& world, const ContactWorkspace<3>& ws, S
   JointAssembly a(world);
   const std::vector<int> bodyOf = assemblyBodies(a, ws);
   const double dt = ws.dt;
-  auto poseOf = [&](std::size_t i) {
-    col::Pose<3> p;
-    if (bodyOf[i] > 0) {
-      p.x = a.bodies[bodyOf[i]].x;
-      p.R = a.bodies[bodyOf[i]].q.toRotationMatrix();
-    } else if (ws.bodies[i].still()) {
-      p = ws.bodies[i].candidate;  // a static body's collision pose (grounded_box.h)
-    } else {
-      p.x = ws.bodies[i].x0;
-      p.R = ws.bodies[i].R0;
-    }
-    return p;
-  };
-  // A partner held still in the solve moves with its own velocity at the point.
-  auto pointVelocity = [&](std::size_t i, const Eigen::Vector3d& point) -> Eigen::Vector3d {
-    const ContactBody<3>& b = ws.bodies[i];
-    if (b.still()) return Eigen::Vector3d::Zero();
-    return b.v + b.omega().cross(point - b.x0);
-  };
-  std::vector<solvers::ContactRow> contacts;
-  std::vector<col::ContactPoint<3>> points;
-  col::ContactQuery query;
-  query.margin = kStepFiveMargin;
-  for (const ContactPairState& p : ws.pairs) {
-    if (bodyOf[p.a] == 0 && bodyOf[p.b] == 0) continue;
-    points.clear();
-    col::findContacts(*ws.bodies[p.a].geometry, poseOf(p.a), *ws.bodies[p.b].geometry, poseOf(p.b), query, points);
-    for (const auto& cp : points) {
-      solvers::ContactRow r;
-      r.a = bodyOf[p.a];
-      r.b = bodyOf[p.b];
-      r.point = cp.point;
-      r.normal = cp.normal;
-      // Touching or overlapping: no approach (push-out's business); apart: the gap in one step.
-      r.gain = std::min(0.0, cp.depth / dt);
-      r.friction = std::min(ws.bodies[p.a].friction, ws.bodies[p.b].friction);
-      if (r.a == 0) r.offset += pointVelocity(p.a, cp.point);
-      if (r.b == 0) r.offset -= pointVelocity(p.b, cp.point);
-      contacts.push_back(r);
-    }
-  }
+  // Touching or overlapping: no approach (push-out's business); apart: the gap in one step.
+  const std::vector<solvers::ContactRow> contacts =
+      contactRows(a, ws, bodyOf, kStepFiveMargin, [&](double depth) { return std::min(0.0, depth / dt); }, true);
   const solvers::ProjectionReport r =
       solvers::projectWithContacts(a.rows(), contacts, a.bodies, s.postIterations, s.postTolerance);
   a.writeBack();
@@ -144,8 +120,11 @@ void resolveJointedInterpenetration(World<3>& world, ContactWorkspace<3>& ws, St
     // again with that margin.
     const double allowed = ws.settings.pushOutTolerance;
     double deepest = 0;
-    for (const auto& c : contactRows(a, ws, bodyOf, 0.0, allowed)) deepest = std::max(deepest, c.gain + allowed);
-    if (deepest > allowed) contacts = contactRows(a, ws, bodyOf, 2 * deepest, allowed);
+    // A row asks the displacements to take away the overlap beyond what push-out accepts; a
+    // point apart by a gap may approach by it.
+    auto gainOf = [&](double depth) { return depth - allowed; };
+    for (const auto& c : contactRows(a, ws, bodyOf, 0.0, gainOf, false)) deepest = std::max(deepest, c.gain + allowed);
+    if (deepest > allowed) contacts = contactRows(a, ws, bodyOf, 2 * deepest, gainOf, false);
   }
   const solvers::PreStabilizationReport r = solvers::closeJointsAgainstContacts(
       a.joints, a.bodies, contacts, s.pushOutContactSweeps, s.pre == ArticulationSolver::Method::Global,
