@@ -9,6 +9,8 @@
 //   spherical  any rotation about the common point
 //   prismatic  translation along the parent frame's z axis
 //   universal  rotation about the parent frame's x axis and the child frame's y axis
+//   twist      rotation about and translation along the parent frame's z axis (the twist joint
+//              of Fig. 4.5; PhysBAM's prismatic twist joint, here with a free slide)
 // Bodies are named, not held as entity handles: the names survive checkpoints as they are.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -18,7 +20,7 @@
 
 namespace monolith {
 
-enum class JointType : int { Fixed = 0, Revolute, Spherical, Prismatic, Universal };
+enum class JointType : int { Fixed = 0, Revolute, Spherical, Prismatic, Universal, Twist };
 
 inline const char* jointTypeName(JointType t) {
   switch (t) {
@@ -27,6 +29,7 @@ inline const char* jointTypeName(JointType t) {
     case JointType::Spherical: return "spherical";
     case JointType::Prismatic: return "prismatic";
     case JointType::Universal: return "universal";
+    case JointType::Twist: return "twist";
   }
   return "?";
 }
@@ -108,6 +111,10 @@ struct ArticulationSolver {
   // processes contact and pre-stabilization together); 0: pre-stabilization once, after shock
   // propagation.
   int contactRounds = 5;
+  // With colliders: sweeps of the jointed bodies' interpenetration resolution, joints and
+  // contacts together (systems/articulation.h, resolveJointedInterpenetration); 0: push-out's
+  // poses, then the joints closed without regard to contacts.
+  int pushOutContactSweeps = 50;
 
   template <class V>
   void visitFields(V& visit) {
@@ -119,6 +126,7 @@ struct ArticulationSolver {
     visit("pre_iterations", preIterations);
     visit("pre_tolerance", preTolerance);
     visit("contact_rounds", contactRounds);
+    visit("push_out_contact_sweeps", pushOutContactSweeps);
   }
 };
 

@@ -78,12 +78,13 @@ void parseKeyframes(const Config& t, Joint& j) {
 
 void parseJoint(World<3>& world, Entity e, const Config& c) {
   Joint j;
-  const std::string type = c.oneOf("type", {"fixed", "revolute", "spherical", "prismatic", "universal"}, "");
-  if (type.empty()) c.failAt("type", "one of fixed, revolute, spherical, prismatic, universal", "none");
+  const std::string type = c.oneOf("type", {"fixed", "revolute", "spherical", "prismatic", "universal", "twist"}, "");
+  if (type.empty()) c.failAt("type", "one of fixed, revolute, spherical, prismatic, universal, twist", "none");
   j.type = type == "fixed"       ? JointType::Fixed
            : type == "revolute"  ? JointType::Revolute
            : type == "spherical" ? JointType::Spherical
            : type == "prismatic" ? JointType::Prismatic
+           : type == "twist"     ? JointType::Twist
                                  : JointType::Universal;
   j.parent = c.string("parent");
   j.child = c.string("child", world.name(e));
@@ -113,7 +114,8 @@ void parseJoint(World<3>& world, Entity e, const Config& c) {
       j.worldAxis = c.vector("axis", 3);
       if (!(j.worldAxis.norm() > 1e-12)) c.failAt("axis", "a non-zero direction", "a zero vector");
       j.worldAxis.normalize();
-    } else if (j.type == JointType::Revolute || j.type == JointType::Prismatic || j.type == JointType::Universal) {
+    } else if (j.type == JointType::Revolute || j.type == JointType::Prismatic || j.type == JointType::Universal ||
+               j.type == JointType::Twist) {
       c.failAt("axis", std::string("the ") + type + " joint's axis (a world direction)", "none");
     } else {
       j.axisInWorld = true;  // frames aligned with the world at the initial poses
@@ -161,6 +163,8 @@ void parseArticulation(World<3>& world, Entity e, const Config& c) {
   s.preIterations = static_cast<int>(c.integer("pre_iterations", s.preIterations, 1, 1000000));
   s.preTolerance = c.number("pre_tolerance", s.preTolerance, Bound::Positive);
   s.contactRounds = static_cast<int>(c.integer("contact_rounds", s.contactRounds, 0, 1000));
+  s.pushOutContactSweeps =
+      static_cast<int>(c.integer("push_out_contact_sweeps", s.pushOutContactSweeps, 0, 1000000));
   world.add(e, s);
 }
 
@@ -220,13 +224,14 @@ void refuseRedundantLoops(World<3>& world, const std::string& file, const std::v
 
 void registerJointComponents(Registry& r) {
   r.addComponentOf<3, Joint>(
-      "articulation joint: type (fixed, revolute, spherical, prismatic, universal), parent (entity or \"world\"), "
+      "articulation joint: type (fixed, revolute, spherical, prismatic, universal, twist), parent (entity or \"world\"), "
       "child (default: this entity), anchor + axis (world, at the initial poses) or parent_frame/child_frame "
       "{position, orientation}; limits [lower, upper] and pd {kp, kd, target} on revolute joints",
       parseJoint);
   r.addComponentOf<3, ArticulationSolver>(
       "how the scene's joints are solved (one per scene): post_stabilization/pre_stabilization \"pairwise\" or "
-      "\"global\", pre_stabilize, post_iterations, post_tolerance, pre_iterations, pre_tolerance, contact_rounds",
+      "\"global\", pre_stabilize, post_iterations, post_tolerance, pre_iterations, pre_tolerance, contact_rounds, "
+      "push_out_contact_sweeps",
       parseArticulation);
 }
 

@@ -5,19 +5,9 @@
 
 #include "solvers/rigid_rotation.h"
 #include "systems/parallel.h"
+#include "systems/rigid_inertia.h"
 
 namespace monolith {
-
-namespace {
-solvers::BodyInertia bodyInertia(const RigidBody<3>& b) {
-  solvers::BodyInertia I;
-  I.I0 = b.inertiaBody;
-  I.I0inv = b.inertiaBodyInverse;
-  I.principalMoments = b.principalMoments;
-  I.principalAxes = b.principalAxes;
-  return I;
-}
-}  // namespace
 
 template <int d>
 void AdvanceRigidPositions<d>::run(World<d>& world, StepContext& ctx) {

@@ -9,100 +9,11 @@
 #include "components/sleep.h"
 #include "solvers/articulation/joint_constraints.h"
 #include "solvers/rigid_rotation.h"
+#include "systems/joint_assembly.h"
+#include "systems/rigid_inertia.h"
 
 namespace monolith {
 
-namespace {
-
-// The jointed bodies and joints of the world as the solvers see them. Body 0 is the world;
-// bodies follow in the order the joints name them (joint pool order: deterministic).
-struct JointAssembly {
-  std::vector<solvers::ConstraintBody> bodies;
-  std::vector<RigidBody<3>*> rigid;  // null for the world
-  std::vector<Entity> entity;
-  std::vector<bool> kinematic;
-  std::vector<solvers::JointDefinition> joints;
-  std::vector<const Joint*> components;
-
-  explicit JointAssembly(World<3>& world) {
-    bodies.emplace_back();
-    rigid.push_back(nullptr);
-    entity.push_back(Entity{});
-    kinematic.push_back(false);
-    std::unordered_map<std::uint32_t, int> index;
-    const auto* sleeps = world.findPool<Sleep<3>>();
-    auto bodyOf = [&](const std::string& name) -> int {
-      if (name == "world") return 0;
-      const auto e = world.find(name);
-      RigidBody<3>* b = e ? world.get<RigidBody<3>>(*e) : nullptr;
-      if (!b) throw std::logic_error("joint names '" + name + "', which is not a rigid body");
-      const auto [it, inserted] = index.emplace(e->index, static_cast<int>(bodies.size()));
-      if (!inserted) return it->second;
-      solvers::ConstraintBody c;
-      c.x = b->x;
-      c.q = b->orientation;
-      const bool moving = world.get<KinematicMotion<3>>(*e) != nullptr;
-      const bool immovable = b->isStatic || moving || isAsleep<3>(sleeps, *e);
-      if (!immovable) {
-        c.invMass = 1 / b->mass;
-        c.invInertia = b->worldInverseInertia();
-      }
-      if (!b->isStatic && !isAsleep<3>(sleeps, *e)) {
-        c.v = b->v;
-        c.w = b->omega();
-      }
-      bodies.push_back(c);
-      rigid.push_back(b);
-      entity.push_back(*e);
-      kinematic.push_back(moving);
-      return it->second;
-    };
-    const auto& pool = world.pool<Joint>();
-    for (const Joint& j : pool.components()) {
-      solvers::JointDefinition def;
-      def.type = static_cast<solvers::JointKind>(j.type);
-      def.parent = bodyOf(j.parent);
-      def.child = bodyOf(j.child);
-      def.parentAnchor = j.parentAnchor;
-      def.childAnchor = j.childAnchor;
-      def.parentFrame = j.parentFrame;
-      def.childFrame = j.childFrame;
-      def.limited = j.limited;
-      def.lower = j.lower;
-      def.upper = j.upper;
-      joints.push_back(def);
-      components.push_back(&j);
-    }
-  }
-
-  std::vector<solvers::JointRows> rows() const {
-    std::vector<solvers::JointRows> out;
-    out.reserve(joints.size());
-    for (const auto& j : joints) out.push_back(solvers::jointRows(j, bodies));
-    return out;
-  }
-
-  // The new velocities of the dynamic bodies; angular momentum takes the torque impulses
-  // exactly (L is the state, w is derived).
-  void writeBack() const {
-    for (std::size_t i = 1; i < bodies.size(); ++i) {
-      if (bodies[i].invMass == 0) continue;
-      rigid[i]->v = bodies[i].v;
-      rigid[i]->L += bodies[i].angularImpulse;
-    }
-  }
-};
-
-solvers::BodyInertia bodyInertia(const RigidBody<3>& b) {
-  solvers::BodyInertia I;
-  I.I0 = b.inertiaBody;
-  I.I0inv = b.inertiaBodyInverse;
-  I.principalMoments = b.principalMoments;
-  I.principalAxes = b.principalAxes;
-  return I;
-}
-
-}  // namespace
 
 ArticulationSolver articulationSettings(const World<3>& world) {
   const auto* pool = world.findPool<ArticulationSolver>();
@@ -148,7 +59,25 @@ bool anyPd(const World<3>& w) {
   return false;
 }
 
+// Post-stabilization proper: the mass-weighted projection of the velocities onto the joints.
+void project(JointAssembly& a, const ArticulationSolver& s, StepContext& ctx) {
+  const auto rows = a.rows();
+  const std::vector<solvers::Vector6d> zero(rows.size(), solvers::Vector6d::Zero());
+  const solvers::ProjectionReport r =
+      s.post == ArticulationSolver::Method::Global
+          ? solvers::projectGlobal(rows, zero, a.bodies, s.postIterations * static_cast<int>(std::max<std::size_t>(rows.size(), 1)),
+                                   s.postTolerance)
+          : solvers::projectPairwise(rows, zero, a.bodies, s.postIterations, s.postTolerance);
+  a.writeBack();
+  ctx.diagnostics.max("joint_post_iterations", r.iterations);
+}
+
 }  // namespace
+
+void postStabilizeJointVelocities(World<3>& world, StepContext& ctx) {
+  JointAssembly a(world);
+  project(a, articulationSettings(world), ctx);
+}
 
 std::string PostStabilizeJoints::name() const {
   switch (place_) {
@@ -170,18 +99,6 @@ Stage PostStabilizeJoints::stage() const {
 
 void PostStabilizeJoints::run(World<3>& world, StepContext& ctx) {
   const ArticulationSolver s = articulationSettings(world);
-  if (place_ == Place::AfterPositions && world.count<Collider<3>>() > 0) {
-    // Interpenetration resolution moved bodies one contact at a time: close the joints again.
-    JointAssembly a(world);
-    const solvers::PreStabilizationReport r = solvers::closeJoints(
-        a.joints, a.bodies, s.pre == ArticulationSolver::Method::Global, s.preIterations, s.preTolerance);
-    for (std::size_t i = 1; i < a.bodies.size(); ++i) {
-      if (a.bodies[i].invMass == 0) continue;
-      a.rigid[i]->x = a.bodies[i].x;
-      a.rigid[i]->orientation = a.bodies[i].q;
-    }
-    ctx.diagnostics.max("joint_push_out_error", r.errorBefore);
-  }
   if (place_ == Place::AfterPositions && !memory_->entity.empty()) {
     for (std::size_t i = 0; i < memory_->entity.size(); ++i) {
       RigidBody<3>* b = world.get<RigidBody<3>>(memory_->entity[i]);
@@ -191,15 +108,7 @@ void PostStabilizeJoints::run(World<3>& world, StepContext& ctx) {
   }
   JointAssembly a(world);
   if (place_ == Place::AfterVelocities) applyPd(a, ctx.time + 0.5 * ctx.dt, ctx.dt);
-  const auto rows = a.rows();
-  const std::vector<solvers::Vector6d> zero(rows.size(), solvers::Vector6d::Zero());
-  const solvers::ProjectionReport r =
-      s.post == ArticulationSolver::Method::Global
-          ? solvers::projectGlobal(rows, zero, a.bodies, s.postIterations * static_cast<int>(std::max<std::size_t>(rows.size(), 1)),
-                                   s.postTolerance)
-          : solvers::projectPairwise(rows, zero, a.bodies, s.postIterations, s.postTolerance);
-  a.writeBack();
-  ctx.diagnostics.max("joint_post_iterations", r.iterations);
+  project(a, s, ctx);
   if (place_ == Place::AfterCollisions) {
     memory_->entity.clear(), memory_->v.clear(), memory_->L.clear();
     for (std::size_t i = 1; i < a.bodies.size(); ++i) {

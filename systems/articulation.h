@@ -78,6 +78,30 @@ class JointDiagnostics final : public JointSystem {
 // together; with rounds, pre_stabilize_joints itself does nothing in a scene with colliders.
 void preStabilizeJointVelocities(World<3>& world, StepContext& ctx);
 int jointContactRounds(const World<3>& world);
+// Post-stabilization (the projection onto the joints) of the bodies' velocities; Step V's
+// contact interleaves it with its sweeps for the same rounds (Sec. 4.7.1: contacts and joints in
+// one constrained solve, here by alternating the two projections).
+void postStabilizeJointVelocities(World<3>& world, StepContext& ctx);
+
+// Step IV, at the end of interpenetration resolution, before it writes its poses (called from
+// systems/interpenetration.cpp; systems/joint_contacts.cpp). The jointed bodies that can move
+// start again from where Step IV's advance put them (the bodies' poses still) and are displaced,
+// by the least mass-weighted displacement, so that their joints close and their contacts -- with
+// the other bodies where push-out left them -- separate (solvers/articulation/joint_closing.h).
+// Their poses in `ws` are replaced. Push-out, one contact at a time, pulled joints apart by
+// centimetres in a pile from overlaps under a millimetre, and closing the joints afterwards
+// pushed the bodies back into their contacts, every step. Diagnostics joint_push_out_error (the
+// joint error at push-out's poses), joint_push_out_contacts, joint_push_out_error_left.
+template <int d>
+class ContactWorkspace;
+void resolveJointedInterpenetration(World<3>& world, ContactWorkspace<3>& ws, StepContext& ctx);
+
+// Step V, in velocity_contact before its sweeps (systems/joint_contacts.cpp; Sec. 4.7.1/4.7.3:
+// contacts as temporary joints in the constrained solve): the jointed bodies' velocities
+// projected onto their joints and their contacts together (normal rows, friction in the cone;
+// solvers::projectWithContacts), the other bodies held still with their own velocities. Before
+// the sweeps, since after them the contacts carry no normal impulse for friction to lean on.
+void postStabilizeWithContacts(World<3>& world, const ContactWorkspace<3>& ws, StepContext& ctx);
 
 // All the joint systems, sharing one velocity memory.
 std::vector<std::unique_ptr<System<3>>> makeJointSystems();

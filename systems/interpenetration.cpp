@@ -29,8 +29,10 @@
 #include <limits>
 #include <utility>
 
+#include "components/joint.h"
 #include "solvers/contact/joint_push_out.h"
 #include "solvers/contact/push_out.h"
+#include "systems/articulation.h"
 #include "systems/opposed_statics.h"
 #include "systems/rigid_contact.h"
 
@@ -505,7 +507,7 @@ int ResolveInterpenetration<d>::pushJamsApart(ContactWorkspace<d>& ws, int& newP
 }
 
 template <int d>
-void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
+void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (ws.bodies.empty()) return;
   const bool clampRotation = d == 3 && ws.settings.energyClamp;
@@ -659,6 +661,9 @@ void ResolveInterpenetration<d>::run(World<d>&, StepContext& ctx) {
     b.L = b.LCollided + b.dL;
   }
   ctx.diagnostics.set("rotation_energy_clamps", clampRotation ? clampEnergyOfRestoredMomentum(ws) : 0);
+  // Jointed bodies: their poses come from the joints and contacts together (systems/articulation.h).
+  if constexpr (d == 3)
+    if (world.template count<Joint>() > 0) resolveJointedInterpenetration(world, ws, ctx);
   ws.unpack(true);
   ctx.diagnostics.set("push_out_solves", solves);
   ctx.diagnostics.set("push_out_new_overlaps", newOverlaps);

@@ -4,6 +4,8 @@
 // (x^{n+1}, v^{n+1}) (Sec. 2.3.2 "Contact Clamping"), so this step never adds kinetic energy.
 #include <algorithm>
 
+#include "components/joint.h"
+#include "systems/articulation.h"
 #include "systems/rigid_contact.h"
 
 namespace monolith {
@@ -18,6 +20,13 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
   ws.pairs = std::move(pairs);
   const ContactSettings& s = ws.settings;
   const auto energyBefore = ws.readEnergy();
+  // Joints (systems/articulation.h): the jointed bodies' velocities first projected onto their
+  // joints and contacts together (with friction, while the contacts still carry the weight).
+  if constexpr (d == 3)
+    if (jointContactRounds(world) > 0) {
+      postStabilizeWithContacts(world, ws, ctx);
+      ws.reloadVelocities();
+    }
   std::vector<int> impulses(ws.islands.members.size(), 0), clamps(ws.islands.members.size(), 0);
   std::vector<double> change(ws.islands.members.size(), 0.0);
   ws.forEachIsland([&](int island) {
@@ -30,6 +39,22 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
     if (s.shockPropagation)
       impulses[island] += ws.propagateShock(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
   });
+  // Then rounds of post-stabilization and contact again, so that neither leaves the other a
+  // velocity to undo; post_stabilize_velocities closes the joints last.
+  if constexpr (d == 3)
+    for (int round = 0, rounds = jointContactRounds(world); round < rounds; ++round) {
+      ws.unpack(false);
+      postStabilizeJointVelocities(world, ctx);
+      ws.reloadVelocities();
+      ws.updateAllCandidates();
+      ws.forEachIsland([&](int island) {
+        impulses[island] +=
+            ws.contactSweeps(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
+        if (s.shockPropagation)
+          impulses[island] +=
+              ws.propagateShock(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
+      });
+    }
   const auto energyAfter = ws.readEnergy();
   // The whole step's energy (systems/step_energy_clamp.cpp); measured after the diagnostics
   // above, which are about this stage's impulses alone.

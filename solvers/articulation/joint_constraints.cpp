@@ -112,6 +112,10 @@ JointRows jointRows(const JointDefinition& joint, const std::vector<ConstraintBo
       rows.linear = 2, rows.linearDirs.leftCols<2>() = Fp.leftCols<2>();
       rows.angular = 3, rows.angularDirs = Fp;
       break;
+    case JointKind::Twist:
+      rows.linear = 2, rows.linearDirs.leftCols<2>() = Fp.leftCols<2>();
+      rows.angular = 2, rows.angularDirs.leftCols<2>() = Fp.leftCols<2>();
+      break;
     case JointKind::Universal: {
       rows.linear = 3, rows.linearDirs = Fp;
       const Eigen::Vector3d n = Fp.col(0).cross(Fc.col(1));
@@ -130,13 +134,14 @@ JointError jointError(const JointDefinition& joint, const Eigen::Vector3d& xPare
   const Eigen::Quaterniond qP = qParent * joint.parentFrame, qC = qChild * joint.childFrame;
   const Eigen::Vector3d axis = qP * Eigen::Vector3d::UnitZ();
   e.linear = (xChild + qChild * joint.childAnchor) - (xParent + qParent * joint.parentAnchor);
-  if (joint.type == JointKind::Prismatic) e.linear -= axis * axis.dot(e.linear);
+  if (joint.type == JointKind::Prismatic || joint.type == JointKind::Twist) e.linear -= axis * axis.dot(e.linear);
   switch (joint.type) {
     case JointKind::Fixed:
     case JointKind::Prismatic:
       e.angular = 2 * positiveScalar(qC * qP.conjugate()).vec();
       break;
-    case JointKind::Revolute: {
+    case JointKind::Revolute:
+    case JointKind::Twist: {
       // Remove the free twist about the hinge first, so that what remains is the error alone
       // (the vector part of q_c q_p^-1 would else mix the twist into the perpendicular rows).
       const double twist = revoluteAngle(joint, qParent, qChild);

@@ -21,7 +21,7 @@ namespace monolith::solvers {
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 // The joint types of components/joint.h, in the same order.
-enum class JointKind : int { Fixed = 0, Revolute, Spherical, Prismatic, Universal };
+enum class JointKind : int { Fixed = 0, Revolute, Spherical, Prismatic, Universal, Twist };
 
 // A body as the joint solves see it. Infinite mass (static, kinematic, the world): invMass 0 and
 // invInertia 0; its velocities still enter the rows.

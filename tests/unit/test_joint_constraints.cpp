@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "solvers/articulation/joint_closing.h"
 #include "solvers/articulation/joint_constraints.h"
 #include "solvers/rigid_rotation.h"
 
@@ -53,8 +54,8 @@ void checkRowsAreErrorRates(JointKind type) {
   const Eigen::Quaterniond frame(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
   JointDefinition j = closedJoint(type, bodies, 0, 1, Eigen::Vector3d(0.2, -0.1, 0.3), frame);
   // A revolute joint a quarter turn into its free twist; a prismatic one slid along its axis.
-  if (type == JointKind::Revolute) j.childFrame = j.childFrame * Eigen::Quaterniond(Eigen::AngleAxisd(1.3, Eigen::Vector3d::UnitZ()));
-  if (type == JointKind::Prismatic) j.childAnchor += Eigen::Vector3d(0.05, 0.02, 0.4);
+  if (type == JointKind::Revolute || type == JointKind::Twist) j.childFrame = j.childFrame * Eigen::Quaterniond(Eigen::AngleAxisd(1.3, Eigen::Vector3d::UnitZ()));
+  if (type == JointKind::Prismatic || type == JointKind::Twist) j.childAnchor += Eigen::Vector3d(0.05, 0.02, 0.4);
   const JointRows rows = jointRows(j, bodies);
   const Vector6d rates = rowVelocities(rows, bodies);
   const double h = 1e-6;
@@ -88,7 +89,8 @@ double kinetic(const std::vector<ConstraintBody>& bodies) {
 }  // namespace
 
 TEST(JointConstraints, RowsAreTheRatesOfTheJointErrorForEveryType) {
-  for (JointKind t : {JointKind::Fixed, JointKind::Revolute, JointKind::Spherical, JointKind::Prismatic, JointKind::Universal})
+  for (JointKind t : {JointKind::Fixed, JointKind::Revolute, JointKind::Spherical, JointKind::Prismatic,
+                      JointKind::Universal, JointKind::Twist})
     checkRowsAreErrorRates(t);
 }
 
@@ -170,4 +172,51 @@ TEST(JointConstraints, RedundantLoopsAreFoundAtTheJointThatClosesThem) {
   EXPECT_EQ(firstRedundantJoint(ring(JointKind::Revolute, 3), bodies).joint, -1);
   // Fixed joints all round: the closing one repeats all six rows.
   EXPECT_EQ(firstRedundantJoint(ring(JointKind::Fixed, 4), bodies).redundantRows, 6);
+}
+
+// A body of mass 2 sliding at 1 m/s while falling at 0.5 m/s onto the ground, one contact point at
+// its centre (no lever arm): the normal row stops the fall with the impulse m * 0.5 = 1 N s,
+// friction 0.6 can take 0.6 N s of the slide's 2 N s, leaving 0.7 m/s; with friction 1 the
+// slide's 2 N s exceeds the cone's 1 N s as well, leaving 0.5 m/s.
+TEST(JointClosing, ContactRowsStopTheApproachAndHoldSlipWithinTheFrictionCone) {
+  for (const double mu : {0.6, 1.0}) {
+    std::vector<ConstraintBody> bodies(2);
+    bodies[1].invMass = 0.5;
+    bodies[1].invInertia = Eigen::Matrix3d::Identity();
+    bodies[1].x = Eigen::Vector3d(0, 1, 0);
+    bodies[1].v = Eigen::Vector3d(1, -0.5, 0);
+    ContactRow c;
+    c.a = 1, c.b = 0, c.point = bodies[1].x, c.normal = Eigen::Vector3d::UnitY(), c.friction = mu;
+    projectWithContacts({}, {c}, bodies, 50, 1e-12);
+    EXPECT_NEAR(bodies[1].v.y(), 0.0, 1e-12);
+    EXPECT_NEAR(bodies[1].v.x(), 1.0 - mu * 0.5, 1e-12) << "friction " << mu;
+    EXPECT_NEAR(bodies[1].w.norm(), 0.0, 1e-12);
+  }
+}
+
+// Two unit bodies on a ball joint 0.1 m apart, the child on a floor (a contact row that lets it
+// gain separation but not lose it), the parent below it (over a hole): closing the joint moves
+// the parent up to the child and not the child into the floor, where closeJoints alone moves
+// each half way.
+TEST(JointClosing, JointsCloseWithoutPushingBodiesIntoTheirContacts) {
+  std::vector<ConstraintBody> bodies(3);
+  for (int i : {1, 2}) {
+    bodies[i].invMass = 1;
+    bodies[i].invInertia = Eigen::Matrix3d::Identity();
+  }
+  bodies[1].x = Eigen::Vector3d(0, -0.1, 0);  // parent, its anchor at its centre
+  bodies[2].x = Eigen::Vector3d(0, 0, 0);    // child on the floor, anchor at its centre
+  JointDefinition j;
+  j.type = JointKind::Spherical;
+  j.parent = 1, j.child = 2;
+  ContactRow floor;
+  floor.a = 2, floor.b = 0, floor.point = bodies[2].x, floor.normal = Eigen::Vector3d::UnitY();
+  std::vector<ConstraintBody> free = bodies;
+  closeJoints({j}, free, false, 20, 1e-12);
+  EXPECT_NEAR(free[2].x.y(), -0.05, 1e-9);
+  const PreStabilizationReport r = closeJointsAgainstContacts({j}, bodies, {floor}, 50, false, 20, 1e-12);
+  EXPECT_NEAR(r.errorBefore, 0.1, 1e-12);
+  EXPECT_LT(r.errorAfter, 1e-12);
+  EXPECT_NEAR(bodies[2].x.y(), 0.0, 1e-9);
+  EXPECT_NEAR(bodies[1].x.y(), 0.0, 1e-9);
 }

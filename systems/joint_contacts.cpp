@@ -1,0 +1,145 @@
+// Interpenetration resolution of the jointed bodies (Step IV; not in the thesis): joints and
+// contacts in one position solve (solvers/articulation/joint_closing.h).
+#include <algorithm>
+
+#include "solvers/articulation/joint_closing.h"
+#include "solvers/collision/narrow_phase.h"
+#include "systems/articulation.h"
+#include "systems/contact_workspace.h"
+#include "systems/joint_assembly.h"
+
+namespace monolith {
+
+namespace {
+
+namespace col = solvers::collision;
+
+// Step V's contact points: those within 5 mm (a body falling for one step at dt = 1/30 moves
+// g dt^2 = 11 mm, one resting on another a few micrometres from it).
+constexpr double kStepFiveMargin = 5e-3;
+
+// Per body of `ws`: its body in the assembly if it is jointed and can move, else 0 (the world,
+// held still).
+std::vector<int> assemblyBodies(const JointAssembly& a, const ContactWorkspace<3>& ws) {
+  std::vector<int> bodyOf(ws.bodies.size(), 0);
+  for (std::size_t i = 0; i < ws.bodies.size(); ++i) {
+    const auto it = a.index.find(ws.entityOf(i).index);
+    if (it != a.index.end() && a.bodies[it->second].invMass > 0 && !ws.bodies[i].infinite()) bodyOf[i] = it->second;
+  }
+  return bodyOf;
+}
+
+// The contact points, within `margin`, of the pairs with a jointed body that can move: that body
+// at its pose in the assembly, the others at their base pose (where push-out left them in Step
+// IV, time n+1 in Step V; a static body's collision pose, grounded_box.h). `gainOf(depth)` is
+// the row's gain. With `partnerMotion`, a partner held still in the solve moves with its own
+// velocity at the point (Step V).
+template <typename GainOf>
+std::vector<solvers::ContactRow> contactRows(const JointAssembly& a, const ContactWorkspace<3>& ws,
+                                             const std::vector<int>& bodyOf, double margin, GainOf&& gainOf,
+                                             bool partnerMotion) {
+  auto poseOf = [&](std::size_t i) {
+    col::Pose<3> p = ws.bodies[i].candidate;
+    if (bodyOf[i] > 0) {
+      p.x = a.bodies[bodyOf[i]].x;
+      p.R = a.bodies[bodyOf[i]].q.toRotationMatrix();
+    } else if (!ws.bodies[i].still()) {
+      p.x = ws.bodies[i].x0;
+      p.R = ws.bodies[i].R0;
+    }
+    return p;
+  };
+  auto pointVelocity = [&](std::size_t i, const Eigen::Vector3d& point) -> Eigen::Vector3d {
+    const ContactBody<3>& b = ws.bodies[i];
+    if (!partnerMotion || b.still()) return Eigen::Vector3d::Zero();
+    return b.v + b.omega().cross(point - b.x0);
+  };
+  std::vector<solvers::ContactRow> rows;
+  std::vector<col::ContactPoint<3>> points;
+  col::ContactQuery query;
+  query.margin = margin;
+  for (const ContactPairState& p : ws.pairs) {
+    if (bodyOf[p.a] == 0 && bodyOf[p.b] == 0) continue;
+    points.clear();
+    col::findContacts(*ws.bodies[p.a].geometry, poseOf(p.a), *ws.bodies[p.b].geometry, poseOf(p.b), query, points);
+    for (const auto& cp : points) {
+      solvers::ContactRow r;
+      r.a = bodyOf[p.a];
+      r.b = bodyOf[p.b];
+      r.point = cp.point;
+      r.normal = cp.normal;
+      r.gain = gainOf(cp.depth);
+      r.friction = std::min(ws.bodies[p.a].friction, ws.bodies[p.b].friction);
+      if (r.a == 0) r.offset += pointVelocity(p.a, cp.point);
+      if (r.b == 0) r.offset -= pointVelocity(p.b, cp.point);
+      rows.push_back(r);
+    }
+  }
+  return rows;
+}
+
+}  // namespace
+
+void postStabilizeWithContacts(World<3>& world, const ContactWorkspace<3>& ws, StepContext& ctx) {
+  const ArticulationSolver s = articulationSettings(world);
+  JointAssembly a(world);
+  const std::vector<int> bodyOf = assemblyBodies(a, ws);
+  const double dt = ws.dt;
+  // Touching or overlapping: no approach (push-out's business); apart: the gap in one step.
+  const std::vector<solvers::ContactRow> contacts =
+      contactRows(a, ws, bodyOf, kStepFiveMargin, [&](double depth) { return std::min(0.0, depth / dt); }, true);
+  const solvers::ProjectionReport r =
+      solvers::projectWithContacts(a.rows(), contacts, a.bodies, s.postIterations, s.postTolerance);
+  a.writeBack();
+  ctx.diagnostics.set("joint_step_v_contacts", static_cast<double>(contacts.size()));
+  ctx.diagnostics.max("joint_post_iterations", r.iterations);
+}
+
+void resolveJointedInterpenetration(World<3>& world, ContactWorkspace<3>& ws, StepContext& ctx) {
+  const ArticulationSolver s = articulationSettings(world);
+  JointAssembly a(world);
+  const std::vector<int> bodyOf = assemblyBodies(a, ws);
+  // The joint error push-out's own poses would leave.
+  std::vector<solvers::ConstraintBody> pushed = a.bodies;
+  {
+    for (std::size_t i = 0; i < ws.bodies.size(); ++i)
+      if (bodyOf[i] > 0) pushed[bodyOf[i]].x = ws.bodies[i].x0, pushed[bodyOf[i]].q = ws.bodies[i].q0;
+    double open = 0;
+    for (const auto& def : a.joints) {
+      const solvers::JointError e =
+          solvers::jointError(def, pushed[def.parent].x, pushed[def.parent].q, pushed[def.child].x, pushed[def.child].q);
+      open = std::max(open, e.linear.norm());
+    }
+    ctx.diagnostics.max("joint_push_out_error", open);
+  }
+  std::vector<solvers::ContactRow> contacts;
+  if (s.pushOutContactSweeps == 0) {
+    a.bodies = pushed;  // closed from where push-out left them, contacts unseen
+  } else {
+    // Points up to twice the deepest overlap apart (the displacements are of that size), found
+    // again with that margin.
+    const double allowed = ws.settings.pushOutTolerance;
+    double deepest = 0;
+    // A row asks the displacements to take away the overlap beyond what push-out accepts; a
+    // point apart by a gap may approach by it.
+    auto gainOf = [&](double depth) { return depth - allowed; };
+    for (const auto& c : contactRows(a, ws, bodyOf, 0.0, gainOf, false)) deepest = std::max(deepest, c.gain + allowed);
+    if (deepest > allowed) contacts = contactRows(a, ws, bodyOf, 2 * deepest, gainOf, false);
+  }
+  const solvers::PreStabilizationReport r = solvers::closeJointsAgainstContacts(
+      a.joints, a.bodies, contacts, s.pushOutContactSweeps, s.pre == ArticulationSolver::Method::Global,
+      s.preIterations, s.preTolerance);
+  for (std::size_t i = 0; i < ws.bodies.size(); ++i) {
+    if (bodyOf[i] == 0) continue;
+    ContactBody<3>& b = ws.bodies[i];
+    b.x0 = a.bodies[bodyOf[i]].x;
+    b.q0 = a.bodies[bodyOf[i]].q;
+    b.R0 = b.q0.toRotationMatrix();
+    b.candidate.x = b.x0;
+    b.candidate.R = b.R0;
+  }
+  ctx.diagnostics.set("joint_push_out_contacts", static_cast<double>(contacts.size()));
+  ctx.diagnostics.set("joint_push_out_error_left", r.errorAfter);
+}
+
+}  // namespace monolith
