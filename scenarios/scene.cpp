@@ -452,7 +452,7 @@ void parseContactSettings(const Config& c, ContactSettings& s) {
     value = static_cast<int>(c.integer(key, value, min, 100000));
   };
   // The schedule first: the keys below adjust it.
-  if (c.oneOf("schedule", {"thesis", "short"}, "thesis") == "short") s.useShortSchedule();
+  if (c.oneOf("schedule", {"thesis", "short"}, "short") == "thesis") s.useThesisSchedule();
   count("collision_iterations", s.collisionIterations, 0);
   count("collision_pair_iterations", s.collisionPairIterations, 1);
   count("contact_iterations", s.contactIterations, 0);
@@ -473,6 +473,7 @@ void parseContactSettings(const Config& c, ContactSettings& s) {
   s.velocityContact = c.boolean("velocity_contact", s.velocityContact);
   s.energyClamp = c.boolean("energy_clamp", s.energyClamp);
   s.stepEnergyClamp = c.boolean("step_energy_clamp", s.stepEnergyClamp);
+  s.closeGaps = c.boolean("close_gaps", s.closeGaps);
   s.sweptCollisions = c.boolean("swept_collisions", s.sweptCollisions);
   s.thickness = c.number("thickness", s.thickness, Bound::NonNegative);
   s.pushOutTolerance = c.number("push_out_tolerance", s.pushOutTolerance, Bound::NonNegative);
