@@ -697,7 +697,8 @@ typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
     const double vn = vrel.dot(p.n);
     // Collisions keep the thesis's test: they meet the time-n velocity, not the one the
     // candidates moved with, and a body they stop above a gap falls through it in contact.
-    const double closable = closableNormalVelocity(settings.closeGaps && !collision, c.depth, vn, dt, settings.pushOutTolerance);
+    const double closable =
+        closableNormalVelocity(settings.closeGaps && !collision, c.depth, vn, dt, settings.pushOutTolerance);
     const bool approaching = vn < closable - settings.approachTolerance;
     anyApproaching = anyApproaching || approaching;
     if (allowance > 0) {

@@ -87,11 +87,11 @@ TEST(ContactGaps, ABoxDroppedAFewMillimetresOntoAShelfLandsOnTheShortSchedule) {
   }
 }
 
-TEST(ContactGaps, TheDefaultScheduleClosesGapsAndTheThesisScheduleClosesThemByItsSweeps) {
-  // The default is the short schedule; the thesis's ten epsilon-ramped sweeps close such a gap
-  // approximately (to 0.1 mm), without closeGaps.
+TEST(ContactGaps, TheThesisScheduleTheDefaultClosesSuchGapsByItsSweeps) {
+  // The thesis's ten epsilon-ramped sweeps close such a gap approximately (to 0.1 mm), without
+  // closeGaps: each removes only part of the approach, the next sees what is left of the gap.
   const std::string scene = boxOnShelf(3e-3, false);
-  EXPECT_NEAR(finalY<3>(scene, {}, "box") - 2.22, 0.0, kLanded);
+  EXPECT_NEAR(finalY<3>(scene, {}, "box") - 2.22, 0.0, 2e-4);
   EXPECT_NEAR(finalY<3>(scene, {{"solvers.contact.schedule", "thesis"}}, "box") - 2.22, 0.0, 2e-4);
 }
 

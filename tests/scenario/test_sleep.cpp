@@ -156,8 +156,7 @@ constexpr const char* kLateElevator = R"({ "dimension": 3, "time": { "dt": 0.033
 // sleeping box's and wakes it, and the box rides up with it (the elevator test's criterion).
 TEST(Sleep, AKinematicPlatformWakesTheBoxOnItWhenItStartsToMove) {
   const Registry registry = builtins();
-  // On both schedules (without closing gaps the short one, the default, left the box resting
-  // 4.5 mm above the platform, stopped in the air by its one fully inelastic contact pass).
+  // On both schedules (without closing gaps the short one left the box resting 4.5 mm above the platform, stopped in the air by its one fully inelastic contact pass).
   for (const char* schedule : {"thesis", "short"}) {
     SCOPED_TRACE(schedule);
     Simulation<3> sim(parseScene(kLateElevator, "late_elevator.json", {{"solvers.contact.schedule", schedule}}),
