@@ -28,6 +28,7 @@ using namespace monolith;
 namespace {
 using test::builtins;
 
+using Overrides = std::vector<std::pair<std::string, std::string>>;
 constexpr double kLanded = 1e-5;  // ContactSettings::pushOutTolerance
 
 template <int d>
@@ -38,8 +39,7 @@ const RigidBody<d>& body(Simulation<d>& sim, const std::string& name) {
 // Runs the scene to its end and returns the y of `name` (the largest total-energy rise over the
 // start, relative to the start's |E|, in `rise`).
 template <int d>
-double finalY(const std::string& text, const std::vector<std::pair<std::string, std::string>>& overrides, const std::string& name,
-              double* rise = nullptr) {
+double finalY(const std::string& text, const Overrides& overrides, const std::string& name, double* rise = nullptr) {
   const Registry registry = builtins();
   Simulation<d> sim(parseScene(text, "gap.json", overrides), registry);
   double first = 0, worst = 0;
@@ -105,9 +105,8 @@ TEST(ContactGaps, ADiskDroppedAFewMillimetresOntoABarLandsOnTheShortSchedule) {
          "rigid_body": {"mass": 1, "position": [0.05, )" + std::to_string(2.11 + gap) +
                               R"(]}, "collider": {"restitution": 0, "friction": 0.5}}]})";
     EXPECT_NEAR(finalY<2>(scene, {{"solvers.contact.schedule", "short"}}, "disk") - 2.11, 0.0, kLanded) << gap;
-    EXPECT_GT(finalY<2>(scene, {{"solvers.contact.schedule", "short"}, {"solvers.contact.close_gaps", "false"}}, "disk") -
-                  2.11,
-              0.5 * gap);
+    const Overrides open = {{"solvers.contact.schedule", "short"}, {"solvers.contact.close_gaps", "false"}};
+    EXPECT_GT(finalY<2>(scene, open, "disk") - 2.11, 0.5 * gap) << "without closing gaps the disk stops in the air";
   }
 }
 
