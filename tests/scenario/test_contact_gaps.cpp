@@ -11,11 +11,11 @@
 #include <gtest/gtest.h>
 
 #include "support/scenes.h"
+#include "support/unit_cube_obj.h"
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <utility>
 #include <vector>
 #include <string>
@@ -115,12 +115,7 @@ TEST(ContactGaps, ABoxDroppedAFewMillimetresOntoADynamicMeshCubeLandsOnTheShortS
   // 1/30 (the mesh's triangles against the box: FCL per triangle plus the feature points).
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "monolith_contact_gaps_mesh";
   std::filesystem::create_directories(dir);
-  {
-    std::ofstream obj(dir / "cube.obj");
-    obj << "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\n"
-           "v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n"
-           "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 4 8 7\nf 4 7 3\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\n";
-  }
+  test::writeUnitCubeObj(dir / "cube.obj");
   const std::string scene = R"({"dimension": 3, "time": {"dt": 0.03333333333333333, "end": 1.5}, "gravity": [0, -9.81, 0],
       "entities": [
         {"name": "ground", "shape": {"type": "plane", "normal": [0, 1, 0]}, "rigid_body": {"static": true},

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "support/scenes.h"
+#include "support/unit_cube_obj.h"
 
 #include <Eigen/Geometry>
 
@@ -1169,11 +1170,8 @@ TEST(MeshGround, ADynamicMeshCubeRestsAsTheBoxItBounds) {
   // (box_box.cpp): the two stacks must come to rest at the same heights and stay put.
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "monolith_dynamic_mesh";
   std::filesystem::create_directories(dir);
+  test::writeUnitCubeObj(dir / "cube.obj");
   {
-    std::ofstream obj(dir / "cube.obj");
-    obj << "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\n"
-           "v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n"
-           "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 4 8 7\nf 4 7 3\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\n";
     std::ofstream scene(dir / "scene.json");
     scene << R"({"dimension": 3, "time": {"dt": 0.016666666666666666, "end": 4}, "gravity": [0, -9.81, 0],
       "entities": [
