@@ -67,8 +67,8 @@ struct FluidSolverSettings {
 // The defaults are the thesis code's schedule (notes 1.4, 1.6, 1.7). `"schedule": "short"`
 // (useShortSchedule, docs/rigid_contact.md) is one contact sweep of one level pass, one
 // shock-propagation pass, exact manifold solves, contact that lets a gap close in the step and
-// the step energy clamp: 12-15x cheaper per awake step, not the default because one 2-D random
-// drop in 3000 still sinks deeper than 5 % for a step on it (docs/rigid_contact.md).
+// the step energy clamp: 12-15x cheaper per awake step, not the default because 2-D random
+// drops still sink deeper than 5 % for a step on it (2 of 838; docs/rigid_contact.md).
 struct ContactSettings {
   int collisionIterations = 5;       // Gauss-Seidel sweeps over the pairs (Step II)
   int collisionPairIterations = 20;  // impulses per pair per sweep

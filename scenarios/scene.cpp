@@ -452,9 +452,7 @@ void parseContactSettings(const Config& c, ContactSettings& s) {
     value = static_cast<int>(c.integer(key, value, min, 100000));
   };
   // The schedule first: the keys below adjust it.
-  const std::string schedule = c.oneOf("schedule", {"thesis", "short"}, "thesis");
-  if (schedule == "short") s.useShortSchedule();
-  else s.useThesisSchedule();
+  if (c.oneOf("schedule", {"thesis", "short"}, "thesis") == "short") s.useShortSchedule();
   count("collision_iterations", s.collisionIterations, 0);
   count("collision_pair_iterations", s.collisionPairIterations, 1);
   count("contact_iterations", s.contactIterations, 0);
