@@ -473,6 +473,7 @@ void parseContactSettings(const Config& c, ContactSettings& s) {
   s.velocityContact = c.boolean("velocity_contact", s.velocityContact);
   s.energyClamp = c.boolean("energy_clamp", s.energyClamp);
   s.stepEnergyClamp = c.boolean("step_energy_clamp", s.stepEnergyClamp);
+  s.closeGaps = c.boolean("close_gaps", s.closeGaps);
   s.sweptCollisions = c.boolean("swept_collisions", s.sweptCollisions);
   s.thickness = c.number("thickness", s.thickness, Bound::NonNegative);
   s.pushOutTolerance = c.number("push_out_tolerance", s.pushOutTolerance, Bound::NonNegative);

@@ -156,22 +156,24 @@ constexpr const char* kLateElevator = R"({ "dimension": 3, "time": { "dt": 0.033
 // sleeping box's and wakes it, and the box rides up with it (the elevator test's criterion).
 TEST(Sleep, AKinematicPlatformWakesTheBoxOnItWhenItStartsToMove) {
   const Registry registry = builtins();
-  // On the thesis's schedule: on the short one the box comes to rest 4.5 mm above
-  // the platform, stopped in the air by the one fully inelastic contact pass
-  // (docs/rigid_contact.md, "Not done").
-  Simulation<3> sim(parseScene(kLateElevator, "late_elevator.json", {{"solvers.contact.schedule", "thesis"}}), registry);
-  double asleepAt14 = -1, wokenAfter = 0, worstRelative = 0;
-  while (!sim.finished()) {
-    const auto& diag = sim.step();
-    if (std::abs(sim.time() - 1.4) < 1e-9) asleepAt14 = diag.at("bodies_asleep");
-    if (sim.time() > 1.45) wokenAfter += diagnostic(diag, "bodies_woken");
-    if (sim.time() > 2.0)
-      worstRelative = std::max(worstRelative, (bodyNamed(sim, "box").v - bodyNamed(sim, "platform").v).norm());
+  // On both schedules (without closing gaps the short one left the box resting 4.5 mm above the platform, stopped in the air by its one fully inelastic contact pass).
+  for (const char* schedule : {"thesis", "short"}) {
+    SCOPED_TRACE(schedule);
+    Simulation<3> sim(parseScene(kLateElevator, "late_elevator.json", {{"solvers.contact.schedule", schedule}}),
+                      registry);
+    double asleepAt14 = -1, wokenAfter = 0, worstRelative = 0;
+    while (!sim.finished()) {
+      const auto& diag = sim.step();
+      if (std::abs(sim.time() - 1.4) < 1e-9) asleepAt14 = diag.at("bodies_asleep");
+      if (sim.time() > 1.45) wokenAfter += diagnostic(diag, "bodies_woken");
+      if (sim.time() > 2.0)
+        worstRelative = std::max(worstRelative, (bodyNamed(sim, "box").v - bodyNamed(sim, "platform").v).norm());
+    }
+    EXPECT_EQ(asleepAt14, 1);
+    EXPECT_EQ(wokenAfter, 1);
+    EXPECT_LT(worstRelative, 1e-3);
+    EXPECT_NEAR(bodyNamed(sim, "box").x.y() - bodyNamed(sim, "platform").x.y(), 0.75, 2e-3);
   }
-  EXPECT_EQ(asleepAt14, 1);
-  EXPECT_EQ(wokenAfter, 1);
-  EXPECT_LT(worstRelative, 1e-3);
-  EXPECT_NEAR(bodyNamed(sim, "box").x.y() - bodyNamed(sim, "platform").x.y(), 0.75, 2e-3);
 }
 
 // box_stack_scatter (Fig. 2.2) with sleeping: the dropped stack falls asleep, the boulder wakes
@@ -180,7 +182,9 @@ TEST(Sleep, AKinematicPlatformWakesTheBoxOnItWhenItStartsToMove) {
 // kinetic energy), and 1 and 2 threads agree bitwise.
 TEST(Sleep, ABoulderWakesTheSleepingStackWholeAndTheRulesHold) {
   const Registry registry = builtins();
-  const SceneSpec scene = loadScene(kScenes + "box_stack_scatter.json", {{"solvers.contact.sleep", "true"}});
+  // The thesis's schedule, whose overlap the 1 % bound was set for (BoxStackScatter.*).
+  const SceneSpec scene = loadScene(kScenes + "box_stack_scatter.json",
+                                    {{"solvers.contact.schedule", "thesis"}, {"solvers.contact.sleep", "true"}});
   Simulation<3> one(scene, registry, 1), two(scene, registry, 2);
   double mostAsleep = 0, mostWokenAtOnce = 0, worstOverlap = 0, worstGain = 0;
   while (!one.finished()) {
