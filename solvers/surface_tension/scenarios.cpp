@@ -122,9 +122,10 @@ StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double e
   return r;
 }
 
-OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTime) {
-  const double dx = 1.0 / n, dt = 0.25 * dx, rhat = 1.0 / 3, omega = 2.0;
-  const int points = static_cast<int>(std::lround(2 * M_PI * rhat / dx));
+OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTime, int points, bool remesh,
+                                             double dtPerDx, bool carryCouplingVelocity) {
+  const double dx = 1.0 / n, dt = dtPerDx * dx, rhat = 1.0 / 3, omega = 2.0;
+  if (points <= 0) points = static_cast<int>(std::lround(2 * M_PI * rhat / dx));
   TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(n, n), dx),
                                           perturbedCircle(Eigen::Vector2d(0.5, 0.5), rhat, epsilon, 2, points));
   TwoPhaseSettings settings;
@@ -132,7 +133,10 @@ OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTi
   settings.onePhase = true;
   settings.sigma = 2.0 / 3;
   settings.blowUpSpeed = 10;
+  settings.remesh = remesh;
+  settings.carryCouplingVelocity = carryCouplingVelocity;
   OscillatingCircleResult r;
+  r.points = points;
   const Eigen::Vector2d probe(0.75, 0.5);
   double previousTime = 0, previousU = 0;
   int crossings = 0;
@@ -162,6 +166,8 @@ OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTi
         worst = std::max(worst, std::abs(state.u[f] - exact));
       }
       r.relativeErrorAtHalf = worst / scale;
+      const double probeExact = -epsilon * omega * (probe.x() - 0.5) * std::sin(omega * state.time);
+      r.probeRelativeErrorAtHalf = std::abs(u - probeExact) / scale;
     }
     if (state.step > 1 && (previousU < 0) != (u < 0)) {
       ++crossings;
@@ -239,6 +245,7 @@ RisingBubbleRun runRisingBubble(int n, double endTime, double sampleEvery, doubl
     s.riseVelocity = riseVelocity;
     s.circularity = shape.circularity;
     s.areaDrift = shape.area / area0 - 1;
+    s.front = state.front;
     run.samples.push_back(s);
   };
   sample(0);

@@ -365,6 +365,24 @@ int advectionSubsteps(const MacLayout<2>& layout, const Eigen::VectorXd& u, doub
   return std::max(1, static_cast<int>(std::ceil(cfl / cflBound)));
 }
 
+// u* of each coupling face i from the front points' carried velocities v_k:
+// n^_i . sum_k w_ik v_k / sum_k w_ik, w_ik the weights of H^T (6.38; H^T_{i,k} = w_ik n^_i), plus
+// the gravity increment. A face whose weights vanish keeps its sampled u*.
+void carriedCouplingVelocities(const InterfaceDiscretization& D, const std::vector<Eigen::Vector2d>& v,
+                               const Eigen::Vector2d& gravityIncrement, Eigen::VectorXd& ustar) {
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = D.Ht;
+  for (int q = D.gridUnknowns; q < rows.rows(); ++q) {
+    const Eigen::Vector2d& normal = D.couplingNormal[q - D.gridUnknowns];
+    double weight = 0, sum = 0;
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(rows, q); it; ++it) {
+      const int k = static_cast<int>(it.col()) / 2, axis = static_cast<int>(it.col()) % 2;
+      weight += it.value() * normal[axis];
+      sum += it.value() * v[k][axis];
+    }
+    if (weight > 1e-12) ustar[q] = sum / weight + gravityIncrement.dot(normal);
+  }
+}
+
 // Marks the step as blown up, with a reason that names the variant ("implicit surface tension blew
 // up ..."); `write` appends when and why.
 template <class Write>
@@ -433,6 +451,9 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
     const Eigen::Vector2d velocity(sampleFaceVelocity(layout, u, 0, x), sampleFaceVelocity(layout, u, 1, x));
     ustar[q] = velocity.dot(D.couplingNormal[k]) + dt * settings.gravity.dot(D.couplingNormal[k]);
   }
+  if (settings.carryCouplingVelocity && !settings.levelSetFront && !state.pointVelocity.empty() &&
+      static_cast<int>(state.pointVelocity.size()) == state.front.pointCount())
+    carriedCouplingVelocities(D, state.pointVelocity, dt * settings.gravity, ustar);
   if (settings.sigma > 0) {
     const auto forces = surfaceTensionForces(state.front, settings.sigma);
     Eigen::VectorXd f(2 * forces.size());
@@ -516,6 +537,9 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
     for (int k = 0; k < state.front.pointCount(); ++k) state.front.points[k] += dt * v.segment<2>(2 * k);
     if (settings.remesh)
       report.remeshChanges = remeshClosedFront(state.front, settings.minSegment * dx, settings.maxSegment * dx);
+    state.pointVelocity.clear();
+    if (settings.carryCouplingVelocity && report.remeshChanges == 0)
+      for (int k = 0; k < state.front.pointCount(); ++k) state.pointVelocity.push_back(v.segment<2>(2 * k));
   }
   state.time += dt;
   ++state.step;
