@@ -20,26 +20,35 @@ double sampleCells(const MacLayout<2>& layout, const std::vector<double>& phi, c
 Eigen::Vector2d velocityAt(const MacLayout<2>& layout, const Eigen::VectorXd& u, const Eigen::Vector2d& x) {
   return {sampleFaceVelocity(layout, u, 0, x), sampleFaceVelocity(layout, u, 1, x)};
 }
-double segmentDistance(const Eigen::Vector2d& x, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+// The closest point of segment ab to x: its parameter t in [0, 1] along ab, and the distance.
+struct ClosestOnSegment {
+  double t, distance;
+};
+ClosestOnSegment closestOnSegment(const Eigen::Vector2d& x, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   const Eigen::Vector2d e = b - a;
   const double t = std::clamp((x - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
-  return (x - (a + t * e)).norm();
+  return {t, (x - (a + t * e)).norm()};
+}
+// Calls visit(c, x) for each cell c (centre x) in the bounding box of segment ab grown by band + 1
+// cells: every cell within band dx of the segment.
+template <class Visit>
+void forCellsNearSegment(const MacLayout<2>& layout, const Eigen::Vector2d& a, const Eigen::Vector2d& b, double band,
+                         Visit visit) {
+  const Eigen::Vector2d lo = (a.cwiseMin(b) - layout.origin) / layout.dx - Eigen::Vector2d::Constant(band + 1);
+  const Eigen::Vector2d hi = (a.cwiseMax(b) - layout.origin) / layout.dx + Eigen::Vector2d::Constant(band + 1);
+  const int i0 = std::max(0, static_cast<int>(std::floor(lo.x()))), i1 = std::min(layout.cells.x() - 1, static_cast<int>(hi.x()));
+  const int j0 = std::max(0, static_cast<int>(std::floor(lo.y()))), j1 = std::min(layout.cells.y() - 1, static_cast<int>(hi.y()));
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i) visit(layout.cellIndex(Eigen::Vector2i(i, j)), layout.cellCenter(Eigen::Vector2i(i, j)));
 }
 // Unsigned distance to the front within the band, band dx beyond it.
 std::vector<double> bandDistance(const MacLayout<2>& layout, const Front2& front, double band) {
-  const double reach = band * layout.dx;
-  std::vector<double> distance(layout.cellCount(), reach);
+  std::vector<double> distance(layout.cellCount(), band * layout.dx);
   for (const auto& e : front.elements) {
     const Eigen::Vector2d a = front.points[e[0]], b = front.points[e[1]];
-    const Eigen::Vector2d lo = (a.cwiseMin(b) - layout.origin) / layout.dx - Eigen::Vector2d::Constant(band + 1);
-    const Eigen::Vector2d hi = (a.cwiseMax(b) - layout.origin) / layout.dx + Eigen::Vector2d::Constant(band + 1);
-    const int i0 = std::max(0, static_cast<int>(std::floor(lo.x()))), i1 = std::min(layout.cells.x() - 1, static_cast<int>(hi.x()));
-    const int j0 = std::max(0, static_cast<int>(std::floor(lo.y()))), j1 = std::min(layout.cells.y() - 1, static_cast<int>(hi.y()));
-    for (int j = j0; j <= j1; ++j)
-      for (int i = i0; i <= i1; ++i) {
-        const int c = layout.cellIndex(Eigen::Vector2i(i, j));
-        distance[c] = std::min(distance[c], segmentDistance(layout.cellCenter(Eigen::Vector2i(i, j)), a, b));
-      }
+    forCellsNearSegment(layout, a, b, band, [&](int c, const Eigen::Vector2d& x) {
+      distance[c] = std::min(distance[c], closestOnSegment(x, a, b).distance);
+    });
   }
   return distance;
 }
@@ -67,22 +76,13 @@ void moveLevelSetWithFront(const MacLayout<2>& layout, const Front2& front, cons
     const double length = edge.norm();
     if (!(length > 0)) continue;
     const Eigen::Vector2d normal(edge.y() / length, -edge.x() / length);  // outward: R t
-    const Eigen::Vector2d lo = (a.cwiseMin(b) - layout.origin) / layout.dx - Eigen::Vector2d::Constant(band + 1);
-    const Eigen::Vector2d hi = (a.cwiseMax(b) - layout.origin) / layout.dx + Eigen::Vector2d::Constant(band + 1);
-    const int i0 = std::max(0, static_cast<int>(std::floor(lo.x()))), i1 = std::min(layout.cells.x() - 1, static_cast<int>(hi.x()));
-    const int j0 = std::max(0, static_cast<int>(std::floor(lo.y()))), j1 = std::min(layout.cells.y() - 1, static_cast<int>(hi.y()));
-    for (int j = j0; j <= j1; ++j)
-      for (int i = i0; i <= i1; ++i) {
-        const int c = layout.cellIndex(Eigen::Vector2i(i, j));
-        const Eigen::Vector2d x = layout.cellCenter(Eigen::Vector2i(i, j));
-        const double t = std::clamp((x - a).dot(edge) / edge.squaredNorm(), 0.0, 1.0);
-        const double distance = (x - (a + t * edge)).norm();
-        if (distance >= best[c] && found[c]) continue;
-        if (distance > reach) continue;
-        best[c] = distance;
-        found[c] = 1;
-        speed[c] = ((1 - t) * velocity[e[0]] + t * velocity[e[1]]).dot(normal);
-      }
+    forCellsNearSegment(layout, a, b, band, [&](int c, const Eigen::Vector2d& x) {
+      const auto [t, distance] = closestOnSegment(x, a, b);
+      if ((distance >= best[c] && found[c]) || distance > reach) return;
+      best[c] = distance;
+      found[c] = 1;
+      speed[c] = ((1 - t) * velocity[e[0]] + t * velocity[e[1]]).dot(normal);
+    });
   }
   for (int c = 0; c < layout.cellCount(); ++c)
     if (found[c]) phi[c] -= dt * speed[c];

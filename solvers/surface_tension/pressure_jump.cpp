@@ -6,8 +6,10 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "solvers/advection/semi_lagrangian.h"
+#include "solvers/surface_tension/face_extrapolation.h"
 #include "solvers/surface_tension/front.h"
 #include "solvers/surface_tension/level_set_front.h"
 #include "solvers/surface_tension/level_set_tracking.h"
@@ -37,12 +39,10 @@ std::vector<double> levelSetCurvature(const MacLayout<2>& layout, const std::vec
 }
 
 namespace {
-// Air faces (no fluid cell on either side) take the mean of their known same-axis neighbours,
-// layer by layer; walls stay 0.
+// Air faces (no fluid cell on either side) get velocities from their fluid neighbours; walls stay 0.
 void extrapolateVelocity(const MacLayout<2>& layout, const std::vector<char>& fluid, Eigen::VectorXd& u) {
-  const int nf = layout.totalFaces();
-  std::vector<char> known(nf, 0);
-  for (int f = 0; f < nf; ++f) {
+  std::vector<char> known(layout.totalFaces(), 0);
+  for (int f = 0; f < layout.totalFaces(); ++f) {
     const auto [axis, idx] = layout.faceCoord(f);
     if (idx[axis] == 0 || idx[axis] == layout.cells[axis]) {
       known[f] = 1;
@@ -51,30 +51,8 @@ void extrapolateVelocity(const MacLayout<2>& layout, const std::vector<char>& fl
     Index2 lower = idx;
     lower[axis] -= 1;
     known[f] = fluid[layout.cellIndex(idx)] || fluid[layout.cellIndex(lower)];
-    if (!known[f]) u[f] = 0;
   }
-  for (int layer = 0; layer < 4; ++layer) {
-    Eigen::VectorXd next = u;
-    std::vector<int> filled;
-    for (int f = 0; f < nf; ++f) {
-      if (known[f]) continue;
-      const auto [axis, idx] = layout.faceCoord(f);
-      const Index2 dims = layout.faceDims(axis);
-      double sum = 0;
-      int count = 0;
-      for (int b = 0; b < 2; ++b)
-        for (int dir : {-1, 1}) {
-          Index2 m = idx;
-          m[b] += dir;
-          if (m[b] < 0 || m[b] >= dims[b]) continue;
-          const int o = layout.faceIndex(axis, m);
-          if (known[o]) sum += u[o], ++count;
-        }
-      if (count > 0) next[f] = sum / count, filled.push_back(f);
-    }
-    u = next;
-    for (int f : filled) known[f] = 1;
-  }
+  extrapolateToUnknownFaces(layout, std::move(known), u);
 }
 }  // namespace
 

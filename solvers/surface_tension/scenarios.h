@@ -49,13 +49,17 @@ TwoPhaseSettings staticCircleSettings(bool onePhase, bool implicit);
 // sigma = 2/3, mu = 0, one phase (omega^2 = sigma (m^2 - 1) m / (rho r^3) is the drop's; T = pi).
 // dt = dx / 4 (not stated in the thesis). The probe p1 at (0.75, 0.5) samples u_x; the period is
 // the time of its second zero crossing (u_x ~ -sin(omega t)). The relative error at t = 0.5 is the
-// max over the faces inside the drop of |u - u_analytic| / (eps omega r |sin omega t|).
+// max over the faces inside the drop of |u - u_analytic| / (eps omega r |sin omega t|); the probe's
+// relative error is its |u_x - u_analytic| on the same scale.
+// The front: `points` points (0: one per dx of arc), remeshed or not. dtPerDx: dt / dx.
+// carryCouplingVelocity: TwoPhaseSettings::carryCouplingVelocity.
 struct OscillatingCircleResult {
-  double period = 0, probeAtHalf = 0, relativeErrorAtHalf = 0;
-  int steps = 0;
+  double period = 0, probeAtHalf = 0, relativeErrorAtHalf = 0, probeRelativeErrorAtHalf = 0;
+  int steps = 0, points = 0;
   bool stable = true;
 };
-OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTime);
+OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTime, int points = 0, bool remesh = true,
+                                             double dtPerDx = 0.25, bool carryCouplingVelocity = false);
 
 // Sec. 6.4.4: [0, 1] x [0, 2] m with n x 2n cells, an air bubble (rho 1e3) of r = 0.2 m at (0.5, 0.5)
 // in water (rho 1e4), mu = 1, sigma = 0.5, g = -8e-4, semi-Lagrangian or ENO/RK3 advection. `steps` steps of dt;
@@ -82,6 +86,7 @@ RisingBubbleStability runRisingBubbleStability(int n, double dt, bool implicit, 
 // level-set-tracked front.
 struct RisingBubbleSample {
   double time = 0, top = 0, bottom = 0, centroidY = 0, riseVelocity = 0, circularity = 0, areaDrift = 0;
+  Front2 front;  // the front at that time, for measures taken afterwards
 };
 struct RisingBubbleRun {
   std::vector<RisingBubbleSample> samples;

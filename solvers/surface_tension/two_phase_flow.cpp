@@ -6,9 +6,11 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "solvers/advection/eno.h"
 #include "solvers/advection/semi_lagrangian.h"
+#include "solvers/surface_tension/face_extrapolation.h"
 #include "solvers/surface_tension/level_set_front.h"
 #include "solvers/surface_tension/level_set_tracking.h"
 
@@ -345,48 +347,51 @@ InterfaceDiscretization discretizeInterface(const MacLayout<2>& layout, const Fr
 
 namespace {
 
-// One phase: give the air faces velocities for the advection by averaging their known same-axis
-// neighbours, layer by layer (a few layers; the rest stays zero).
+// One phase: give the air faces velocities for the advection from their known neighbours
+// (face_extrapolation.h).
 void extrapolateToAir(const MacLayout<2>& layout, const InterfaceDiscretization& D, Eigen::VectorXd& u) {
-  const int nf = layout.totalFaces();
-  std::vector<char> known(nf, 0);
-  for (int f = 0; f < nf; ++f) {
+  std::vector<char> known(layout.totalFaces(), 0);
+  for (int f = 0; f < layout.totalFaces(); ++f) {
     const auto [axis, idx] = layout.faceCoord(f);
     known[f] = D.faceUnknown[f] >= 0 || idx[axis] == 0 || idx[axis] == layout.cells[axis];
-    if (!known[f]) u[f] = 0;
   }
-  for (int layer = 0; layer < 4; ++layer) {
-    std::vector<int> filled;
-    Eigen::VectorXd next = u;
-    for (int f = 0; f < nf; ++f) {
-      if (known[f]) continue;
-      const auto [axis, idx] = layout.faceCoord(f);
-      const Index2 dims = layout.faceDims(axis);
-      double sum = 0;
-      int count = 0;
-      for (int b = 0; b < 2; ++b)
-        for (int dir : {-1, 1}) {
-          Index2 m = idx;
-          m[b] += dir;
-          if (m[b] < 0 || m[b] >= dims[b]) continue;
-          const int o = layout.faceIndex(axis, m);
-          if (known[o]) sum += u[o], ++count;
-        }
-      if (count > 0) next[f] = sum / count, filled.push_back(f);
-    }
-    u = next;
-    for (int f : filled) known[f] = 1;
-  }
+  extrapolateToUnknownFaces(layout, std::move(known), u);
 }
 
-}  // namespace
-
-namespace {
 // ENO/RK3 is stable up to CFL ~1: with a CFL bound, the step is split into that many substeps.
 int advectionSubsteps(const MacLayout<2>& layout, const Eigen::VectorXd& u, double dt, double cflBound) {
   if (!(cflBound > 0) || u.size() == 0) return 1;
   const double cfl = u.cwiseAbs().maxCoeff() * dt / layout.dx;
   return std::max(1, static_cast<int>(std::ceil(cfl / cflBound)));
+}
+
+// u* of each coupling face i from the front points' carried velocities v_k:
+// n^_i . sum_k w_ik v_k / sum_k w_ik, w_ik the weights of H^T (6.38; H^T_{i,k} = w_ik n^_i), plus
+// the gravity increment. A face whose weights vanish keeps its sampled u*.
+void carriedCouplingVelocities(const InterfaceDiscretization& D, const std::vector<Eigen::Vector2d>& v,
+                               const Eigen::Vector2d& gravityIncrement, Eigen::VectorXd& ustar) {
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = D.Ht;
+  for (int q = D.gridUnknowns; q < rows.rows(); ++q) {
+    const Eigen::Vector2d& normal = D.couplingNormal[q - D.gridUnknowns];
+    double weight = 0, sum = 0;
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(rows, q); it; ++it) {
+      const int k = static_cast<int>(it.col()) / 2, axis = static_cast<int>(it.col()) % 2;
+      weight += it.value() * normal[axis];
+      sum += it.value() * v[k][axis];
+    }
+    if (weight > 1e-12) ustar[q] = sum / weight + gravityIncrement.dot(normal);
+  }
+}
+
+// Marks the step as blown up, with a reason that names the variant ("implicit surface tension blew
+// up ..."); `write` appends when and why.
+template <class Write>
+void reportBlowUp(TwoPhaseStepReport& report, const TwoPhaseSettings& settings, Write write) {
+  report.blewUp = true;
+  std::ostringstream why;
+  why << (settings.implicitSurfaceTension ? "implicit" : "explicit") << " surface tension blew up ";
+  write(why);
+  report.blowUpReason = why.str();
 }
 
 // The level set's mesh; a level set so distorted that its marching-squares segments no longer
@@ -397,11 +402,9 @@ bool rebuildFront(TwoPhaseState& state, const MacLayout<2>& layout, const TwoPha
     state.front = frontFromLevelSet(layout, state.phi, CrossingOrder::Fourth);
     return true;
   } catch (const std::invalid_argument&) {
-    report.blewUp = true;
-    std::ostringstream why;
-    why << (settings.implicitSurfaceTension ? "implicit" : "explicit") << " surface tension blew up at step "
-        << state.step + 1 << " (t = " << state.time << "): the level set's mesh no longer forms closed curves";
-    report.blowUpReason = why.str();
+    reportBlowUp(report, settings, [&](std::ostream& why) {
+      why << "at step " << state.step + 1 << " (t = " << state.time << "): the level set's mesh no longer forms closed curves";
+    });
     return false;
   }
 }
@@ -416,11 +419,9 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
   const Eigen::Vector2d upper = layout.origin + dx * layout.cells.cast<double>();
   for (const auto& x : state.front.points)
     if (!x.allFinite() || (x.array() < layout.origin.array()).any() || (x.array() > upper.array()).any()) {
-      report.blewUp = true;
-      std::ostringstream why;
-      why << (settings.implicitSurfaceTension ? "implicit" : "explicit") << " surface tension blew up before step "
-          << state.step + 1 << " (t = " << state.time << "): the front left the domain";
-      report.blowUpReason = why.str();
+      reportBlowUp(report, settings, [&](std::ostream& why) {
+        why << "before step " << state.step + 1 << " (t = " << state.time << "): the front left the domain";
+      });
       return report;
     }
   if (settings.levelSetFront) {
@@ -450,6 +451,9 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
     const Eigen::Vector2d velocity(sampleFaceVelocity(layout, u, 0, x), sampleFaceVelocity(layout, u, 1, x));
     ustar[q] = velocity.dot(D.couplingNormal[k]) + dt * settings.gravity.dot(D.couplingNormal[k]);
   }
+  if (settings.carryCouplingVelocity && !settings.levelSetFront && !state.pointVelocity.empty() &&
+      static_cast<int>(state.pointVelocity.size()) == state.front.pointCount())
+    carriedCouplingVelocities(D, state.pointVelocity, dt * settings.gravity, ustar);
   if (settings.sigma > 0) {
     const auto forces = surfaceTensionForces(state.front, settings.sigma);
     Eigen::VectorXd f(2 * forces.size());
@@ -533,6 +537,9 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
     for (int k = 0; k < state.front.pointCount(); ++k) state.front.points[k] += dt * v.segment<2>(2 * k);
     if (settings.remesh)
       report.remeshChanges = remeshClosedFront(state.front, settings.minSegment * dx, settings.maxSegment * dx);
+    state.pointVelocity.clear();
+    if (settings.carryCouplingVelocity && report.remeshChanges == 0)
+      for (int k = 0; k < state.front.pointCount(); ++k) state.pointVelocity.push_back(v.segment<2>(2 * k));
   }
   state.time += dt;
   ++state.step;
@@ -560,13 +567,11 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
   report.area = enclosedArea(state.front);
   report.cutCells = static_cast<int>(std::count(D.cutCell.begin(), D.cutCell.end(), 1));
   if (!report.blewUp && (!finite || maxSpeed > settings.blowUpSpeed)) {
-    report.blewUp = true;
-    std::ostringstream why;
-    why << (settings.implicitSurfaceTension ? "implicit" : "explicit") << " surface tension blew up at step "
-        << state.step << " (t = " << state.time << "): max speed " << maxSpeed << " above the guard "
-        << settings.blowUpSpeed << "; dt = " << dt << " is " << dt / report.capillaryDt << " x the capillary limit "
-        << report.capillaryDt << ", CFL " << report.cfl;
-    report.blowUpReason = why.str();
+    reportBlowUp(report, settings, [&](std::ostream& why) {
+      why << "at step " << state.step << " (t = " << state.time << "): max speed " << maxSpeed << " above the guard "
+          << settings.blowUpSpeed << "; dt = " << dt << " is " << dt / report.capillaryDt << " x the capillary limit "
+          << report.capillaryDt << ", CFL " << report.cfl;
+    });
   }
   return report;
 }

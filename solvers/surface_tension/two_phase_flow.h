@@ -75,6 +75,13 @@ struct TwoPhaseSettings {
   // like), and set phi to the signed distance to the moved mesh. The next step's mesh is rebuilt
   // from that phi as usual.
   bool levelSetImplicitUpdate = false;
+  // Front tracking, beyond the thesis (which does not say where a coupling face's u* comes from):
+  // false samples it from the grid velocity each step, which discards the last solve's coupling
+  // velocities and damps the interface's motion by a fixed amount per step (more steps, more
+  // damping: docs/benchmarks_surface_tension.md, Table 6.4). true carries them on the front: the
+  // points keep H u^n, and a coupling face's u* is n^_i . (the H^T-weighted mean of its points'
+  // velocities). After a remesh that changed the points, one step samples the grid again.
+  bool carryCouplingVelocity = false;
 };
 
 struct TwoPhaseState {
@@ -83,6 +90,7 @@ struct TwoPhaseState {
   Front2 front;
   std::vector<double> pInside, pOutside;  // per cell: the phase's pressure (0 where it has none)
   std::vector<double> phi;                // level-set-tracked fronts: signed distance per cell
+  std::vector<Eigen::Vector2d> pointVelocity;  // carryCouplingVelocity: H u^n per front point, else empty
   double time = 0;
   int step = 0;
 };

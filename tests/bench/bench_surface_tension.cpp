@@ -72,15 +72,41 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
     }
   } else if (mode == "oscillating" || mode == "epsilon") {
+    // Options among the sizes: points=P (front points; default one per dx of arc; driver: the
+    // original driver's 2^k at about dx / 4 as in the static circle, with r = 1/3), no_remesh,
+    // dt_per_dx=S (dt = S dx; default 1/4), carry (the coupling faces' u* carried on the front).
+    // Columns: the relative error as defined (scale eps omega r |sin omega t|), the same max error
+    // on the scale eps omega |sin omega t| (without r; see docs/benchmarks_surface_tension.md), and
+    // the probe's relative error.
     const bool eps = mode == "epsilon";
-    std::printf("oscillating circle, front tracking, implicit\n| N | epsilon | period T | T/pi - 1 | u(0.75,0.5) at t=0.5 | rel. Linf err at t=0.5 | steps | wall s |\n|---|---|---|---|---|---|---|---|\n");
-    const std::vector<int> ns = eps ? sizes(argc, argv, 2, {50}) : sizes(argc, argv, 2, {50, 100});
+    int points = 0;
+    bool remesh = true;
+    double dtPerDx = 0.25;
+    bool carry = false;
+    std::vector<int> ns;
+    for (int i = 2; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (a.rfind("dt_per_dx=", 0) == 0) dtPerDx = std::atof(a.c_str() + 10);
+      else if (a == "points=driver") points = -1;
+      else if (a.rfind("points=", 0) == 0) points = std::atoi(a.c_str() + 7);
+      else if (a == "no_remesh") remesh = false;
+      else if (a == "carry") carry = true;
+      else ns.push_back(std::atoi(a.c_str()));
+    }
+    if (ns.empty()) ns = eps ? std::vector<int>{50} : std::vector<int>{50, 100};
+    std::printf("oscillating circle, front tracking, implicit, dt = %g dx, coupling u* %s, front %s%s\n"
+                "| N | epsilon | period T | T/pi - 1 | u(0.75,0.5) at t=0.5 | rel. Linf err at t=0.5 | same, scale without r | probe rel. err | points | steps | wall s |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|\n",
+                dtPerDx, carry ? "carried on the front" : "sampled from the grid", points == 0 ? "one point per dx" : points < 0 ? "2^k points at about dx/4" : std::to_string(points).c_str(),
+                remesh ? ", remeshed" : ", not remeshed");
     for (int n : ns)
       for (double epsilon : eps ? std::vector<double>{0.05, 0.025, 0.0125} : std::vector<double>{0.05}) {
         const auto start = std::chrono::steady_clock::now();
-        const OscillatingCircleResult r = runOscillatingCircle(n, epsilon, 1.2 * M_PI);
-        std::printf("| %d | %g | %.4f | %+.2f %% | %.4e | %.3e | %d | %.1f |\n", n, epsilon, r.period, 100 * (r.period / M_PI - 1),
-                    r.probeAtHalf, r.relativeErrorAtHalf, r.steps, seconds(start));
+        const int p = points >= 0 ? points : 1 << static_cast<int>(std::lround(std::log2(8 * M_PI * n / 3.0)));
+        const OscillatingCircleResult r = runOscillatingCircle(n, epsilon, 1.2 * M_PI, p, remesh, dtPerDx, carry);
+        std::printf("| %d | %g | %.4f | %+.2f %% | %.4e | %.3e | %.3e | %.3e | %d | %d | %.1f |\n", n, epsilon, r.period,
+                    100 * (r.period / M_PI - 1), r.probeAtHalf, r.relativeErrorAtHalf, r.relativeErrorAtHalf / 3,
+                    r.probeRelativeErrorAtHalf, r.points, r.steps, seconds(start));
         std::fflush(stdout);
       }
   } else if (mode == "rising_stability") {
@@ -111,17 +137,40 @@ int main(int argc, char** argv) {
       }
     }
   } else if (mode == "rising_bubble") {
-    // rising_bubble [sl|eno] [front|ls] [endTime] [N...]: Sec. 6.4.5, top and bottom of the bubble
-    // on x = 0 against time at each resolution, then the observed orders at the end time.
+    // rising_bubble [sl|eno] [front|ls] [endTime] [N...] [dt_per_dx=S] [fronts=PREFIX]: Sec. 6.4.5,
+    // top and bottom of the bubble on the vertical line through its centroid against time at each
+    // resolution, then the observed orders at the end time. dt = S dx (default 2 s/m); fronts=PREFIX
+    // writes each sample's front to PREFIX_N.csv (time, x, y per point, in order along the front).
     const bool eno = argc > 2 && std::string(argv[2]) == "eno";
     const bool ls = argc > 3 && std::string(argv[3]) == "ls";
     const double endTime = argc > 4 ? std::atof(argv[4]) : 0.05;
-    const std::vector<int> ns = sizes(argc, argv, 5, {20, 40, 80});
+    double dtPerDx = 2.0;
+    std::string frontsPrefix;
+    std::vector<int> ns;
+    for (int i = 5; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (a.rfind("dt_per_dx=", 0) == 0) dtPerDx = std::atof(a.c_str() + 10);
+      else if (a.rfind("fronts=", 0) == 0) frontsPrefix = a.substr(7);
+      else ns.push_back(std::atoi(a.c_str()));
+    }
+    if (ns.empty()) ns = {20, 40, 80};
     std::vector<RisingBubbleRun> runs;
     for (int n : ns) {
       const auto start = std::chrono::steady_clock::now();
-      runs.push_back(runRisingBubble(n, endTime, endTime / 10, 2.0, eno ? TwoPhaseAdvection::EnoRk3 : TwoPhaseAdvection::SemiLagrangian, ls));
+      runs.push_back(runRisingBubble(n, endTime, endTime / 10, dtPerDx, eno ? TwoPhaseAdvection::EnoRk3 : TwoPhaseAdvection::SemiLagrangian, ls));
       const RisingBubbleRun& r = runs.back();
+      if (!frontsPrefix.empty()) {
+        FILE* out = std::fopen((frontsPrefix + "_" + std::to_string(n) + ".csv").c_str(), "w");
+        if (!out) {
+          std::fprintf(stderr, "cannot write %s_%d.csv\n", frontsPrefix.c_str(), n);
+          return 1;
+        }
+        std::fprintf(out, "time,x,y\n");
+        for (const auto& s : r.samples)
+          for (const auto& e : s.front.elements)
+            std::fprintf(out, "%.6f,%.9e,%.9e\n", s.time, s.front.points[e[0]].x(), s.front.points[e[0]].y());
+        std::fclose(out);
+      }
       std::printf("\n%dx%d, %s, %s, dt %.3g s (%.1f x capillary), %d steps, %s, max speed %.3f m/s, wall %.1f s\n"
                   "| t (s) | top (m) | bottom (m) | centroid y (m) | rise velocity (m/s) | circularity | area drift |\n|---|---|---|---|---|---|---|\n",
                   n, 3 * n / 2, eno ? "ENO/RK3" : "semi-Lagrangian", ls ? "level-set front" : "front tracking", r.dt,
