@@ -127,12 +127,16 @@ template <int d>
 MeshData<d> boxMesh(const VecD<d>& halfExtents, double h) {
   if (!(h > 0) || !(halfExtents.minCoeff() > 0)) throw std::invalid_argument("box mesh: sizes must be positive");
   Eigen::Matrix<int, d, 1> n;
-  VecD<d> cell;
-  for (int a = 0; a < d; ++a) {
-    n(a) = std::max(1, static_cast<int>(std::lround(2 * halfExtents(a) / h)));
-    cell(a) = 2 * halfExtents(a) / n(a);
-  }
-  return gridMesh<d>(-halfExtents, n, cell, [](const VecD<d>&) { return true; });
+  for (int a = 0; a < d; ++a) n(a) = std::max(1, static_cast<int>(std::lround(2 * halfExtents(a) / h)));
+  return boxMesh<d>(halfExtents, n);
+}
+
+template <int d>
+MeshData<d> boxMesh(const VecD<d>& halfExtents, const Eigen::Matrix<int, d, 1>& cells) {
+  if (!(halfExtents.minCoeff() > 0) || cells.minCoeff() < 1)
+    throw std::invalid_argument("box mesh: sizes and cell counts must be positive");
+  const VecD<d> cell = (2 * halfExtents.array() / cells.template cast<double>().array()).matrix();
+  return gridMesh<d>(-halfExtents, cells, cell, [](const VecD<d>&) { return true; });
 }
 
 template <int d>
@@ -405,6 +409,7 @@ ForceModel<d> prepareForceModel(const std::vector<double>& restX, const std::vec
 
 #define MONOLITH_INSTANTIATE(D)                                                                                   \
   template MeshData<D> boxMesh<D>(const VecD<D>&, double);                                                        \
+  template MeshData<D> boxMesh<D>(const VecD<D>&, const Eigen::Matrix<int, D, 1>&);                                \
   template MeshData<D> sphereMesh<D>(double, double);                                                             \
   template std::string meshProblem<D>(const MeshData<D>&);                                                        \
   template MeshData<D> readGmsh<D>(const std::string&);                                                           \

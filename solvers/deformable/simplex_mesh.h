@@ -30,6 +30,10 @@ struct MeshError : std::runtime_error {
 // six tetrahedra around its main diagonal (each square into two triangles).
 template <int d>
 MeshData<d> boxMesh(const VecD<d>& halfExtents, double h);
+// Box [-a, a] with the given number of cells per axis (a bar with several elements through its
+// thickness and fewer along it, or the reverse), split as above.
+template <int d>
+MeshData<d> boxMesh(const VecD<d>& halfExtents, const Eigen::Matrix<int, d, 1>& cells);
 // Ball of the given radius: grid cells whose centre is inside, the surface vertices then moved
 // radially onto the sphere where no element inverts or flattens by it.
 template <int d>

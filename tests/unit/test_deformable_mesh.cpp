@@ -53,6 +53,20 @@ TEST(DeformableMesh, BoxMeshIsValidWithExactVolume) {
   EXPECT_NEAR(volume(m2), 2.0, 1e-12);
 }
 
+// A bar meshed by cell counts per axis: more cells through the thickness than its edge length
+// would give, one across the width.
+TEST(DeformableMesh, BoxMeshByCellsPerAxis) {
+  const auto bar = dm::boxMesh<3>(Eigen::Vector3d(0.5, 0.05, 0.05), Eigen::Vector3i(30, 6, 1));
+  EXPECT_EQ(dm::meshProblem(bar), "");
+  EXPECT_EQ(bar.elementCount(), 30 * 6 * 1 * 6);
+  EXPECT_EQ(bar.x.size(), 31u * 7u * 2u);
+  EXPECT_NEAR(volume(bar), 1.0 * 0.1 * 0.1, 1e-14);
+  const auto m2 = dm::boxMesh<2>(Eigen::Vector2d(0.5, 0.05), Eigen::Vector2i(40, 4));
+  EXPECT_EQ(dm::meshProblem(m2), "");
+  EXPECT_EQ(m2.elementCount(), 40 * 4 * 2);
+  EXPECT_THROW(dm::boxMesh<3>(Eigen::Vector3d(1, 1, 1), Eigen::Vector3i(2, 0, 2)), std::invalid_argument);
+}
+
 // The ball's volume converges to 4/3 pi r^3 as the cells shrink (the cut-cell boundary moved
 // onto the sphere); at h = r/4 within 8 %, at r/8 within 4 %.
 TEST(DeformableMesh, SphereMeshConvergesToBallVolume) {
