@@ -207,13 +207,16 @@ double elasticEnergy(const ForceModel<d>& fm, const double* x) {
 }
 
 template <int d>
-void addElasticForces(const ForceModel<d>& fm, const double* x, double* f) {
+void addElasticForces(const ForceModel<d>& fm, const double* x, double* f, std::vector<MatD<d>>* rotations) {
+  const bool withRotations = rotations && fm.finiteElements() && fm.rayleighBeta > 0;
+  if (rotations) rotations->assign(withRotations ? fm.elementCount() : 0, MatD<d>::Identity());
   if (fm.finiteElements()) {
     std::vector<MatD<d>> G(fm.elementCount());
     forEachElement(fm.elementCount(), [&](int e) {
       MatD<d> U, V;
       VecD<d> s;
       rotatedSvd<d>(deformationGradient(fm, e, x), U, s, V);
+      if (withRotations) (*rotations)[e] = U * V.transpose();
       const MatD<d> P = U * diagonalStress<d>(fm.model, fm.lame, s, fm.clamp).asDiagonal() * V.transpose();
       G[e] = -fm.restVolume[e] * P * fm.DmInv[e].transpose();
     });
@@ -355,7 +358,7 @@ void applyDampingFactorTranspose(const ForceModel<d>& fm, const std::vector<MatD
   template struct ForceModel<D>;                                                                                  \
   template MatD<D> deformationGradient<D>(const ForceModel<D>&, int, const double*);                              \
   template double elasticEnergy<D>(const ForceModel<D>&, const double*);                                          \
-  template void addElasticForces<D>(const ForceModel<D>&, const double*, double*);                                \
+  template void addElasticForces<D>(const ForceModel<D>&, const double*, double*, std::vector<MatD<D>>*);                           \
   template std::vector<MatD<D>> dampingRotations<D>(const ForceModel<D>&, const double*);                         \
   template void addDampingForces<D>(const ForceModel<D>&, const std::vector<MatD<D>>&, const double*,             \
                                     const double*, double*);                                                      \

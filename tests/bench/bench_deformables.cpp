@@ -8,7 +8,8 @@
 //
 // usage: bench_deformables cantilever [end, default 0.6] [edge ...]   (default 0.025 0.0125 0.00625)
 //        bench_deformables cantilever3d [end] [nx,ny,nz ...]          (default 40,4,1 80,8,1 120,12,1)
-//        a model name (corotated, neo_hookean) among the meshes runs only that model
+//        a model name (corotated, neo_hookean) among the meshes runs only that model, cfl=C
+//        overrides the scene's CFL number (the equilibrium does not depend on it)
 //        bench_deformables scene NAME.json [end]
 #include <chrono>
 #include <cmath>
@@ -38,14 +39,16 @@ bool isCells(const std::string& mesh) { return mesh.find(',') != std::string::np
 // Tip deflection of the cantilever scene (2-D) or cantilever_3d (3-D): the mean downward
 // displacement of the free end's vertices once the mass damping has brought the bar to rest.
 template <int d>
-Measured runCantilever(const Registry& registry, const std::string& model, const std::string& mesh, double end) {
+Measured runCantilever(const Registry& registry, const std::string& model, const std::string& mesh, double end,
+                       const std::string& cfl) {
   const std::string meshKey = "entities.bar.deformable.mesh.box";
   const SceneSpec spec =
       loadScene(kScenes + (d == 2 ? "cantilever.json" : "cantilever_3d.json"),
                 {{"entities.bar.deformable.model", "\"" + model + "\""},
                  {meshKey, std::string(d == 2 ? "{\"half_extents\": [0.5, 0.05], " : "{\"half_extents\": [0.5, 0.05, 0.05], ") +
                                (isCells(mesh) ? "\"cells\": [" + mesh + "]}" : "\"edge_length\": " + mesh + "}")},
-                 {"time.end", std::to_string(end)}});
+                 {"time.end", std::to_string(end)},
+                 {"time.cfl", cfl}});
   Simulation<d> sim(spec, registry, 1);
   Measured m;
   const auto start = std::chrono::steady_clock::now();
@@ -74,9 +77,11 @@ template <int d>
 int cantilever(int argc, char** argv) {
   const double end = argc > 2 ? std::atof(argv[2]) : 0.6;
   std::vector<std::string> meshes, models;
+  std::string cfl = "0.5";
   for (int i = 3; i < argc; ++i) {
     const std::string a = argv[i];
-    (a == "corotated" || a == "neo_hookean" ? models : meshes).push_back(a);
+    if (a.rfind("cfl=", 0) == 0) cfl = a.substr(4);
+    else (a == "corotated" || a == "neo_hookean" ? models : meshes).push_back(a);
   }
   if (models.empty()) models = {"corotated", "neo_hookean"};
   if (meshes.empty())
@@ -86,14 +91,15 @@ int cantilever(int argc, char** argv) {
   registerBuiltins(registry);
   const double rho = 1000, g = 9.81, L = 1, h = 0.1, E = 1e8;
   const double exact = 1.5 * rho * g * L * L * L * L / (E * h * h);
-  std::printf("cantilever (%d-D): Euler-Bernoulli tip deflection %.6f mm, end %.3g s, 1 thread\n\n", d, 1e3 * exact, end);
+  std::printf("cantilever (%d-D): Euler-Bernoulli tip deflection %.6f mm, end %.3g s, cfl %s, 1 thread\n\n", d, 1e3 * exact,
+              end, cfl.c_str());
   std::printf("| model | %s | %s | tip (mm) | error | observed order | substeps/frame | ms/step | s total | kinetic at end (J) |\n",
               "mesh (edge or cells)", d == 2 ? "triangles" : "tetrahedra");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   for (const std::string& model : models) {
     double prevErr = 0, prevSize = 0;
     for (const std::string& mesh : meshes) {
-      const Measured m = runCantilever<d>(registry, model, mesh, end);
+      const Measured m = runCantilever<d>(registry, model, mesh, end, cfl);
       const double err = (m.tip - exact) / exact;
       // Mesh size: the edge, or the cell height through the thickness.
       const double size = isCells(mesh) ? h / std::atof(mesh.substr(mesh.find(',') + 1).c_str()) : std::atof(mesh.c_str());
