@@ -2,7 +2,7 @@
 // Simplex meshes of deformable bodies, entity-free: tetrahedra in 3-D, triangles in 2-D.
 // A built-in mesher (a structured grid of cubes/squares split into simplices, kept where a
 // level set is negative and its boundary vertices moved onto the surface) so scenes need no
-// files, readers for Gmsh .msh (v2 ASCII) and TetGen .node/.ele, and the checks every mesh
+// files, readers for Gmsh .msh (v2 and v4.1 ASCII) and TetGen .node/.ele, and the checks every mesh
 // passes before it is simulated.
 #include <Eigen/Core>
 #include <stdexcept>
