@@ -125,8 +125,9 @@ void checkFactor(dm::Model m) {
   std::vector<double> u(n), w(n);
   for (auto& q : u) q = g(rng);
   for (auto& q : w) q = g(rng);
-  std::vector<double> Du(n, 0.0), Dw(n, 0.0), Cw(fm.dampingRows()), CtCw(n, 0.0);
-  ASSERT_GT(fm.dampingRows(), 0);
+  const int rows = fm.dampingRows();
+  ASSERT_GT(rows, 0);
+  std::vector<double> Du(n, 0.0), Dw(n, 0.0), Cw(static_cast<std::size_t>(rows)), CtCw(n, 0.0);
   dm::addDampingForces<d>(fm, R, x.data(), u.data(), Du.data());
   dm::addDampingForces<d>(fm, R, x.data(), w.data(), Dw.data());
   dm::applyDampingFactor<d>(fm, R, x.data(), dt, w.data(), Cw.data());
