@@ -127,10 +127,9 @@ TEST(DeformableMesh, ReadsGmshV2AndV41AndTetgen) {
                                    "$EndNodes\n$Elements\n3 4 1 4\n0 1 15 1\n1 1\n2 1 2 1\n2 1 2 3\n"
                                    "3 1 4 2\n3 1 2 3 4\n4 2 3 4 5\n$EndElements\n");
   const auto m4 = dm::readGmsh<3>(v4);
-  EXPECT_EQ(m4.elementCount(), 2);
-  EXPECT_EQ(m4.x.size(), 5u);
-  EXPECT_EQ(dm::meshProblem(m4), "");
-  EXPECT_EQ(m4.elements, m.elements);
+  EXPECT_EQ(m4.elements, m.elements);  // the same mesh as from version 2
+  for (std::size_t i = 0; i < m.x.size() && i < m4.x.size(); ++i) EXPECT_EQ(m4.x[i], m.x[i]) << "vertex " << i;
+  EXPECT_EQ(m4.x.size(), m.x.size());
   const auto tri = dm::readGmsh<2>(v4);  // in 2-D the triangle, its z dropped
   EXPECT_EQ(tri.elementCount(), 1);
   EXPECT_EQ(dm::meshProblem(tri), "");
