@@ -1,6 +1,7 @@
 #include "scenarios/deformable_components.h"
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <filesystem>
 
 #include "components/deformable.h"
@@ -23,7 +24,7 @@ std::string resolvePath(const Config& c, const std::string& file) {
   return path.string();
 }
 
-// "mesh": {"box": {half_extents, edge_length}} | {"sphere": {radius, edge_length}} |
+// "mesh": {"box": {half_extents, edge_length | cells}} | {"sphere": {radius, edge_length}} |
 //         {"gmsh": "file.msh"} | {"tetgen": "base"} (3-D; base.node + base.ele)
 template <int d>
 dm::MeshData<d> parseMesh(const Config& c, std::string& origin) {
@@ -38,10 +39,24 @@ dm::MeshData<d> parseMesh(const Config& c, std::string& origin) {
     if (c.has("box")) {
       const Config b = c.child("box");
       const Vec<d> half = b.vector("half_extents", d, Bound::Positive);
-      const double h = b.number("edge_length", Bound::Positive);
-      b.finish();
+      if (b.has("edge_length") == b.has("cells"))
+        b.fail("exactly one of edge_length (a number) or cells (" + std::to_string(d) + " whole cell counts per axis)",
+               b.has("cells") ? "both" : "neither");
       origin = "built-in box";
-      return dm::boxMesh<d>(half, h);
+      if (b.has("edge_length")) {
+        const double h = b.number("edge_length", Bound::Positive);
+        b.finish();
+        return dm::boxMesh<d>(half, h);
+      }
+      const Eigen::VectorXd counts = b.vector("cells", d, Bound::Positive);
+      Eigen::Matrix<int, d, 1> cells;
+      for (int a = 0; a < d; ++a) {
+        if (counts(a) != std::round(counts(a)) || counts(a) > 1e4)
+          b.failAt("cells", "whole cell counts from 1 to 10000 per axis", describeJson(b.raw()["cells"]));
+        cells(a) = static_cast<int>(counts(a));
+      }
+      b.finish();
+      return dm::boxMesh<d>(half, cells);
     }
     if (c.has("sphere")) {
       const Config b = c.child("sphere");
@@ -228,7 +243,7 @@ template <int d>
 void registerDeformableComponents(Registry& r) {
   r.addComponent<d>(ComponentType<d>{
       "deformable",
-      "deformable solid: mesh {box {half_extents, edge_length} | sphere {radius, edge_length} | gmsh FILE" +
+      "deformable solid: mesh {box {half_extents, edge_length | cells} | sphere {radius, edge_length} | gmsh FILE" +
           std::string(d == 3 ? " | tetgen BASE" : "") +
           "}, model (corotated | neo_hookean | springs), youngs_modulus, poisson_ratio, density, rayleigh_alpha, "
           "rayleigh_beta, overdamping, altitude_stiffness, particle_mass, clamp, position, " +

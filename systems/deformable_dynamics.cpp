@@ -37,9 +37,10 @@ const dm::ForceModel<d>& ForceModelCache<d>::get(Entity e, const Particles<d>& p
 }
 
 template <int d>
-std::vector<double> explicitForces(const dm::ForceModel<d>& fm, const Particles<d>& p, const Vec<d>& gravity) {
+std::vector<double> explicitForces(const dm::ForceModel<d>& fm, const Particles<d>& p, const Vec<d>& gravity,
+                                   std::vector<dm::MatD<d>>* rotations) {
   std::vector<double> f(p.x.size(), 0.0);
-  dm::addElasticForces<d>(fm, p.x.data(), f.data());
+  dm::addElasticForces<d>(fm, p.x.data(), f.data(), rotations);
   for (int i = 0; i < p.count(); ++i)
     for (int a = 0; a < d; ++a) f[d * i + a] = p.fixed[i] ? 0.0 : f[d * i + a] + p.m[i] * gravity(a);
   return f;
@@ -48,7 +49,8 @@ std::vector<double> explicitForces(const dm::ForceModel<d>& fm, const Particles<
 template <int d>
 ImplicitSolveReport implicitDampingSolve(const dm::ForceModel<d>& fm, const Particles<d>& p,
                                          const std::vector<double>& f, double h, std::vector<double>& u,
-                                         std::vector<double>* dampingForce) {
+                                         std::vector<double>* dampingForce,
+                                         const std::vector<dm::MatD<d>>* rotations) {
   const int n = static_cast<int>(p.x.size());
   ImplicitSolveReport report;
   u.assign(n, 0.0);
@@ -58,7 +60,8 @@ ImplicitSolveReport implicitDampingSolve(const dm::ForceModel<d>& fm, const Part
     if (dampingForce) dampingForce->assign(n, 0.0);
     return report;
   }
-  const auto R = dm::dampingRotations<d>(fm, p.x.data());
+  const std::vector<dm::MatD<d>> computed = rotations ? std::vector<dm::MatD<d>>() : dm::dampingRotations<d>(fm, p.x.data());
+  const std::vector<dm::MatD<d>>& R = rotations ? *rotations : computed;
   Eigen::VectorXd diag(n), prescribed = Eigen::VectorXd::Zero(n);
   for (int i = 0; i < n; ++i) {
     diag(i) = p.m[i / d];
@@ -139,12 +142,13 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
         // inside it (systems/fluid_structure_coupling.h).
         if (world.template has<FluidCoupling<d>>(e)) return;
         const auto& fm = cache_.get(e, p, mesh, el);
-        const std::vector<double> f = explicitForces(fm, p, g);
+        std::vector<dm::MatD<d>> R;
+        const std::vector<double> f = explicitForces(fm, p, g, &R);
         std::vector<double> u;
         const double h = half ? 0.5 * ctx.dt : 0.25 * ctx.dt;
         RigidBinding<d>* binding = world.template get<RigidBinding<d>>(e);
         std::vector<double> Du;
-        const ImplicitSolveReport r = implicitDampingSolve(fm, p, f, h, u, binding ? &Du : nullptr);
+        const ImplicitSolveReport r = implicitDampingSolve(fm, p, f, h, u, binding ? &Du : nullptr, &R);
         iterations = std::max(iterations, r.iterations);
         // The damping forces the solve put on bound particles act on their bodies: over this
         // stage's velocity change, h (Step I) or 2h (Step V's extrapolation) times D u.
@@ -240,10 +244,11 @@ void DeformableDiagnostics<d>::run(World<d>& world, StepContext& ctx) {
 #define MONOLITH_INSTANTIATE(D)                                                                                 \
   template dm::ForceModel<D> forceModelOf<D>(const Particles<D>&, const SimplexMesh<D>&, const Elasticity&);   \
   template class ForceModelCache<D>;                                                                            \
-  template std::vector<double> explicitForces<D>(const dm::ForceModel<D>&, const Particles<D>&, const Vec<D>&); \
+  template std::vector<double> explicitForces<D>(const dm::ForceModel<D>&, const Particles<D>&, const Vec<D>&,  \
+                                                 std::vector<dm::MatD<D>>*);                                    \
   template ImplicitSolveReport implicitDampingSolve<D>(const dm::ForceModel<D>&, const Particles<D>&,          \
                                                        const std::vector<double>&, double, std::vector<double>&, \
-                                                       std::vector<double>*);                                   \
+                                                       std::vector<double>*, const std::vector<dm::MatD<D>>*);  \
   template class AdvanceDeformableVelocity<D>;                                                                  \
   template class AdvanceDeformablePositions<D>;                                                                 \
   template class DeformableDiagnostics<D>;                                                                      \

@@ -45,15 +45,19 @@ struct ImplicitSolveReport {
 
 // Solves (M - h D(x)) u = M v + h f with the fixed and bound particles' u prescribed (their
 // current v) and projected out of the solve; u returned in `u`, and D u in `dampingForce` if given.
+// `rotations`: the damping rotations at the current positions if already known (explicitForces).
 template <int d>
 ImplicitSolveReport implicitDampingSolve(const solvers::deformable::ForceModel<d>& fm, const Particles<d>& p,
                                          const std::vector<double>& f, double h, std::vector<double>& u,
-                                         std::vector<double>* dampingForce = nullptr);
+                                         std::vector<double>* dampingForce = nullptr,
+                                         const std::vector<solvers::deformable::MatD<d>>* rotations = nullptr);
 
-// Elastic forces plus gravity at the particles' current positions (zero on fixed particles).
+// Elastic forces plus gravity at the particles' current positions (zero on fixed particles);
+// with `rotations` given, also the damping rotations there (one decomposition per element).
 template <int d>
 std::vector<double> explicitForces(const solvers::deformable::ForceModel<d>& fm, const Particles<d>& p,
-                                   const Vec<d>& gravity);
+                                   const Vec<d>& gravity,
+                                   std::vector<solvers::deformable::MatD<d>>* rotations = nullptr);
 
 template <int d>
 class AdvanceDeformableVelocity final : public System<d> {

@@ -97,11 +97,14 @@ MatD<d> deformationGradient(const ForceModel<d>& fm, int e, const double* x);
 // Elastic potential energy of the whole body at x.
 template <int d>
 double elasticEnergy(const ForceModel<d>& fm, const double* x);
-// f += elastic forces at x (= -dE/dx). Deterministic on any thread count.
+// f += elastic forces at x (= -dE/dx). Deterministic on any thread count. With `rotations`
+// given, also the damping rotations at x from the same decompositions (what dampingRotations
+// returns, without decomposing every element again).
 template <int d>
-void addElasticForces(const ForceModel<d>& fm, const double* x, double* f);
+void addElasticForces(const ForceModel<d>& fm, const double* x, double* f, std::vector<MatD<d>>* rotations = nullptr);
 
-// The rotations R = U V^T of every element at x, on which the damping operator depends.
+// The rotations R = U V^T of every element at x, on which the damping operator depends (empty
+// without finite-element stiffness damping).
 template <int d>
 std::vector<MatD<d>> dampingRotations(const ForceModel<d>& fm, const double* x);
 

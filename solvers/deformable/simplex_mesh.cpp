@@ -127,12 +127,16 @@ template <int d>
 MeshData<d> boxMesh(const VecD<d>& halfExtents, double h) {
   if (!(h > 0) || !(halfExtents.minCoeff() > 0)) throw std::invalid_argument("box mesh: sizes must be positive");
   Eigen::Matrix<int, d, 1> n;
-  VecD<d> cell;
-  for (int a = 0; a < d; ++a) {
-    n(a) = std::max(1, static_cast<int>(std::lround(2 * halfExtents(a) / h)));
-    cell(a) = 2 * halfExtents(a) / n(a);
-  }
-  return gridMesh<d>(-halfExtents, n, cell, [](const VecD<d>&) { return true; });
+  for (int a = 0; a < d; ++a) n(a) = std::max(1, static_cast<int>(std::lround(2 * halfExtents(a) / h)));
+  return boxMesh<d>(halfExtents, n);
+}
+
+template <int d>
+MeshData<d> boxMesh(const VecD<d>& halfExtents, const Eigen::Matrix<int, d, 1>& cells) {
+  if (!(halfExtents.minCoeff() > 0) || cells.minCoeff() < 1)
+    throw std::invalid_argument("box mesh: sizes and cell counts must be positive");
+  const VecD<d> cell = (2 * halfExtents.array() / cells.template cast<double>().array()).matrix();
+  return gridMesh<d>(-halfExtents, cells, cell, [](const VecD<d>&) { return true; });
 }
 
 template <int d>
@@ -259,17 +263,75 @@ MeshData<d> readGmsh(const std::string& path) {
   std::unordered_map<long, int> nodeIndex;
   std::string s;
   bool sawFormat = false;
+  double version = 0;
+  const int wanted = d == 3 ? 4 : 2;
+  auto addNode = [&](long id, const std::string& line) {
+    std::istringstream ls(line);
+    double c[3];
+    if (!(ls >> c[0] >> c[1] >> c[2])) r.fail("expected node coordinates \"x y z\", got \"" + line + "\"");
+    VecD<d> x;
+    for (int a = 0; a < d; ++a) x(a) = c[a];
+    nodeIndex[id] = static_cast<int>(m.x.size());
+    m.x.push_back(x);
+  };
+  auto addElementNodes = [&](long id, std::istringstream& ls) {
+    for (int k = 0; k <= d; ++k) {
+      long node;
+      if (!(ls >> node)) r.fail("element " + std::to_string(id) + ": expected " + std::to_string(d + 1) + " node ids");
+      auto it = nodeIndex.find(node);
+      if (it == nodeIndex.end()) r.fail("element " + std::to_string(id) + ": node " + std::to_string(node) + " is not in $Nodes");
+      m.elements.push_back(it->second);
+    }
+  };
+  // Reads "count..." header numbers of a version 4 section.
+  auto header = [&](const char* what, int count) {
+    std::vector<long> v(count);
+    if (!r.next(s, false)) r.fail(std::string("expected ") + what);
+    std::istringstream ls(s);
+    for (long& x : v)
+      if (!(ls >> x) || x < 0) r.fail(std::string("expected ") + what + ", got \"" + s + "\"");
+    return v;
+  };
   while (r.next(s, false)) {
     if (s.rfind("$MeshFormat", 0) == 0) {
-      if (!r.next(s, false)) r.fail("expected the format line \"2.2 0 8\"");
+      if (!r.next(s, false)) r.fail("expected the format line \"2.2 0 8\" or \"4.1 0 8\"");
       std::istringstream ls(s);
-      double version = 0;
       int fileType = -1;
       ls >> version >> fileType;
-      if (!ls || version < 2 || version >= 3)
-        r.fail("expected Gmsh format version 2 (got \"" + s + "\"; save the mesh as \"Version 2 ASCII\")");
+      if (!ls || !((version >= 2 && version < 3) || (version >= 4.1 && version < 5)))
+        r.fail("expected Gmsh format version 2 or 4.1 (got \"" + s + "\"; save the mesh as \"Version 2 ASCII\" or "
+               "\"Version 4 ASCII\")");
       if (fileType != 0) r.fail("expected an ASCII file (file type 0), got binary");
       sawFormat = true;
+    } else if (s.rfind("$Nodes", 0) == 0 && version >= 4) {
+      if (!sawFormat) r.fail("$Nodes before $MeshFormat");
+      // 4.1: "blocks nodes minTag maxTag", then per block "dim entity parametric count", the
+      // block's node tags one a line, then their coordinates one a line.
+      const long blocks = header("\"numEntityBlocks numNodes minNodeTag maxNodeTag\"", 4)[0];
+      for (long b = 0; b < blocks; ++b) {
+        const long count = header("a node block \"entityDim entityTag parametric numNodesInBlock\"", 4)[3];
+        std::vector<long> ids(count);
+        for (long& id : ids) id = header("a node tag", 1)[0];
+        for (long id : ids) {
+          if (!r.next(s, false)) r.fail("expected the coordinates of node " + std::to_string(id));
+          addNode(id, s);
+        }
+      }
+    } else if (s.rfind("$Elements", 0) == 0 && version >= 4) {
+      // 4.1: "blocks elements minTag maxTag", then per block "dim entity type count" and one
+      // line "tag node..." per element.
+      const long blocks = header("\"numEntityBlocks numElements minElementTag maxElementTag\"", 4)[0];
+      for (long b = 0; b < blocks; ++b) {
+        const std::vector<long> block = header("an element block \"entityDim entityTag elementType numElementsInBlock\"", 4);
+        for (long i = 0; i < block[3]; ++i) {
+          if (!r.next(s, false)) r.fail("expected " + std::to_string(block[3]) + " elements in the block, the file ends");
+          if (block[2] != wanted) continue;
+          std::istringstream ls(s);
+          long id;
+          if (!(ls >> id)) r.fail("expected an element \"tag node...\", got \"" + s + "\"");
+          addElementNodes(id, ls);
+        }
+      }
     } else if (s.rfind("$Nodes", 0) == 0) {
       if (!sawFormat) r.fail("$Nodes before $MeshFormat");
       if (!r.next(s, false)) r.fail("expected the node count");
@@ -278,17 +340,14 @@ MeshData<d> readGmsh(const std::string& path) {
         if (!r.next(s, false)) r.fail("expected " + std::to_string(n) + " nodes, the file ends after " + std::to_string(i));
         std::istringstream ls(s);
         long id;
-        double c[3];
-        if (!(ls >> id >> c[0] >> c[1] >> c[2])) r.fail("expected a node \"id x y z\", got \"" + s + "\"");
-        VecD<d> x;
-        for (int a = 0; a < d; ++a) x(a) = c[a];
-        nodeIndex[id] = static_cast<int>(m.x.size());
-        m.x.push_back(x);
+        if (!(ls >> id)) r.fail("expected a node \"id x y z\", got \"" + s + "\"");
+        std::string rest;
+        std::getline(ls, rest);
+        addNode(id, rest);
       }
     } else if (s.rfind("$Elements", 0) == 0) {
       if (!r.next(s, false)) r.fail("expected the element count");
       const long n = std::stol(s);
-      const int wanted = d == 3 ? 4 : 2;
       for (long i = 0; i < n; ++i) {
         if (!r.next(s, false)) r.fail("expected " + std::to_string(n) + " elements, the file ends after " + std::to_string(i));
         std::istringstream ls(s);
@@ -300,13 +359,7 @@ MeshData<d> readGmsh(const std::string& path) {
           ls >> tag;
         }
         if (type != wanted) continue;
-        for (int k = 0; k <= d; ++k) {
-          long node;
-          if (!(ls >> node)) r.fail("element " + std::to_string(id) + ": expected " + std::to_string(d + 1) + " node ids");
-          auto it = nodeIndex.find(node);
-          if (it == nodeIndex.end()) r.fail("element " + std::to_string(id) + ": node " + std::to_string(node) + " is not in $Nodes");
-          m.elements.push_back(it->second);
-        }
+        addElementNodes(id, ls);
       }
     }
   }
@@ -429,6 +482,7 @@ ForceModel<d> prepareForceModel(const std::vector<double>& restX, const std::vec
 
 #define MONOLITH_INSTANTIATE(D)                                                                                   \
   template MeshData<D> boxMesh<D>(const VecD<D>&, double);                                                        \
+  template MeshData<D> boxMesh<D>(const VecD<D>&, const Eigen::Matrix<int, D, 1>&);                                \
   template MeshData<D> sphereMesh<D>(double, double);                                                             \
   template std::string meshProblem<D>(const MeshData<D>&);                                                        \
   template MeshData<D> readGmsh<D>(const std::string&);                                                           \

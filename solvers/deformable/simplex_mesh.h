@@ -2,7 +2,7 @@
 // Simplex meshes of deformable bodies, entity-free: tetrahedra in 3-D, triangles in 2-D.
 // A built-in mesher (a structured grid of cubes/squares split into simplices, kept where a
 // level set is negative and its boundary vertices moved onto the surface) so scenes need no
-// files, readers for Gmsh .msh (v2 ASCII) and TetGen .node/.ele, and the checks every mesh
+// files, readers for Gmsh .msh (v2 and v4.1 ASCII) and TetGen .node/.ele, and the checks every mesh
 // passes before it is simulated.
 #include <Eigen/Core>
 #include <stdexcept>
@@ -30,6 +30,10 @@ struct MeshError : std::runtime_error {
 // six tetrahedra around its main diagonal (each square into two triangles).
 template <int d>
 MeshData<d> boxMesh(const VecD<d>& halfExtents, double h);
+// Box [-a, a] with the given number of cells per axis (a bar with several elements through its
+// thickness and fewer along it, or the reverse), split as above.
+template <int d>
+MeshData<d> boxMesh(const VecD<d>& halfExtents, const Eigen::Matrix<int, d, 1>& cells);
 // Ball of the given radius: grid cells whose centre is inside, the surface vertices then moved
 // radially onto the sphere where no element inverts or flattens by it.
 template <int d>

@@ -215,6 +215,14 @@ TEST(DeformableScenes, BadMeshesAreRefusedWithTheirLocation) {
   e = sceneError(deformableScene(R"({ "mesh": { "box": { "half_extents": [1, 1, 1], "edge_length": 0.5 } },
       "youngs_modulus": 1e5, "fixed": [ { "min": [5, 5, 5], "max": [6, 6, 6] } ] })"));
   EXPECT_NE(e.find("entities[0].deformable.fixed[0]"), std::string::npos) << e;
+  e = sceneError(deformableScene(R"({ "mesh": { "box": { "half_extents": [1, 1, 1], "cells": [4, 2.5, 1] } },
+      "youngs_modulus": 1e5 })"));
+  EXPECT_NE(e.find("entities[0].deformable.mesh.box.cells"), std::string::npos) << e;
+  EXPECT_NE(e.find("whole cell counts"), std::string::npos) << e;
+  e = sceneError(deformableScene(R"({ "mesh": { "box": { "half_extents": [1, 1, 1], "cells": [4, 2, 1],
+      "edge_length": 0.5 } }, "youngs_modulus": 1e5 })"));
+  EXPECT_NE(e.find("entities[0].deformable.mesh.box"), std::string::npos) << e;
+  EXPECT_NE(e.find("exactly one of edge_length"), std::string::npos) << e;
   e = sceneError(deformableScene(R"({ "mesh": { "cube": {} }, "youngs_modulus": 1e5 })"));
   EXPECT_NE(e.find("exactly one mesh form of: box, sphere, gmsh, tetgen"), std::string::npos) << e;
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <random>
 
 #include "solvers/deformable/simplex_mesh.h"
@@ -131,8 +132,9 @@ void checkFactor(dm::Model m, double altitude = 0) {
   std::vector<double> u(n), w(n);
   for (auto& q : u) q = g(rng);
   for (auto& q : w) q = g(rng);
-  std::vector<double> Du(n, 0.0), Dw(n, 0.0), Cw(fm.dampingRows()), CtCw(n, 0.0);
-  ASSERT_GT(fm.dampingRows(), 0);
+  const int rows = fm.dampingRows();
+  ASSERT_GT(rows, 0);
+  std::vector<double> Du(n, 0.0), Dw(n, 0.0), Cw(static_cast<std::size_t>(rows)), CtCw(n, 0.0);
   dm::addDampingForces<d>(fm, R, x.data(), u.data(), Du.data());
   dm::addDampingForces<d>(fm, R, x.data(), w.data(), Dw.data());
   dm::applyDampingFactor<d>(fm, R, x.data(), dt, w.data(), Cw.data());
@@ -201,6 +203,43 @@ TEST(DeformableForces, InvertedElementIsPushedBack) {
       dm::addElasticForces<3>(fm, x.data(), f.data());
       EXPECT_GT(f[11], 0) << "model " << int(m) << " z " << z;
       for (double q : f) EXPECT_TRUE(std::isfinite(q));
+    }
+  }
+}
+
+// The 3x3 rotated SVD: F = U diag(s) V^T to round-off with U, V rotations, |s| equal to the
+// general SVD's singular values (descending), the sign of det F carried by the last one; also
+// for repeated singular values (rest, uniform scaling), rank-deficient and zero F.
+TEST(DeformableForces, RotatedSvdReconstructsAndCarriesInversion) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Eigen::Matrix3d> cases = {Eigen::Matrix3d::Identity(), 2.5 * Eigen::Matrix3d::Identity(),
+                                        Eigen::Matrix3d::Zero(), Eigen::Vector3d(1, 1, -1).asDiagonal(),
+                                        Eigen::Vector3d(3, 1e-9, 0).asDiagonal()};
+  Eigen::Matrix3d rank1 = Eigen::Vector3d(1, 2, 3) * Eigen::RowVector3d(-1, 0.5, 2);
+  cases.push_back(rank1);
+  for (int k = 0; k < 200; ++k) {
+    Eigen::Matrix3d F;
+    for (int i = 0; i < 9; ++i) F(i) = u(rng);
+    if (k % 2) F = Eigen::Matrix3d::Identity() + 1e-3 * F;  // near rest, nearly repeated values
+    cases.push_back(F);
+  }
+  for (const Eigen::Matrix3d& F : cases) {
+    Eigen::Matrix3d U, V;
+    Eigen::Vector3d s;
+    dm::rotatedSvd<3>(F, U, s, V);
+    const double scale = std::max(1.0, F.norm());
+    EXPECT_LT((U * s.asDiagonal() * V.transpose() - F).norm(), 1e-13 * scale) << F;
+    EXPECT_LT((U.transpose() * U - Eigen::Matrix3d::Identity()).norm(), 1e-13);
+    EXPECT_LT((V.transpose() * V - Eigen::Matrix3d::Identity()).norm(), 1e-13);
+    EXPECT_NEAR(U.determinant(), 1, 1e-12);
+    EXPECT_NEAR(V.determinant(), 1, 1e-12);
+    const Eigen::Vector3d general = Eigen::JacobiSVD<Eigen::Matrix3d>(F).singularValues();
+    EXPECT_LT((s.cwiseAbs() - general).norm(), 1e-12 * scale) << F;
+    EXPECT_GE(s(0), 0);
+    EXPECT_GE(s(1), 0);
+    if (std::abs(F.determinant()) > 1e-12) {
+      EXPECT_EQ(s(2) < 0, F.determinant() < 0) << F;
     }
   }
 }

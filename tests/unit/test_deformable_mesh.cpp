@@ -53,6 +53,20 @@ TEST(DeformableMesh, BoxMeshIsValidWithExactVolume) {
   EXPECT_NEAR(volume(m2), 2.0, 1e-12);
 }
 
+// A bar meshed by cell counts per axis: more cells through the thickness than its edge length
+// would give, one across the width.
+TEST(DeformableMesh, BoxMeshByCellsPerAxis) {
+  const auto bar = dm::boxMesh<3>(Eigen::Vector3d(0.5, 0.05, 0.05), Eigen::Vector3i(30, 6, 1));
+  EXPECT_EQ(dm::meshProblem(bar), "");
+  EXPECT_EQ(bar.elementCount(), 30 * 6 * 1 * 6);
+  EXPECT_EQ(bar.x.size(), 31u * 7u * 2u);
+  EXPECT_NEAR(volume(bar), 1.0 * 0.1 * 0.1, 1e-14);
+  const auto m2 = dm::boxMesh<2>(Eigen::Vector2d(0.5, 0.05), Eigen::Vector2i(40, 4));
+  EXPECT_EQ(dm::meshProblem(m2), "");
+  EXPECT_EQ(m2.elementCount(), 40 * 4 * 2);
+  EXPECT_THROW(dm::boxMesh<3>(Eigen::Vector3d(1, 1, 1), Eigen::Vector3i(2, 0, 2)), std::invalid_argument);
+}
+
 // The ball's volume converges to 4/3 pi r^3 as the cells shrink (the cut-cell boundary moved
 // onto the sphere); at h = r/4 within 8 %, at r/8 within 4 %.
 TEST(DeformableMesh, SphereMeshConvergesToBallVolume) {
@@ -91,7 +105,7 @@ TEST(DeformableMesh, ProblemsNameElementAndFault) {
   EXPECT_NE(dm::meshProblem(m).find("element 0: vertex index 9 out of range"), std::string::npos);
 }
 
-TEST(DeformableMesh, ReadsGmshV2AndTetgen) {
+TEST(DeformableMesh, ReadsGmshV2AndV41AndTetgen) {
   const std::string msh = writeFile("two_tets.msh",
                                     "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n"
                                     "1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n$EndNodes\n"
@@ -105,12 +119,30 @@ TEST(DeformableMesh, ReadsGmshV2AndTetgen) {
   const auto t = dm::readTetgen(base.substr(0, base.size() - 5));
   EXPECT_EQ(t.elementCount(), 2);
   EXPECT_EQ(dm::meshProblem(t), "");
+  // The same two tetrahedra in Gmsh 4.1 ASCII: nodes in two entity blocks (tags, then
+  // coordinates), a point block and a triangle block skipped, the tetrahedra in a third block.
+  const std::string v4 = writeFile("two_tets_v4.msh",
+                                   "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n1 0 0 0 1 1 1 0 0\n$EndEntities\n"
+                                   "$Nodes\n2 5 1 5\n0 1 0 1\n1\n0 0 0\n3 1 0 4\n2\n3\n4\n5\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n"
+                                   "$EndNodes\n$Elements\n3 4 1 4\n0 1 15 1\n1 1\n2 1 2 1\n2 1 2 3\n"
+                                   "3 1 4 2\n3 1 2 3 4\n4 2 3 4 5\n$EndElements\n");
+  const auto m4 = dm::readGmsh<3>(v4);
+  EXPECT_EQ(m4.elements, m.elements);  // the same mesh as from version 2
+  for (std::size_t i = 0; i < m.x.size() && i < m4.x.size(); ++i) EXPECT_EQ(m4.x[i], m.x[i]) << "vertex " << i;
+  EXPECT_EQ(m4.x.size(), m.x.size());
+  const auto tri = dm::readGmsh<2>(v4);  // in 2-D the triangle, its z dropped
+  EXPECT_EQ(tri.elementCount(), 1);
+  EXPECT_EQ(dm::meshProblem(tri), "");
 }
 
 TEST(DeformableMesh, BadFilesNameFileAndLine) {
-  const std::string v4 = writeFile("v4.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n");
-  EXPECT_NE(errorOf([&] { dm::readGmsh<3>(v4); }).find("v4.msh: line 2: expected Gmsh format version 2"),
+  const std::string v40 = writeFile("v40.msh", "$MeshFormat\n4 0 8\n$EndMeshFormat\n");
+  EXPECT_NE(errorOf([&] { dm::readGmsh<3>(v40); }).find("v40.msh: line 2: expected Gmsh format version 2 or 4.1"),
             std::string::npos);
+  const std::string v4short = writeFile("v4_short.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 1 2\n"
+                                                        "0 1 0 2\n1\n2\n0 0 0\n");
+  EXPECT_NE(errorOf([&] { dm::readGmsh<3>(v4short); }).find("expected the coordinates of node 2"), std::string::npos)
+      << errorOf([&] { dm::readGmsh<3>(v4short); });
   const std::string truncated = writeFile("truncated.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n");
   EXPECT_NE(errorOf([&] { dm::readGmsh<3>(truncated); }).find("expected 3 nodes, the file ends after 1"),
             std::string::npos);
