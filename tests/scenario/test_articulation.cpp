@@ -13,6 +13,7 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -342,6 +343,17 @@ TEST(Articulation, ScenesWithoutJointsScheduleNoJointSystem) {
   EXPECT_EQ(jointed.scheduler().indexOf("joint_pd_control"), -1);  // no PD drive in the scene
 }
 
+// Runs to the end; the largest joint position and angle errors over every step.
+static std::pair<double, double> runToEndWithWorstJointErrors(Simulation<3>& sim) {
+  double worst = 0, worstAngle = 0;
+  while (!sim.finished()) {
+    const auto& d = sim.step();
+    worst = std::max(worst, d.at("joint_error_max"));
+    worstAngle = std::max(worstAngle, d.at("joint_angle_error_max"));
+  }
+  return {worst, worstAngle};
+}
+
 TEST(Articulation, PrismaticAndUniversalJointsKeepTheirConstraints) {
   const Registry registry = builtins();
   // A slider on a tilted rail (prismatic along (1, -1, 0)/sqrt 2) under gravity: it slides with
@@ -356,12 +368,7 @@ TEST(Articulation, PrismaticAndUniversalJointsKeepTheirConstraints) {
       "joint": { "type": "universal", "parent": "slider", "anchor": [0, -0.1, 0], "axis": [0, 1, 0] } } ] })",
                                 "slider.json"),
                      registry);
-  double worst = 0, worstAngle = 0;
-  while (!sim.finished()) {
-    const auto& d = sim.step();
-    worst = std::max(worst, d.at("joint_error_max"));
-    worstAngle = std::max(worstAngle, d.at("joint_angle_error_max"));
-  }
+  const auto [worst, worstAngle] = runToEndWithWorstJointErrors(sim);
   EXPECT_LT(worst, 1e-6);
   EXPECT_LT(worstAngle, 1e-6);
   const Eigen::Vector3d x = body(sim, "slider").x;
@@ -384,12 +391,7 @@ TEST(Articulation, TwistJointSlidesAndSpinsFreelyAboutItsAxis) {
       "joint": { "type": "twist", "parent": "world", "anchor": [0, 0, 0], "axis": [0.7071067811865476, -0.7071067811865476, 0] } } ] })",
                                 "twist.json"),
                      registry);
-  double worst = 0, worstAngle = 0;
-  while (!sim.finished()) {
-    const auto& d = sim.step();
-    worst = std::max(worst, d.at("joint_error_max"));
-    worstAngle = std::max(worstAngle, d.at("joint_angle_error_max"));
-  }
+  const auto [worst, worstAngle] = runToEndWithWorstJointErrors(sim);
   const RigidBody<3>& cube = body(sim, "cube");
   const Eigen::Vector3d axis(std::sqrt(0.5), -std::sqrt(0.5), 0);
   const double slide = kG * 1.0 / (2 * std::sqrt(2.0));
