@@ -37,6 +37,8 @@ class PoolBase {
   // sparse table allocate gigabytes.
   virtual void deserialize(BinaryReader& in, std::size_t slotCount) = 0;
   virtual std::optional<ComponentViolation> firstViolation(double maxAbs) const = 0;
+  // The saved layout of one component (FieldLayoutWriter).
+  virtual std::string fieldLayout() const = 0;
 };
 
 template <class T, class = void>
@@ -122,6 +124,13 @@ class Pool final : public PoolBase {
       if constexpr (HasAfterLoad<T>::value) value.afterLoad();
       add(e, std::move(value));
     }
+  }
+
+  std::string fieldLayout() const override {
+    T value{};
+    FieldLayoutWriter w;
+    value.visitFields(w);
+    return w.layout;
   }
 
   std::optional<ComponentViolation> firstViolation(double maxAbs) const override {

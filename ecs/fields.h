@@ -59,6 +59,31 @@ struct FieldReader {
   }
 };
 
+// A component's saved layout as text, one "name:kind" per field in visit order ("s" string,
+// "v<bytes>" vector of elements of that size, "q" quaternion, "e<bytes>" fixed Eigen object,
+// "p<bytes>" plain value). Checkpoints store it beside each pool, so that a file written by a
+// build whose component had other fields is refused by name instead of being misread.
+struct FieldLayoutWriter {
+  std::string layout;
+  template <class T>
+  void operator()(const char* name, const T&) {
+    std::string kind;
+    if constexpr (std::is_same_v<T, std::string>) {
+      kind = "s";
+    } else if constexpr (IsStdVector<T>::value) {
+      kind = "v" + std::to_string(sizeof(typename T::value_type));
+    } else if constexpr (std::is_same_v<T, Eigen::Quaterniond>) {
+      kind = "q";
+    } else if constexpr (IsEigenDense<T>::value) {
+      kind = "e" + std::to_string(sizeof(typename T::Scalar) * T::SizeAtCompileTime);
+    } else {
+      kind = "p" + std::to_string(sizeof(T));
+    }
+    if (!layout.empty()) layout += ' ';
+    layout += std::string(name) + ":" + kind;
+  }
+};
+
 // The first non-finite or absurdly large floating-point value, with the field's name and
 // the index inside the field (for vectors/matrices).
 struct FieldViolation {

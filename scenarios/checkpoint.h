@@ -2,14 +2,21 @@
 // Checkpoints: the full state of a run in a versioned binary file, written atomically
 // (temporary file + rename), so a crash never leaves a half-written checkpoint behind.
 //
-// Layout (format 3): magic "MONOLITH-CKPT", u32 format, u32 endianness probe 0x01020304,
+// Layout (format 4): magic "MONOLITH-CKPT", u32 format, u32 endianness probe 0x01020304,
 // u32 sizeof(double), i32 dimension, i64 step (steps completed), f64 time, string scene file,
 // string scene JSON (after --set overrides), i64 checkpoint interval of the run, i64 + f64 the
-// clock origin of a fixed-dt run (ClockOrigin), world state (see serializeWorld), u64 FNV-1a of
-// every byte before it (a flipped bit anywhere is caught). Format 2, without the clock origin
-// (which was then always (0, 0)), is still read.
+// clock origin of a fixed-dt run (ClockOrigin), the field layout of every saved component
+// (u64 count, then name and PoolBase::fieldLayout() strings), world state (see serializeWorld),
+// u64 FNV-1a of every byte before it (a flipped bit anywhere is caught).
+// A component whose fields differ from the saved layout is refused by name: its bytes would
+// otherwise be read into the wrong fields. Formats 2 and 3 (no layouts; format 2 also without
+// the clock origin, then always (0, 0)) are still read for the components whose fields have not
+// changed since (rigid bodies, shapes, colliders, kinematic motion, forces, MAC grids and
+// obstacles); files holding any other component are refused.
 #include <cstdint>
+#include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ecs/registry.h"
@@ -18,15 +25,17 @@
 
 namespace monolith {
 
-inline constexpr std::uint32_t kCheckpointFormat = 3;
+inline constexpr std::uint32_t kCheckpointFormat = 4;
 
 // Entity table (generations, alive flags, free list, names) and every pool, in name order.
 template <int d>
 void serializeWorld(const World<d>& world, BinaryWriter& out);
 // Replaces the world's state with the serialized one. Pools are created through the registry
-// (so plugin components restore too); an unknown component name is an error.
+// (so plugin components restore too); an unknown component name is an error. `beforePool`, if
+// given, sees each component name before its pool is read (and may refuse it by throwing).
 template <int d>
-void deserializeWorld(World<d>& world, BinaryReader& in, const Registry& registry);
+void deserializeWorld(World<d>& world, BinaryReader& in, const Registry& registry,
+                      const std::function<void(const std::string&)>& beforePool = {});
 
 // FNV-1a hash of serializeWorld's bytes: equal hashes = bitwise equal state.
 template <int d>
@@ -47,7 +56,10 @@ void writeCheckpoint(const std::string& path, const CheckpointHeader& header, co
 
 // Reads the header and keeps the rest for restoreCheckpointWorld().
 struct CheckpointFile {
+  std::string path;
+  std::uint32_t format = 0;
   CheckpointHeader header;
+  std::vector<std::pair<std::string, std::string>> layouts;  // component name, field layout (format >= 4)
   std::vector<std::uint8_t> bytes;
   std::size_t worldOffset = 0, worldEnd = 0;
 };

@@ -173,9 +173,10 @@ TEST(CheckpointRestart, StraightAndResumedRunsAgreeBitwise) {
 // name string per slot, u64 pool count, then per pool: name string, u64 count, and per
 // component u32 entity index, u32 generation, fields (rigid_body starts with f64 mass).
 struct Layout {
-  std::size_t format = 14, dimension = 26, step = 30, sceneFile = 46, sceneJson = 0, clock = 0, world = 0,
+  std::size_t format = 14, dimension = 26, step = 30, sceneFile = 46, sceneJson = 0, clock = 0, layouts = 0, world = 0,
               firstPool = 0, firstRecord = 0;
   std::string firstPoolName;
+  std::size_t firstLayoutText = 0;  // the first saved component's field layout string
 };
 
 // Recomputes the trailing checksum, so that a deliberately damaged field reaches the deeper
@@ -200,8 +201,16 @@ Layout parseLayout(const std::string& b) {
   Layout l;
   l.sceneJson = l.sceneFile + 8 + u64At(b, l.sceneFile);
   l.clock = l.sceneJson + 8 + u64At(b, l.sceneJson) + 8;
-  l.world = l.clock + 16;
-  std::size_t p = l.world;
+  l.layouts = l.clock + 16;
+  std::size_t p = l.layouts;
+  const std::uint64_t saved = u64At(b, p);
+  p += 8;
+  for (std::uint64_t i = 0; i < saved; ++i) {
+    p += 8 + u64At(b, p);  // component name
+    if (i == 0) l.firstLayoutText = p + 8;
+    p += 8 + u64At(b, p);  // its field layout
+  }
+  l.world = p;
   const std::uint64_t slots = u64At(b, p);
   p += 8 + 4 * slots;                // generations (u32)
   p += 8 + u64At(b, p);              // alive flags (u8)
@@ -227,6 +236,7 @@ TEST(CheckpointRestart, DamagedCheckpointsAreRejectedCleanly) {
   ASSERT_EQ(u64At(good, l.step), std::uint64_t(N));
   ASSERT_EQ(good[l.sceneJson + 8], '{');
   ASSERT_EQ(l.firstPoolName, "rigid_body");
+  ASSERT_EQ(good.substr(l.firstLayoutText, 8), "mass:p8 ");
 
   std::map<std::string, std::string> damaged;
   for (std::size_t n : {std::size_t(0), std::size_t(10), std::size_t(13), std::size_t(20), l.step + 4,
@@ -274,6 +284,20 @@ TEST(CheckpointRestart, DamagedCheckpointsAreRejectedCleanly) {
     b = good;
     b[l.firstRecord + 9] ^= 0x01;  // one flipped bit in the first body's mass, checksum not resealed
     damaged["flipped_byte"] = b;
+  }
+  {
+    // A build whose rigid body saved "mast" where this one saves "mass": refused by name, not
+    // read into the wrong fields.
+    std::string b = good;
+    b[l.firstLayoutText + 3] = 't';
+    const fs::path bad = f.tmp.path() / "other_layout.ckpt", out = f.tmp.path() / "out_other_layout";
+    writeFile(bad, reseal(b));
+    const CommandResult r =
+        run({MONOLITH_CLI, "resume", bad.string(), "--out", out.string(), "--quiet"}, f.logs, kCommandTimeoutSeconds);
+    EXPECT_EQ(r.exitCode, 3) << r.err;
+    for (const char* m : {"other_layout.ckpt", "component 'rigid_body'", "only in the file: mast:p8", "only here: mass:p8"})
+      EXPECT_NE(r.err.find(m), std::string::npos) << m << " in: " << r.err;
+    EXPECT_FALSE(fs::exists(out));
   }
 
   for (const auto& [label, bytes] : damaged) {
@@ -480,7 +504,7 @@ TEST(CheckpointRestart, FormatTwoCheckpointsStillResume) {
   ASSERT_EQ(f.straightRun(A).exitCode, 0);
   std::string b = slurp(A / checkpoint(N));
   const Layout l = parseLayout(b);
-  b.erase(l.clock, 16);
+  b.erase(l.clock, l.world - l.clock);  // clock origin and component layouts
   put<std::uint32_t>(b, l.format, 2);
   const fs::path old = f.tmp.path() / "format2.ckpt";
   writeFile(old, reseal(b));
@@ -488,6 +512,50 @@ TEST(CheckpointRestart, FormatTwoCheckpointsStillResume) {
                               kCommandTimeoutSeconds);
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_EQ(Json::parse(slurp(B / "summary.json"))["state_hash"], Json::parse(slurp(A / "summary.json"))["state_hash"]);
+}
+
+// Format 3 (no component layouts): rigid bodies still resume bitwise; a component whose saved
+// fields have changed since is refused by name.
+TEST(CheckpointRestart, FormatThreeCheckpointsResumeOnlyUnchangedComponents) {
+  Fixture f;
+  const fs::path A = f.tmp.path() / "A", B = f.tmp.path() / "B";
+  ASSERT_EQ(f.straightRun(A).exitCode, 0);
+  const auto downgrade = [](std::string b) {
+    const Layout l = parseLayout(b);
+    b.erase(l.layouts, l.world - l.layouts);
+    put<std::uint32_t>(b, l.format, 3);
+    return reseal(b);
+  };
+  const fs::path old = f.tmp.path() / "format3.ckpt";
+  writeFile(old, downgrade(slurp(A / checkpoint(N))));
+  const CommandResult r = run({MONOLITH_CLI, "resume", old.string(), "--out", B.string(), "--quiet"}, f.logs,
+                              kCommandTimeoutSeconds);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(Json::parse(slurp(B / "summary.json"))["state_hash"], Json::parse(slurp(A / "summary.json"))["state_hash"]);
+
+  // A sleeping box on a shelf: its "sleep" component has gained fields since format 3.
+  const fs::path scene = f.tmp.path() / "sleeper.json", C = f.tmp.path() / "C", D = f.tmp.path() / "D";
+  writeFile(scene, R"json({
+    "dimension": 3, "time": { "dt": 0.03333333333333333, "steps": 4 }, "gravity": [0, 0, -9.81],
+    "solvers": { "contact": { "sleep": true } },
+    "entities": [
+      { "name": "shelf", "shape": { "type": "box", "half_extents": [2, 2, 0.1] }, "collider": {},
+        "rigid_body": { "static": true } },
+      { "name": "box", "shape": { "type": "box", "half_extents": [0.2, 0.2, 0.2] }, "collider": {}, "sleep": {},
+        "rigid_body": { "mass": 1, "position": [0, 0, 0.31] } }
+    ]
+  })json");
+  const CommandResult c = run({MONOLITH_CLI, "run", scene.string(), "--out", C.string(), "--checkpoint-every", "2", "--quiet"},
+                              f.logs, kCommandTimeoutSeconds);
+  ASSERT_EQ(c.exitCode, 0) << c.err;
+  const fs::path sleeper = f.tmp.path() / "sleeper3.ckpt";
+  writeFile(sleeper, downgrade(slurp(C / checkpoint(2))));
+  const CommandResult d = run({MONOLITH_CLI, "resume", sleeper.string(), "--out", D.string(), "--quiet"}, f.logs,
+                              kCommandTimeoutSeconds);
+  EXPECT_EQ(d.exitCode, 3) << d.err;
+  for (const char* m : {"sleeper3.ckpt", "format 3", "component 'sleep'", "run the scene again from its start"})
+    EXPECT_NE(d.err.find(m), std::string::npos) << m << " in: " << d.err;
+  EXPECT_FALSE(fs::exists(D / "summary.json"));
 }
 
 }  // namespace
