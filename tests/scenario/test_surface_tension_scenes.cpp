@@ -87,6 +87,38 @@ TEST(SurfaceTensionScenes, CheckpointRestartCarriesTheFrontAndThreadsAgree) {
   EXPECT_LT(lastValue(tmp.path() / "A" / "metrics.csv", "p1_u"), 0.0);  // the drop's first half-period
 }
 
+TEST(SurfaceTensionScenes, CarriedCouplingVelocitiesRestartBitwise) {
+  // "coupling_velocity": "carried" keeps H u^n on the front's points; the checkpoint saves them
+  // (front_point_velocity), so a run resumed at step 20 ends bitwise equal to the straight one.
+  // The sampled run differs, so the option reaches the solver.
+  TempDir tmp;
+  const std::vector<std::string> common = {"--set", "entities.0.two_phase_flow.cells=[40,40]", "--set",
+                                           "time.end=0.4", "--set", "time.dt=0.01", "--quiet"};
+  auto runWith = [&](const std::string& out, const std::string& coupling, std::vector<std::string> extra) {
+    std::vector<std::string> argv = {MONOLITH_CLI, "run", kScenes + "oscillating_circle.json", "--out", (tmp.path() / out).string(),
+                                     "--set", "entities.0.two_phase_flow.coupling_velocity=" + coupling};
+    argv.insert(argv.end(), common.begin(), common.end());
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return run(argv, tmp.logs());
+  };
+  ASSERT_EQ(runWith("A", "carried", {"--checkpoint-every", "20"}).exitCode, 0);
+  ASSERT_EQ(runWith("S", "sampled", {}).exitCode, 0);
+  const fs::path checkpoint = tmp.path() / "A" / "checkpoints" / "step_00000020.ckpt";
+  ASSERT_TRUE(fs::exists(checkpoint));
+  const CommandResult b = run({MONOLITH_CLI, "resume", checkpoint.string(), "--out", (tmp.path() / "B").string(), "--quiet"},
+                              tmp.logs());
+  ASSERT_EQ(b.exitCode, 0) << b.err;
+  const Json a = Json::parse(slurp(tmp.path() / "A" / "summary.json"));
+  const Json rb = Json::parse(slurp(tmp.path() / "B" / "summary.json"));
+  const Json sampled = Json::parse(slurp(tmp.path() / "S" / "summary.json"));
+  EXPECT_EQ(a["steps_completed"], 40);
+  EXPECT_EQ(a["state_hash"], rb["state_hash"]);
+  EXPECT_NE(a["state_hash"], sampled["state_hash"]);
+  const double carriedU = lastValue(tmp.path() / "A" / "metrics.csv", "p1_u");
+  EXPECT_EQ(carriedU, lastValue(tmp.path() / "B" / "metrics.csv", "p1_u"));
+  EXPECT_NE(carriedU, lastValue(tmp.path() / "S" / "metrics.csv", "p1_u"));
+}
+
 TEST(SurfaceTensionScenes, ExplicitRisingBubbleIsStoppedByTheGuardThatNamesIt) {
   // 40 x 80 instead of 80 x 160 (the bench runs the full size): dt = 3 s is 18x the capillary limit.
   TempDir tmp;
@@ -142,9 +174,20 @@ TEST(SurfaceTensionScenes, ValidationNamesFilePathAndExpectation) {
   EXPECT_NE(tracking.exitCode, 0);
   EXPECT_NE(tracking.err.find("two_phase_flow.front.tracking"), std::string::npos) << tracking.err;
   EXPECT_NE(tracking.err.find("level_set_implicit"), std::string::npos) << tracking.err;
+  const CommandResult carried = validate("carry.json", "{" + base + R"("density_outside": 1, "coupling_velocity": "carried",
+      "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, "tracking": "level_set" } })");
+  EXPECT_NE(carried.exitCode, 0);
+  EXPECT_NE(carried.err.find("carry.json"), std::string::npos) << carried.err;
+  EXPECT_NE(carried.err.find("two_phase_flow.coupling_velocity"), std::string::npos) << carried.err;
+  EXPECT_NE(carried.err.find("\"tracking\": \"front\""), std::string::npos) << carried.err;
+  const CommandResult coupling = validate("coupling.json", "{" + base + R"("density_outside": 1, "coupling_velocity": "kept",
+      "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2 } })");
+  EXPECT_NE(coupling.exitCode, 0);
+  EXPECT_NE(coupling.err.find("two_phase_flow.coupling_velocity"), std::string::npos) << coupling.err;
+  EXPECT_NE(coupling.err.find("carried"), std::string::npos) << coupling.err;
   // The options of this page are accepted.
   const CommandResult options = validate("ok.json", "{" + base + R"("density_outside": 1, "advection": "eno_rk3",
-      "remesh": false, "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, "tracking": "level_set_implicit" } })");
+      "remesh": false, "coupling_velocity": "sampled", "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, "tracking": "level_set_implicit" } })");
   EXPECT_EQ(options.exitCode, 0) << options.err;
   const CommandResult threeD = validate("3d.json", R"({"cells": [4, 4, 4], "domain_max": [1, 1, 1]})", 3);
   EXPECT_NE(threeD.exitCode, 0);
