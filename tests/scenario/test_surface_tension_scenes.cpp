@@ -60,24 +60,32 @@ TEST(SurfaceTensionScenes, StaticCircleReportsSpeedsLimitsAndThePressureJump) {
   EXPECT_TRUE(scheduled);
 }
 
+namespace {
+// The oscillating drop at 40 x 40 to t = 0.4 (40 steps; its front moves) into tmp/out, with `extra`
+// arguments.
+CommandResult runSmallOscillatingDrop(const TempDir& tmp, const std::string& out, const std::vector<std::string>& extra) {
+  std::vector<std::string> argv = {MONOLITH_CLI, "run", kScenes + "oscillating_circle.json", "--out", (tmp.path() / out).string(),
+                                   "--set", "entities.0.two_phase_flow.cells=[40,40]", "--set", "time.end=0.4", "--set",
+                                   "time.dt=0.01", "--quiet"};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  return run(argv, tmp.logs());
+}
+
+// Resumes the checkpoint that run tmp/from wrote at step 20, into tmp/out.
+CommandResult resumeAtStep20(const TempDir& tmp, const std::string& from, const std::string& out) {
+  const fs::path checkpoint = tmp.path() / from / "checkpoints" / "step_00000020.ckpt";
+  EXPECT_TRUE(fs::exists(checkpoint));
+  return run({MONOLITH_CLI, "resume", checkpoint.string(), "--out", (tmp.path() / out).string(), "--quiet"}, tmp.logs());
+}
+}  // namespace
+
 TEST(SurfaceTensionScenes, CheckpointRestartCarriesTheFrontAndThreadsAgree) {
-  // The oscillating drop at 40 x 40 (its front moves and is remeshed): 2 x 20 steps straight with a
-  // checkpoint at 20, resumed from it, and the straight run on 1 thread: all three end bitwise equal.
+  // 2 x 20 steps straight with a checkpoint at 20, resumed from it, and the straight run on 1
+  // thread: all three end bitwise equal.
   TempDir tmp;
-  const std::vector<std::string> common = {"--set", "entities.0.two_phase_flow.cells=[40,40]", "--set",
-                                           "time.end=0.4", "--set", "time.dt=0.01", "--quiet"};
-  auto runWith = [&](const std::string& out, std::vector<std::string> extra) {
-    std::vector<std::string> argv = {MONOLITH_CLI, "run", kScenes + "oscillating_circle.json", "--out", (tmp.path() / out).string()};
-    argv.insert(argv.end(), common.begin(), common.end());
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    return run(argv, tmp.logs());
-  };
-  ASSERT_EQ(runWith("A", {"--checkpoint-every", "20", "--threads", "2"}).exitCode, 0);
-  ASSERT_EQ(runWith("C", {"--threads", "1"}).exitCode, 0);
-  const fs::path checkpoint = tmp.path() / "A" / "checkpoints" / "step_00000020.ckpt";
-  ASSERT_TRUE(fs::exists(checkpoint));
-  const CommandResult b = run({MONOLITH_CLI, "resume", checkpoint.string(), "--out", (tmp.path() / "B").string(), "--quiet"},
-                              tmp.logs());
+  ASSERT_EQ(runSmallOscillatingDrop(tmp, "A", {"--checkpoint-every", "20", "--threads", "2"}).exitCode, 0);
+  ASSERT_EQ(runSmallOscillatingDrop(tmp, "C", {"--threads", "1"}).exitCode, 0);
+  const CommandResult b = resumeAtStep20(tmp, "A", "B");
   ASSERT_EQ(b.exitCode, 0) << b.err;
   const Json a = Json::parse(slurp(tmp.path() / "A" / "summary.json"));
   const Json rb = Json::parse(slurp(tmp.path() / "B" / "summary.json"));
@@ -92,33 +100,25 @@ TEST(SurfaceTensionScenes, CheckpointRestartCarriesTheFrontAndThreadsAgree) {
 TEST(SurfaceTensionScenes, CarriedCouplingVelocitiesRestartBitwise) {
   // "coupling_velocity": "carried" keeps H u^n on the front's points; the checkpoint saves them
   // (front_point_velocity), so a run resumed at step 20 ends bitwise equal to the straight one.
-  // The sampled run differs, so the option reaches the solver.
+  // Sampled (with its own checkpoint and resume) differs, so the option reaches the solver.
   TempDir tmp;
-  const std::vector<std::string> common = {"--set", "entities.0.two_phase_flow.cells=[40,40]", "--set",
-                                           "time.end=0.4", "--set", "time.dt=0.01", "--quiet"};
-  auto runWith = [&](const std::string& out, const std::string& coupling, std::vector<std::string> extra) {
-    std::vector<std::string> argv = {MONOLITH_CLI, "run", kScenes + "oscillating_circle.json", "--out", (tmp.path() / out).string(),
-                                     "--set", "entities.0.two_phase_flow.coupling_velocity=" + coupling};
-    argv.insert(argv.end(), common.begin(), common.end());
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    return run(argv, tmp.logs());
-  };
-  ASSERT_EQ(runWith("A", "carried", {"--checkpoint-every", "20"}).exitCode, 0);
-  ASSERT_EQ(runWith("S", "sampled", {}).exitCode, 0);
-  const fs::path checkpoint = tmp.path() / "A" / "checkpoints" / "step_00000020.ckpt";
-  ASSERT_TRUE(fs::exists(checkpoint));
-  const CommandResult b = run({MONOLITH_CLI, "resume", checkpoint.string(), "--out", (tmp.path() / "B").string(), "--quiet"},
-                              tmp.logs());
-  ASSERT_EQ(b.exitCode, 0) << b.err;
-  const Json a = Json::parse(slurp(tmp.path() / "A" / "summary.json"));
-  const Json rb = Json::parse(slurp(tmp.path() / "B" / "summary.json"));
-  const Json sampled = Json::parse(slurp(tmp.path() / "S" / "summary.json"));
-  EXPECT_EQ(a["steps_completed"], 40);
-  EXPECT_EQ(a["state_hash"], rb["state_hash"]);
-  EXPECT_NE(a["state_hash"], sampled["state_hash"]);
-  const double carriedU = lastValue(tmp.path() / "A" / "metrics.csv", "p1_u");
-  EXPECT_EQ(carriedU, lastValue(tmp.path() / "B" / "metrics.csv", "p1_u"));
-  EXPECT_NE(carriedU, lastValue(tmp.path() / "S" / "metrics.csv", "p1_u"));
+  for (const std::string coupling : {"carried", "sampled"}) {
+    const std::vector<std::string> set = {"--set", "entities.0.two_phase_flow.coupling_velocity=" + coupling};
+    std::vector<std::string> extra = set;
+    extra.insert(extra.end(), {"--checkpoint-every", "20"});
+    ASSERT_EQ(runSmallOscillatingDrop(tmp, coupling, extra).exitCode, 0);
+    const CommandResult b = resumeAtStep20(tmp, coupling, coupling + "_resumed");
+    ASSERT_EQ(b.exitCode, 0) << b.err;
+    const Json a = Json::parse(slurp(tmp.path() / coupling / "summary.json"));
+    const Json rb = Json::parse(slurp(tmp.path() / (coupling + "_resumed") / "summary.json"));
+    EXPECT_EQ(a["steps_completed"], 40);
+    EXPECT_EQ(a["state_hash"], rb["state_hash"]) << coupling;
+    EXPECT_EQ(lastValue(tmp.path() / coupling / "metrics.csv", "p1_u"),
+              lastValue(tmp.path() / (coupling + "_resumed") / "metrics.csv", "p1_u")) << coupling;
+  }
+  EXPECT_NE(Json::parse(slurp(tmp.path() / "carried" / "summary.json"))["state_hash"],
+            Json::parse(slurp(tmp.path() / "sampled" / "summary.json"))["state_hash"]);
+  EXPECT_NE(lastValue(tmp.path() / "carried" / "metrics.csv", "p1_u"), lastValue(tmp.path() / "sampled" / "metrics.csv", "p1_u"));
 }
 
 TEST(SurfaceTensionScenes, FrontFramesReadBackWithVtk) {
