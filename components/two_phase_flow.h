@@ -37,6 +37,7 @@ struct TwoPhaseFlow {
   double tolerance = 1e-12;                      // CG relative tolerance of (6.33)
   std::uint8_t levelSetFront = 0;                // 1: the front is rebuilt each step from `phi`;
                                                  // 2: and phi follows the mesh moved by H u (implicit update)
+  std::uint8_t carryCouplingVelocity = 0;        // 1: coupling faces' u* from the points' carried H u^n
 
   // --- state ---
   std::vector<double> u;               // face velocities, MAC layout order
@@ -45,6 +46,7 @@ struct TwoPhaseFlow {
   std::vector<double> pInside, pOutside;  // per cell
   std::vector<double> phi;             // level-set-tracked fronts: signed distance per cell
   double initialArea = 0;              // enclosed by the front at the start (area drift)
+  std::vector<double> frontPointVelocity;  // carryCouplingVelocity: H u^n, d per point (empty: sample the grid)
 
   // --- probes: velocity sampled at points, reported as <name>_u, <name>_v in metrics.csv ---
   std::vector<double> probePoints;     // d per probe
@@ -79,6 +81,9 @@ struct TwoPhaseFlow {
     visit("initial_area", initialArea);
     visit("probe_points", probePoints);
     visit("probe_names", probeNames);
+    // Appended after the original fields, so the layout of the fields before them is unchanged.
+    visit("carry_coupling_velocity", carryCouplingVelocity);
+    visit("front_point_velocity", frontPointVelocity);
   }
 };
 

@@ -23,6 +23,8 @@
 #include "scenarios/vtk_grid_writer.h"
 #include "scenarios/vtk_writer.h"
 #include "scenarios/vtk_deformable_writer.h"
+#include "scenarios/vtk_front_writer.h"
+#include "components/two_phase_flow.h"
 #include "components/deformable.h"
 
 namespace monolith {
@@ -136,6 +138,9 @@ void Run<d>::setUpFrameSeries() {
     add("fluid", ".vti", [](const World<d>& w, const std::string& p) { writeMacGridFrame(w, p); });
   if (world().template count<Particles<d>>() > 0)
     add("deformables", ".vtu", [](const World<d>& w, const std::string& p) { writeDeformableFrame(w, p); });
+  if constexpr (d == 2)
+    if (world().template count<TwoPhaseFlow<d>>() > 0)
+      add("front", ".vtp", [](const World<d>& w, const std::string& p) { writeFrontFrame(w, p); });
 }
 
 template <int d>

@@ -111,6 +111,15 @@ void parseTwoPhaseFlow(World<d>& world, Entity e, const Config& c) {
     const Config f = c.child("front");
     const std::string tracking = f.oneOf("tracking", {"front", "level_set", "level_set_implicit"}, "front");
     flow.levelSetFront = tracking == "front" ? 0 : tracking == "level_set" ? 1 : 2;
+    // Where a coupling face's u* comes from (docs/surface_tension.md, step 3): sampled from the grid
+    // each step, or carried on the front's points from the last solve. A level-set front's mesh is
+    // rebuilt every step, so it has no points to carry velocities on.
+    flow.carryCouplingVelocity = c.oneOf("coupling_velocity", {"sampled", "carried"}, "sampled") == "carried";
+    if (flow.carryCouplingVelocity && flow.levelSetFront)
+      c.failAt("coupling_velocity",
+               "\"sampled\" with a level-set-tracked front (\"carried\" needs \"tracking\": \"front\": a level set's mesh "
+               "is rebuilt every step, so no point keeps its velocity)",
+               "\"carried\" with \"tracking\": \"" + tracking + "\"");
     solvers::Front2 front = parseFront(f, flow.dx);
     const Eigen::Vector2d upper = flow.origin + flow.dx * flow.cells.cast<double>();
     for (const auto& x : front.points)
@@ -162,7 +171,8 @@ void registerSurfaceTensionComponents(Registry& r) {
   r.addComponentOf<d, TwoPhaseFlow<d>>(
       "one- or two-phase flow with surface tension on a Lagrangian front (2-D): cells, domain_min/max, phases "
       "(one|two), density_inside/outside, viscosity, surface_tension, treatment (implicit|explicit), gravity, "
-      "advection, front {shape: circle|polygon, tracking: front|level_set}, probes [{name, position}]",
+      "advection, coupling_velocity (sampled|carried), front {shape: circle|polygon, tracking: "
+      "front|level_set|level_set_implicit}, probes [{name, position}]",
       parseTwoPhaseFlow<d>);
 }
 

@@ -51,13 +51,16 @@ void appendStringArray(std::ostringstream& x, const char* name, const std::vecto
 }
 
 std::string polyDataFile(std::size_t nPoints, const std::vector<double>& coords, const std::string& pointData,
-                         const std::string& cells, std::size_t nVerts, std::size_t nPolys) {
+                         const std::string& cells, std::size_t nVerts, std::size_t nPolys, std::size_t nLines = 0,
+                         const std::string& cellData = "") {
   std::ostringstream x;
   x << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
        "header_type=\"UInt64\">\n  <PolyData>\n    <Piece NumberOfPoints=\""
-    << nPoints << "\" NumberOfVerts=\"" << nVerts << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\""
-    << nPolys << "\">\n      <PointData>\n"
-    << pointData << "      </PointData>\n      <Points>\n";
+    << nPoints << "\" NumberOfVerts=\"" << nVerts << "\" NumberOfLines=\"" << nLines
+    << "\" NumberOfStrips=\"0\" NumberOfPolys=\"" << nPolys << "\">\n      <PointData>\n"
+    << pointData << "      </PointData>\n";
+  if (!cellData.empty()) x << "      <CellData>\n" << cellData << "      </CellData>\n";
+  x << "      <Points>\n";
   appendArray(x, "Float64", "Points", 3, coords);
   x << "      </Points>\n" << cells << "    </Piece>\n  </PolyData>\n</VTKFile>\n";
   return x.str();
@@ -80,6 +83,17 @@ std::string cellBlock(const char* tag, const std::vector<std::vector<int>>& cell
 }
 
 }  // namespace
+
+std::string polyLineFile(const std::vector<double>& coords, const std::vector<std::vector<int>>& lines,
+                         const std::vector<VtkArray>& pointData, const std::vector<VtkArray>& cellData) {
+  auto arrays = [](const std::vector<VtkArray>& list) {
+    std::ostringstream x;
+    for (const VtkArray& a : list) appendArray(x, "Float64", a.name.c_str(), a.components, a.values);
+    return x.str();
+  };
+  return polyDataFile(coords.size() / 3, coords, arrays(pointData), cellBlock("Lines", lines), 0, 0, lines.size(),
+                      arrays(cellData));
+}
 
 void writeFileAtomically(const std::string& path, const std::string& content) {
   const std::string tmp = path + ".tmp";

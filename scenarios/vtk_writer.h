@@ -35,6 +35,17 @@ class PvdCollection {
   std::vector<std::pair<double, std::string>> entries_;
 };
 
+// One Float64 data array of a VTK file: `components` values per point (or per cell).
+struct VtkArray {
+  std::string name;
+  int components = 1;
+  std::vector<double> values;
+};
+// The text of a PolyData (.vtp) file of polylines: coords holds x, y, z per point, each line lists
+// its point ids in order (a closed loop repeats its first id at the end).
+std::string polyLineFile(const std::vector<double>& coords, const std::vector<std::vector<int>>& lines,
+                         const std::vector<VtkArray>& pointData, const std::vector<VtkArray>& cellData);
+
 // Writes a file atomically: to path + ".tmp", then rename.
 void writeFileAtomically(const std::string& path, const std::string& content);
 

@@ -39,6 +39,8 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
       state.pInside = flow.pInside;
       state.pOutside = flow.pOutside;
       state.phi = flow.phi;
+      for (std::size_t k = 0; k + 1 < flow.frontPointVelocity.size(); k += 2)
+        state.pointVelocity.emplace_back(flow.frontPointVelocity[k], flow.frontPointVelocity[k + 1]);
       state.time = ctx.time;
       state.step = static_cast<int>(ctx.step);
 
@@ -61,6 +63,7 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
       s.solve.relativeTolerance = flow.tolerance;
       s.levelSetFront = flow.levelSetFront != 0;
       s.levelSetImplicitUpdate = flow.levelSetFront == 2;
+      s.carryCouplingVelocity = flow.carryCouplingVelocity != 0;
 
       const Eigen::Vector2d centroidBefore = solvers::measureFront(state.front).centroid;
       const solvers::TwoPhaseStepReport r = solvers::advanceTwoPhase(state, s, ctx.dt);
@@ -73,6 +76,8 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
       flow.pInside = state.pInside;
       flow.pOutside = state.pOutside;
       flow.phi = state.phi;
+      flow.frontPointVelocity.clear();
+      for (const auto& v : state.pointVelocity) flow.frontPointVelocity.insert(flow.frontPointVelocity.end(), {v.x(), v.y()});
 
       auto& out = ctx.diagnostics;
       out.max("fluid_max_speed", r.maxSpeed);

@@ -6,10 +6,10 @@ usage: read_vtp.py FILE...   (FILE: *.vtp or *.pvd)
 Prints one JSON object {"files": {FILE: {...}}, "vtk_version": "..."} on stdout.
 
   *.vtp  read with vtk.vtkXMLPolyDataReader (the reader ParaView uses):
-         number_of_points/verts/polys, bounds (VTK's GetBounds), points [[x,y,z],...],
-         polys [[point ids],...], and point_data {array name: {class, components, tuples,
-         values}} where values are a flat list for one component, a list of tuples otherwise
-         and a list of str for a vtkStringArray.
+         number_of_points/verts/polys/lines, bounds (VTK's GetBounds), points [[x,y,z],...],
+         polys and lines [[point ids],...], and point_data and cell_data {array name: {class,
+         components, tuples, values}} where values are a flat list for one component, a list
+         of tuples otherwise and a list of str for a vtkStringArray.
   *.pvd  read with vtkPVDReader when this VTK has it (it is ParaView's), else parsed as XML:
          reader, timesteps, files, files_exist.
 
@@ -70,11 +70,18 @@ def read_vtp(path):
     while cells.GetNextCell(ids):
         polys.append([ids.GetId(k) for k in range(ids.GetNumberOfIds())])
     out["polys"] = polys
-    point_data = poly.GetPointData()
-    out["point_data"] = {}
-    for i in range(point_data.GetNumberOfArrays()):
-        array = point_data.GetAbstractArray(i)
-        out["point_data"][array.GetName()] = array_json(array)
+    out["number_of_lines"] = poly.GetNumberOfLines()
+    lines = []
+    cells = poly.GetLines()
+    cells.InitTraversal()
+    while cells.GetNextCell(ids):
+        lines.append([ids.GetId(k) for k in range(ids.GetNumberOfIds())])
+    out["lines"] = lines
+    for key, data in (("point_data", poly.GetPointData()), ("cell_data", poly.GetCellData())):
+        out[key] = {}
+        for i in range(data.GetNumberOfArrays()):
+            array = data.GetAbstractArray(i)
+            out[key][array.GetName()] = array_json(array)
     return out
 
 
