@@ -115,6 +115,9 @@ struct ArticulationSolver {
   // contacts together (systems/articulation.h, resolveJointedInterpenetration); 0: push-out's
   // poses, then the joints closed without regard to contacts.
   int pushOutContactSweeps = 50;
+  // With colliders: passes of that solve, each with the contact points found again where the
+  // last one left the bodies, while an overlap beyond push-out's tolerance is left.
+  int pushOutContactPasses = 1;
 
   template <class V>
   void visitFields(V& visit) {
@@ -127,6 +130,7 @@ struct ArticulationSolver {
     visit("pre_tolerance", preTolerance);
     visit("contact_rounds", contactRounds);
     visit("push_out_contact_sweeps", pushOutContactSweeps);
+    visit("push_out_contact_passes", pushOutContactPasses);
   }
 };
 

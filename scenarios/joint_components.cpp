@@ -165,6 +165,8 @@ void parseArticulation(World<3>& world, Entity e, const Config& c) {
   s.contactRounds = static_cast<int>(c.integer("contact_rounds", s.contactRounds, 0, 1000));
   s.pushOutContactSweeps =
       static_cast<int>(c.integer("push_out_contact_sweeps", s.pushOutContactSweeps, 0, 1000000));
+  s.pushOutContactPasses =
+      static_cast<int>(c.integer("push_out_contact_passes", s.pushOutContactPasses, 1, 1000));
   world.add(e, s);
 }
 
@@ -231,7 +233,7 @@ void registerJointComponents(Registry& r) {
   r.addComponentOf<3, ArticulationSolver>(
       "how the scene's joints are solved (one per scene): post_stabilization/pre_stabilization \"pairwise\" or "
       "\"global\", pre_stabilize, post_iterations, post_tolerance, pre_iterations, pre_tolerance, contact_rounds, "
-      "push_out_contact_sweeps",
+      "push_out_contact_sweeps, push_out_contact_passes",
       parseArticulation);
 }
 

@@ -226,9 +226,73 @@ Limbs stop short of their joints: jointed parts never touch. Check: no joint ope
 any step (the pile does not come to rest: docs/articulation.md).""", scene)
 
 
+def twisting_chain_rigid(loops=(1, 3, 5), rings=7, end=2.0):
+    """Rigid part of Fig. 4.1: hexagonal rings of six capsules hung on one another along x."""
+    side, radius, mass = 0.3, 0.03, 0.2
+    col = {"restitution": 0.0, "friction": 0.5}
+    notch = 0.045  # a rigid ring's unjointed vertex: its two caps kept apart (they would collide)
+    entities = []
+    for k in range(rings):
+        c = (side * k, 0.0, 0.0)
+        e = (0.0, 1.0, 0.0) if k % 2 == 0 else (0.0, 0.0, 1.0)  # rings alternate between the xy and xz planes
+
+        def vertex(j):
+            t = math.pi / 3 * (j % 6)
+            return [c[i] + side * (math.cos(t) * (1.0 if i == 0 else 0.0) + math.sin(t) * e[i]) for i in range(3)]
+
+        kind = "static" if k == 0 else "loop" if k in loops else "rigid"
+        for j in range(6):
+            # Capsule j runs from vertex j + 1 to vertex j + 2, so that vertex 1 (at 60 degrees, off
+            # the axis) is where a rigid ring's chain of fixed joints stays open.
+            a, b = vertex(j + 1), vertex(j + 2)
+            d = [b[i] - a[i] for i in range(3)]
+            ln = math.sqrt(sum(x * x for x in d))
+            u = [x / ln for x in d]
+            cut_a = notch if kind != "loop" and k != 0 and j == 0 else 0.0
+            cut_b = notch if kind != "loop" and k != 0 and j == 5 else 0.0
+            aa = [a[i] + cut_a * u[i] for i in range(3)]
+            bb = [b[i] - cut_b * u[i] for i in range(3)]
+            centre = [(aa[i] + bb[i]) / 2 for i in range(3)]
+            half = 0.5 * (ln - cut_a - cut_b)  # the caps' centres at the vertices
+            name = "ring%d_%d" % (k, j)
+            body = {"mass": mass, "position": r(centre), "orientation": r(quat_from_z_to(u))}
+            if kind == "static":
+                body = {"static": True, "position": r(centre), "orientation": r(quat_from_z_to(u))}
+            ent = {"name": name, "shape": {"type": "capsule", "radius": radius, "half_height": round(half, 12)},
+                   "rigid_body": body, "collider": col}
+            if kind == "loop":
+                ent["joint"] = {"type": "spherical", "parent": "ring%d_%d" % (k, (j - 1) % 6), "anchor": r(a)}
+            elif kind == "rigid" and j > 0:
+                ent["joint"] = {"type": "fixed", "parent": "ring%d_%d" % (k, j - 1), "anchor": r(a)}
+            entities.append(ent)
+        if k == rings - 1:
+            entities.append({"name": "crank", "shape": {"type": "sphere", "radius": 0.05},
+                             "rigid_body": {"mass": 1.0, "position": r(c)},
+                             "kinematic": {"schedule": [{"angular_velocity": [math.pi, 0.0, 0.0]}]}})
+            entities.append({"name": "crank_weld", "joint": {"type": "fixed", "parent": "crank",
+                                                             "child": "ring%d_0" % k, "anchor": r(c)}})
+    entities.append({"name": "solver", "articulation": {"post_stabilization": "global", "pre_stabilization": "global",
+                                                        "push_out_contact_passes": 10}})
+    return {"description": "rigid part of the twisting chain (Fig. 4.1): rings and articulated loops wound by a spun ring",
+            "dimension": 3, "time": {"dt": 1 / 120, "end": end, "frame_rate": 30},
+            "gravity": [0, -9.81, 0], "entities": entities,
+            "checks": [{"name": "joints_closed", "kind": "diagnostic", "diagnostic": "joint_error_max",
+                        "statistic": "max", "reference": 0, "tolerance": 1e-6},
+                       {"name": "overlap_left", "kind": "diagnostic", "diagnostic": "joint_push_out_overlap_left",
+                        "statistic": "max", "reference": 0, "tolerance": 0.01}]}
+
+
 if __name__ == "__main__":
     pendulum()
     chain_hanging()
     loop_six()
     pd_arm()
     ragdoll_pile()
+    scene = twisting_chain_rigid()
+    write("twisting_chain_rigid", """
+Rigid part of the twisting chain (thesis Fig. 4.1): seven hexagonal rings of six capsules (0.3 m
+sides, radius 3 cm) along x, each turned 90 degrees from the one before so that its vertex on the
+axis sits at the centre of the next ring's hole. Ring 0 is static; rings 1, 3, 5 are articulated
+loops (spherical joints at the vertices); rings 2, 4, 6 are rigid (chains of fixed joints, open at
+the vertex at 60 degrees); ring 6 is welded to a kinematic crank turning half a turn a second
+about the axis, which winds the chain. The capsules' caps are centred on the vertices.""", scene)
