@@ -8,11 +8,13 @@ struct SurfaceCollision {
   static constexpr const char* kName = "surface_collision";
   double thickness = 0.01;  // m; a pair uses the larger of its bodies'
   double friction = 0;      // Coulomb coefficient; a pair uses the larger of its bodies'
+  int self = 1;             // 1: the surface also collides with itself (cloth); 0: only with others
 
   template <class V>
   void visitFields(V& visit) {
     visit("thickness", thickness);
     visit("friction", friction);
+    visit("self", self);
   }
 };
 

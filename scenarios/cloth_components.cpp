@@ -71,9 +71,14 @@ void parseCloth(World<3>& world, Entity e, const Config& c) {
 
 template <int d>
 void parseSurfaceCollision(World<d>& world, Entity e, const Config& c) {
+  if (!world.template has<SimplexMesh<d>>(e) && !world.template has<ClothMesh>(e))
+    c.fail("surface_collision on an entity with a \"deformable\" or \"cloth\" entry", "an entity without either");
   SurfaceCollision s;
   s.thickness = c.number("thickness", Bound::Positive);
   s.friction = c.number("friction", 0.0, Bound::NonNegative);
+  // Cloth folds onto itself; a solid's own surface meets itself only through large deformations,
+  // and its snapped surface vertices may lie closer than the thickness to their neighbours.
+  s.self = c.boolean("self", world.template has<ClothMesh>(e)) ? 1 : 0;
   world.add(e, s);
 }
 
@@ -109,7 +114,7 @@ void registerSurfaceCollision(Registry& r) {
   r.addComponent<d>(ComponentType<d>{
       "surface_collision",
       "on a deformable or cloth entity: its surface collides with other such surfaces and itself (Bridson et al. "
-      "2002): thickness (m), friction",
+      "2002): thickness (m), friction, self (default: true for cloth, false for solids)",
       parseSurfaceCollision<d>, [](World<d>& w) { w.template ensurePool<SurfaceCollision>(); }, ""});
 }
 

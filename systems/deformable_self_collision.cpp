@@ -1,6 +1,5 @@
 #include "systems/deformable_self_collision.h"
 
-#include <limits>
 
 #include "components/cloth.h"
 
@@ -24,14 +23,17 @@ void DeformableSelfCollision<d>::run(World<d>& world, StepContext& ctx) {
     for (std::size_t k = 0; k < entities.size(); ++k) {
       const SurfaceCollision& c = *world.template get<SurfaceCollision>(entities[k]);
       if (const auto* mesh = world.template get<SimplexMesh<d>>(entities[k]))
-        dm::addMeshBoundary<d>(surface_, mesh->elements, first, c.thickness, c.friction);
+        dm::addMeshBoundary<d>(surface_, mesh->elements, first, c.thickness, c.friction,
+                               c.self ? -1 : static_cast<int>(k));
       if constexpr (d == 3)
         if (const auto* cloth = world.template get<ClothMesh>(entities[k]))
-          dm::addFaces<3>(surface_, cloth->triangles, first, particles[k]->count(), c.thickness, c.friction);
+          dm::addFaces<3>(surface_, cloth->triangles, first, particles[k]->count(), c.thickness, c.friction,
+                          c.self ? -1 : static_cast<int>(k));
       first += particles[k]->count();
     }
     surface_.thickness.resize(first, 0.0);
     surface_.friction.resize(first, 0.0);
+    surface_.group.resize(first, -1);
     bodies_ = bodies;
   }
   std::vector<double> x, v, inverseMass;
@@ -45,7 +47,6 @@ void DeformableSelfCollision<d>::run(World<d>& world, StepContext& ctx) {
   if (stage_ == Stage::Collisions) {
     const dm::ProximityReport r = dm::repelProximities<d>(surface_, x, v, inverseMass, ctx.dt, settings);
     out.set("self_collision_repulsions", r.repulsions);
-    if (std::isfinite(r.closest)) out.set("self_collision_closest", r.closest);
   }
   const dm::ProximityReport c = dm::resolveCollisions<d>(surface_, x, v, inverseMass, ctx.dt, settings);
   out.max("self_collision_impulses", c.collisions);

@@ -113,7 +113,7 @@ template <int d, class X>
 Stencil<d> stencilOf(const CollisionSurface<d>& s, const Pair& pair, X pos) {
   Stencil<d> st;
   VecD<d> fallback = VecD<d>::Zero();
-  VecD<d> gap;
+  VecD<d> gap = VecD<d>::Zero();
   if (!pair.edges) {
     const int* f = &s.faces[d * pair.b];
     st.n = d + 1;
@@ -253,7 +253,8 @@ std::vector<Pair> candidatePairs(const CollisionSurface<d>& s, const std::vector
     hits.erase(std::remove_if(hits.begin(), hits.end(),
                               [&](int f) {
                                 const int* idx = &s.faces[d * f];
-                                return std::find(idx, idx + d, i) != idx + d;
+                                const int g = s.group[i];
+                                return std::find(idx, idx + d, i) != idx + d || (g >= 0 && g == s.group[idx[0]]);
                               }),
                hits.end());
     std::sort(hits.begin(), hits.end());
@@ -265,7 +266,9 @@ std::vector<Pair> candidatePairs(const CollisionSurface<d>& s, const std::vector
     hits.erase(std::remove_if(hits.begin(), hits.end(),
                               [&](int f) {
                                 const int b0 = s.edges[2 * f], b1 = s.edges[2 * f + 1];
-                                return f <= e || b0 == a0 || b0 == a1 || b1 == a0 || b1 == a1;
+                                const int g = s.group[a0];
+                                return f <= e || b0 == a0 || b0 == a1 || b1 == a0 || b1 == a1 ||
+                                       (g >= 0 && g == s.group[b0]);
                               }),
                hits.end());
     std::sort(hits.begin(), hits.end());
@@ -398,12 +401,13 @@ double firstContactTime(const CollisionSurface<d>& s, const Pair& pair, const st
 
 template <int d>
 void addEdgesAndPoints(CollisionSurface<d>& s, const std::vector<int>& newFaces, int particleCount, int first,
-                       double thickness, double friction) {
+                       double thickness, double friction, int group) {
   const int base = static_cast<int>(s.thickness.size());
   const int needed = first + particleCount;
   if (base < needed) {
     s.thickness.resize(needed, 0.0);
     s.friction.resize(needed, 0.0);
+    s.group.resize(needed, -1);
   }
   std::vector<char> used(particleCount, 0);
   std::vector<std::pair<int, int>> edges;
@@ -430,6 +434,7 @@ void addEdgesAndPoints(CollisionSurface<d>& s, const std::vector<int>& newFaces,
       s.points.push_back(first + i);
       s.thickness[first + i] = thickness;
       s.friction[first + i] = friction;
+      s.group[first + i] = group;
     }
 }
 
@@ -437,7 +442,7 @@ void addEdgesAndPoints(CollisionSurface<d>& s, const std::vector<int>& newFaces,
 
 template <int d>
 void addMeshBoundary(CollisionSurface<d>& s, const std::vector<int>& elements, int first, double thickness,
-                     double friction) {
+                     double friction, int group) {
   // Faces of one element only, kept with the orientation they have in it.
   std::map<std::vector<int>, std::pair<int, std::vector<int>>> faces;
   const int ne = static_cast<int>(elements.size()) / (d + 1);
@@ -457,13 +462,13 @@ void addMeshBoundary(CollisionSurface<d>& s, const std::vector<int>& elements, i
   std::vector<int> boundary;
   for (const auto& [key, entry] : faces)
     if (entry.first == 1) boundary.insert(boundary.end(), entry.second.begin(), entry.second.end());
-  addEdgesAndPoints<d>(s, boundary, particleCount, first, thickness, friction);
+  addEdgesAndPoints<d>(s, boundary, particleCount, first, thickness, friction, group);
 }
 
 template <int d>
 void addFaces(CollisionSurface<d>& s, const std::vector<int>& faces, int first, int particleCount, double thickness,
-              double friction) {
-  addEdgesAndPoints<d>(s, faces, particleCount, first, thickness, friction);
+              double friction, int group) {
+  addEdgesAndPoints<d>(s, faces, particleCount, first, thickness, friction, group);
 }
 
 template <int d>
@@ -525,8 +530,8 @@ int countCollisions(const CollisionSurface<d>& s, const std::vector<double>& x, 
 }
 
 #define MONOLITH_INSTANTIATE(D)                                                                                   \
-  template void addMeshBoundary<D>(CollisionSurface<D>&, const std::vector<int>&, int, double, double);          \
-  template void addFaces<D>(CollisionSurface<D>&, const std::vector<int>&, int, int, double, double);            \
+  template void addMeshBoundary<D>(CollisionSurface<D>&, const std::vector<int>&, int, double, double, int);     \
+  template void addFaces<D>(CollisionSurface<D>&, const std::vector<int>&, int, int, double, double, int);       \
   template ProximityReport repelProximities<D>(const CollisionSurface<D>&, const std::vector<double>&,           \
                                                std::vector<double>&, const std::vector<double>&, double,         \
                                                const ProximitySettings&);                                        \

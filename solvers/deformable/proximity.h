@@ -32,6 +32,9 @@ struct CollisionSurface {
   std::vector<int> points;  // particles on a surface, each once
   std::vector<double> thickness;  // per particle; a pair uses the largest of its particles'
   std::vector<double> friction;   // per particle; a pair uses the largest of its particles'
+  // Per particle: pairs whose particles are all of one group >= 0 are skipped (a solid's own
+  // surface); -1 collides with everything, itself included (cloth).
+  std::vector<int> group;
   int faceCount() const { return static_cast<int>(faces.size()) / d; }
   int edgeCount() const { return static_cast<int>(edges.size()) / 2; }
 };
@@ -55,11 +58,11 @@ struct ProximityReport {
 // surface point. Indices are offset by `first` (the body's first particle in the joint arrays).
 template <int d>
 void addMeshBoundary(CollisionSurface<d>& s, const std::vector<int>& elements, int first, double thickness,
-                     double friction);
+                     double friction, int group);
 // A surface given by its faces (cloth triangles, d indices each), both sides colliding.
 template <int d>
 void addFaces(CollisionSurface<d>& s, const std::vector<int>& faces, int first, int particleCount, double thickness,
-              double friction);
+              double friction, int group);
 
 template <int d>
 ProximityReport repelProximities(const CollisionSurface<d>& s, const std::vector<double>& x, std::vector<double>& v,
