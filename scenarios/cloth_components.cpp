@@ -122,11 +122,16 @@ template <int d>
 void registerSelfCollisionSystems(Registry& r) {
   r.addSystem<d>({"deformable_self_collisions",
                   "deformable-deformable and self collisions (Bridson et al. 2002): proximity repulsion and "
-                  "continuous collision passes at Step II, collision passes again at Step III",
+                  "continuous collision passes at Step II, collision passes again at Step III; surface_crossings counts "
+                  "what still passed through a colliding surface over the step",
                   [] {
                     std::vector<std::unique_ptr<System<d>>> v;
-                    v.push_back(std::make_unique<DeformableSelfCollision<d>>(Stage::Collisions));
-                    v.push_back(std::make_unique<DeformableSelfCollision<d>>(Stage::Contact));
+                    auto afterCollisions = std::make_shared<std::vector<double>>();
+                    v.push_back(std::make_unique<DeformableSelfCollision<d>>(Stage::Collisions, afterCollisions));
+                    v.push_back(std::make_unique<DeformableSelfCollision<d>>(Stage::Contact, afterCollisions));
+                    auto scratch = std::make_shared<SurfaceCrossingScratch>();
+                    v.push_back(std::make_unique<SurfaceCrossings<d>>(Stage::ForcesAtStart, scratch));
+                    v.push_back(std::make_unique<SurfaceCrossings<d>>(Stage::Diagnostics, scratch));
                     return v;
                   },
                   ""});

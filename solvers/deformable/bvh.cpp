@@ -49,6 +49,29 @@ int Bvh<d>::buildNode(const std::vector<Box<d>>& boxes, int begin, int end) {
 }
 
 template <int d>
+void Bvh<d>::refit(const std::vector<Box<d>>& boxes) {
+  if (boxes.size() != order_.size()) {
+    build(boxes);
+    return;
+  }
+  leafBoxes_ = boxes;
+  // Children are created after their parent: a reverse sweep sees them first.
+  for (int id = static_cast<int>(nodes_.size()) - 1; id >= 0; --id) {
+    Node& n = nodes_[id];
+    if (n.left < 0) {
+      n.box = boxes[order_[n.begin]];
+      for (int k = n.begin + 1; k < n.end; ++k) {
+        n.box.lo = n.box.lo.cwiseMin(boxes[order_[k]].lo);
+        n.box.hi = n.box.hi.cwiseMax(boxes[order_[k]].hi);
+      }
+    } else {
+      n.box.lo = nodes_[n.left].box.lo.cwiseMin(nodes_[n.right].box.lo);
+      n.box.hi = nodes_[n.left].box.hi.cwiseMax(nodes_[n.right].box.hi);
+    }
+  }
+}
+
+template <int d>
 void Bvh<d>::query(const Box<d>& q, std::vector<int>& out) const {
   if (nodes_.empty()) return;
   int stack[128];

@@ -10,7 +10,7 @@ namespace monolith::solvers::deformable {
 
 template <int d>
 struct Box {
-  Eigen::Matrix<double, d, 1> lo, hi;
+  Eigen::Matrix<double, d, 1> lo = Eigen::Matrix<double, d, 1>::Zero(), hi = Eigen::Matrix<double, d, 1>::Zero();
   bool overlaps(const Box& o) const { return (lo.array() <= o.hi.array()).all() && (o.lo.array() <= hi.array()).all(); }
 };
 
@@ -18,6 +18,10 @@ template <int d>
 class Bvh {
  public:
   void build(const std::vector<Box<d>>& boxes);
+  // New boxes for the same primitives: the tree keeps its structure, its boxes are recomputed
+  // bottom-up (cheaper than a build; looser as the primitives move, never wrong).
+  void refit(const std::vector<Box<d>>& boxes);
+  std::size_t size() const { return order_.size(); }
   // Appends to `out` every primitive index whose box overlaps `query`, in tree order (fixed for a
   // given build).
   void query(const Box<d>& query, std::vector<int>& out) const;

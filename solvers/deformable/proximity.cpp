@@ -9,7 +9,6 @@
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
 
-#include "solvers/deformable/bvh.h"
 #include "solvers/deformable/elasticity.h"
 
 namespace monolith::solvers::deformable {
@@ -242,9 +241,10 @@ std::vector<Pair> candidatePairs(const CollisionSurface<d>& s, const std::vector
   std::vector<Box<d>> faceBoxes(nf), edgeBoxes(ne);
   parallelIndices(nf, [&](int f) { faceBoxes[f] = boundsOf<d>(x, v, dt, &s.faces[d * f], d, pad); });
   parallelIndices(ne, [&](int e) { edgeBoxes[e] = boundsOf<d>(x, v, dt, &s.edges[2 * e], 2, pad); });
-  Bvh<d> faceTree, edgeTree;
-  faceTree.build(faceBoxes);
-  edgeTree.build(edgeBoxes);
+  Bvh<d>& faceTree = s.faceTree;
+  Bvh<d>& edgeTree = s.edgeTree;
+  faceTree.refit(faceBoxes);
+  edgeTree.refit(edgeBoxes);
   std::vector<std::vector<int>> pointHits(np), edgeHits(ne);
   parallelIndices(np, [&](int k) {
     const int i = s.points[k];
@@ -335,7 +335,7 @@ std::vector<double> rootsInUnitInterval(double c0, double c1, double c2, double 
 // collinear in 2-D) and within `tolerance`; negative if none.
 template <int d>
 double firstContactTime(const CollisionSurface<d>& s, const Pair& pair, const std::vector<double>& x,
-                        const std::vector<double>& v, double dt, double tolerance) {
+                        const std::vector<double>& v, double dt, double tolerance, bool crossingsOnly = false) {
   int idx[4];
   if (!pair.edges) {
     idx[0] = pair.a;
@@ -388,7 +388,15 @@ double firstContactTime(const CollisionSurface<d>& s, const Pair& pair, const st
     return stencilOf<d>(s, pair, pos).distance <= tolerance;
   };
   const double tiny = 1e-12 * scale;
-  if (std::abs(c[0]) <= tiny && std::abs(c[1]) <= tiny && std::abs(c[2]) <= tiny && std::abs(c[3]) <= tiny) {
+  const bool coplanar =
+      std::abs(c[0]) <= tiny && std::abs(c[1]) <= tiny && std::abs(c[2]) <= tiny && std::abs(c[3]) <= tiny;
+  if (crossingsOnly) {  // a sign change of the coplanarity function inside the step, nothing else
+    if (coplanar) return -1;
+    for (double t : rootsInUnitInterval(c[0], c[1], c[2], c[3]))
+      if (t > 0 && within(t)) return t;
+    return -1;
+  }
+  if (coplanar) {
     // Coplanar throughout (a flat sheet moving in its plane): check proximity at a few times.
     for (double t : {0.0, 0.25, 0.5, 0.75, 1.0})
       if (within(t)) return t;
@@ -525,7 +533,7 @@ int countCollisions(const CollisionSurface<d>& s, const std::vector<double>& x, 
   for (std::size_t i = 0; i < pad.size(); ++i) pad[i] = 1e-3 * s.thickness[i];
   int count = 0;
   for (const Pair& pair : candidatePairs<d>(s, x, v, dt, pad))
-    if (firstContactTime<d>(s, pair, x, v, dt, 1e-9) >= 0) ++count;
+    if (firstContactTime<d>(s, pair, x, v, dt, 1e-9, true) >= 0) ++count;
   return count;
 }
 

@@ -23,6 +23,8 @@
 // are applied serially in that fixed order (Gauss-Seidel): the same on any number of threads.
 #include <vector>
 
+#include "solvers/deformable/bvh.h"
+
 namespace monolith::solvers::deformable {
 
 template <int d>
@@ -35,6 +37,9 @@ struct CollisionSurface {
   // Per particle: pairs whose particles are all of one group >= 0 are skipped (a solid's own
   // surface); -1 collides with everything, itself included (cloth).
   std::vector<int> group;
+  // The BVHs over the faces and edges, built on first use and refitted after (a cache: the
+  // candidate pairs are listed in an order that does not depend on the trees).
+  mutable Bvh<d> faceTree, edgeTree;
   int faceCount() const { return static_cast<int>(faces.size()) / d; }
   int edgeCount() const { return static_cast<int>(edges.size()) / 2; }
 };
@@ -72,8 +77,10 @@ template <int d>
 ProximityReport resolveCollisions(const CollisionSurface<d>& s, const std::vector<double>& x, std::vector<double>& v,
                                   const std::vector<double>& inverseMass, double dt, const ProximitySettings& settings);
 
-// Whether any point–face or edge–edge pair crosses over [x, x + dt v] (what resolveCollisions
-// removes), for tests and diagnostics.
+// The number of point–face and edge–edge pairs that cross over [x, x + dt v]: their
+// coplanarity function changes sign at a time in (0, 1] where they meet (what resolveCollisions
+// removes; a pair merely touching at the start, or sliding in its plane, does not count). For
+// tests and diagnostics.
 template <int d>
 int countCollisions(const CollisionSurface<d>& s, const std::vector<double>& x, const std::vector<double>& v, double dt);
 
