@@ -82,13 +82,6 @@ void parseSurfaceCollision(World<d>& world, Entity e, const Config& c) {
   world.add(e, s);
 }
 
-template <class S, class... Args>
-auto single(Args... args) {
-  std::vector<std::unique_ptr<System<S::dimension>>> v;
-  v.push_back(std::make_unique<S>(args...));
-  return v;
-}
-
 }  // namespace
 
 void registerClothComponents(Registry& r) {
@@ -140,11 +133,11 @@ void registerSelfCollisionSystems(Registry& r) {
 void registerClothSystems(Registry& r) {
   r.addSystem<3>({"advance_cloth_velocity_half",
                   "Step I (Sec. 4.3) for cloth: (M - dt/2 D) v^{n+1/2} = M v^n + dt/2 f(x^n), CG",
-                  [] { return single<AdvanceClothVelocity>(Stage::AdvanceVelocityHalf); }, ""});
+                  [] { return singleSystem<AdvanceClothVelocity>(Stage::AdvanceVelocityHalf); }, ""});
   r.addSystem<3>({"advance_cloth_velocity", "Step V (Sec. 4.7) for cloth: trapezoid in the damping, CG",
-                  [] { return single<AdvanceClothVelocity>(Stage::AdvanceVelocity); }, ""});
+                  [] { return singleSystem<AdvanceClothVelocity>(Stage::AdvanceVelocity); }, ""});
   r.addSystem<3>({"cloth_diagnostics", "the cloth springs' energy in the energy columns",
-                  [] { return single<ClothDiagnostics>(); }, ""});
+                  [] { return singleSystem<ClothDiagnostics>(); }, ""});
 }
 
 template void registerSurfaceCollision<2>(Registry&);

@@ -266,13 +266,6 @@ void parseParticle(World<d>& world, Entity e, const Config& c) {
   world.add(e, p);
 }
 
-template <class S, class... Args>
-auto single(Args... args) {
-  std::vector<std::unique_ptr<System<S::dimension>>> v;
-  v.push_back(std::make_unique<S>(args...));
-  return v;
-}
-
 }  // namespace
 
 template <int d>
@@ -306,12 +299,12 @@ template <int d>
 void registerDeformableSystems(Registry& r) {
   r.addSystem<d>({"advance_deformable_velocity_half",
                   "Step I (Sec. 4.3) for deformables: (M - dt/2 D) v^{n+1/2} = M v^n + dt/2 f(x^n), CG",
-                  [] { return single<AdvanceDeformableVelocity<d>>(Stage::AdvanceVelocityHalf); }, ""});
+                  [] { return singleSystem<AdvanceDeformableVelocity<d>>(Stage::AdvanceVelocityHalf); }, ""});
   r.addSystem<d>({"advance_deformable_positions", "Step IV (Sec. 4.6) for deformables: x^{n+1} = x^n + dt v^{n+1/2}",
-                  [] { return single<AdvanceDeformablePositions<d>>(); }, ""});
+                  [] { return singleSystem<AdvanceDeformablePositions<d>>(); }, ""});
   r.addSystem<d>({"advance_deformable_velocity",
                   "Step V (Sec. 4.7) for deformables: trapezoid in the damping as backward Euler + extrapolation, CG",
-                  [] { return single<AdvanceDeformableVelocity<d>>(Stage::AdvanceVelocity); }, ""});
+                  [] { return singleSystem<AdvanceDeformableVelocity<d>>(Stage::AdvanceVelocity); }, ""});
   r.addSystem<d>({"particle_bindings",
                   "particles hard-bound to rigid bodies: binding_forces@n/@n+1 (elastic forces on the bodies), "
                   "follow_bound_bodies (Step IV, Step V)",
@@ -329,7 +322,7 @@ void registerDeformableSystems(Registry& r) {
                   "particle_push_out (Step IV), particle_velocity_contact (Step V, two-way)",
                   [] { return makeParticleContactSystems<d>(); }, ""});
   r.addSystem<d>({"deformable_diagnostics", "energies (kinetic, gravity, elastic) and momenta of deformables",
-                  [] { return single<DeformableDiagnostics<d>>(); }, ""});
+                  [] { return singleSystem<DeformableDiagnostics<d>>(); }, ""});
 }
 
 template <int d>

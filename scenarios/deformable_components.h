@@ -16,6 +16,14 @@ void registerDeformableSystems(Registry& r);
 template <int d>
 void registerParticleCollisionSystems(Registry& r);
 
+// One system of type S, as the registry's system factories return it.
+template <class S, class... Args>
+std::vector<std::unique_ptr<System<S::dimension>>> singleSystem(Args... args) {
+  std::vector<std::unique_ptr<System<S::dimension>>> v;
+  v.push_back(std::make_unique<S>(args...));
+  return v;
+}
+
 // The entry's "fixed": [{min, max}, ...]: particles inside any world box are held in place.
 template <int d>
 void parseFixedParticles(const Config& c, Particles<d>& p);

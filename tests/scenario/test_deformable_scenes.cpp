@@ -19,6 +19,7 @@
 #include "scenarios/checkpoint.h"
 #include "scenarios/simulation.h"
 #include "support/cli_harness.h"
+#include "support/scene_error.h"
 #include "support/scenes.h"
 
 using namespace monolith;
@@ -178,15 +179,7 @@ TEST(DeformableScenes, ResumedRunMatchesStraightRunBitwise) {
 
 namespace {
 
-std::string sceneError(const std::string& json) {
-  try {
-    const Registry registry = builtins();
-    Simulation<3> sim(parseScene(json, "bad.json"), registry);
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::sceneError;
 
 std::string deformableScene(const std::string& body) {
   return R"({ "dimension": 3, "time": { "dt": 0.001, "end": 0.01 }, "entities": [ { "name": "b", "deformable": )" + body +

@@ -16,6 +16,7 @@
 #include "components/rigid_body.h"
 #include "scenarios/checkpoint.h"
 #include "scenarios/simulation.h"
+#include "support/scene_error.h"
 #include "support/scenes.h"
 
 using namespace monolith;
@@ -218,15 +219,7 @@ TEST(DeformableSurfaceCollisions, TrampolineCatchesBallsAndToriWithoutPassThroug
 }
 
 TEST(DeformableSurfaceCollisions, BadInputNamesEntityAndKey) {
-  auto error = [](const std::string& json) -> std::string {
-    try {
-      const Registry registry = builtins();
-      Simulation<3> sim(parseScene(json, "bad.json"), registry);
-    } catch (const SceneError& e) {
-      return e.what();
-    }
-    return "";
-  };
+  const auto error = test::sceneError;
   const std::string rigid = error(
       R"({ "dimension": 3, "time": { "dt": 0.001, "end": 0.01 }, "entities": [ { "name": "b",
       "shape": { "type": "sphere", "radius": 0.1 }, "rigid_body": { "mass": 1 },
