@@ -19,6 +19,7 @@
 #include "scenarios/checkpoint.h"
 #include "scenarios/simulation.h"
 #include "support/cli_harness.h"
+#include "support/resume_check.h"
 #include "support/scene_error.h"
 #include "support/scenes.h"
 
@@ -161,20 +162,7 @@ TEST(DeformableScenes, OneAndTwoThreadsAgreeBitwise) {
 // A run resumed from a checkpoint reproduces the straight run bitwise (the force models and
 // prepared shapes are caches rebuilt from checkpointed components).
 TEST(DeformableScenes, ResumedRunMatchesStraightRunBitwise) {
-  namespace fs = std::filesystem;
-  test::TempDir tmp;
-  const fs::path A = tmp.path() / "A", B = tmp.path() / "B";
-  const auto a = test::run({MONOLITH_CLI, "run", kScenes + "deformable_hits_box.json", "--out", A.string(), "--set",
-                            "time.end=0.2", "--no-frames", "--checkpoint-every", "100", "--quiet"},
-                           tmp.logs(), 300);
-  ASSERT_EQ(a.exitCode, 0) << a.err;
-  const auto b = test::run({MONOLITH_CLI, "resume", (A / "checkpoints" / "step_00000100.ckpt").string(), "--out",
-                            B.string(), "--quiet"},
-                           tmp.logs(), 300);
-  ASSERT_EQ(b.exitCode, 0) << b.err;
-  const auto sa = nlohmann::json::parse(test::slurp(A / "summary.json"));
-  const auto sb = nlohmann::json::parse(test::slurp(B / "summary.json"));
-  EXPECT_EQ(sa["state_hash"], sb["state_hash"]);
+  test::expectResumeMatchesStraightRun("deformable_hits_box.json", "0.2");
 }
 
 namespace {

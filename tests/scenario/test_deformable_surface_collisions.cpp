@@ -9,16 +9,14 @@
 
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <map>
-#include <nlohmann/json.hpp>
 
 #include "components/cloth.h"
 #include "components/deformable.h"
 #include "components/rigid_body.h"
 #include "scenarios/checkpoint.h"
 #include "scenarios/simulation.h"
-#include "support/cli_harness.h"
+#include "support/resume_check.h"
 #include "support/scene_error.h"
 #include "support/scenes.h"
 
@@ -250,20 +248,7 @@ TEST(DeformableSurfaceCollisions, BadInputNamesEntityAndKey) {
 // reproduces the straight run bitwise: cloth meshes and materials and the surface_collision
 // components are checkpointed; force models, surfaces and BVHs are caches rebuilt from them.
 TEST(DeformableSurfaceCollisions, ClothResumedRunMatchesStraightRunBitwise) {
-  namespace fs = std::filesystem;
-  test::TempDir tmp;
-  const fs::path A = tmp.path() / "A", B = tmp.path() / "B";
-  const auto a = test::run({MONOLITH_CLI, "run", kScenes + "cloth_drape.json", "--out", A.string(), "--set",
-                            "time.end=0.06", "--no-frames", "--checkpoint-every", "100", "--quiet", "--check"},
-                           tmp.logs(), 300);
-  ASSERT_EQ(a.exitCode, 0) << a.err;
-  const auto b = test::run({MONOLITH_CLI, "resume", (A / "checkpoints" / "step_00000100.ckpt").string(), "--out",
-                            B.string(), "--quiet"},
-                           tmp.logs(), 300);
-  ASSERT_EQ(b.exitCode, 0) << b.err;
-  const auto sa = nlohmann::json::parse(test::slurp(A / "summary.json"));
-  const auto sb = nlohmann::json::parse(test::slurp(B / "summary.json"));
-  EXPECT_EQ(sa["state_hash"], sb["state_hash"]);
+  test::expectResumeMatchesStraightRun("cloth_drape.json", "0.06", {"--check"});
 }
 
 // 2-D: two neo-Hookean disks meet head-on; their boundary segments collide (point–segment
