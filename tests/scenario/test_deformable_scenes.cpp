@@ -205,7 +205,7 @@ TEST(DeformableScenes, BadMeshesAreRefusedWithTheirLocation) {
   EXPECT_NE(e.find("entities[0].deformable.mesh.box"), std::string::npos) << e;
   EXPECT_NE(e.find("exactly one of edge_length"), std::string::npos) << e;
   e = sceneError(deformableScene(R"({ "mesh": { "cube": {} }, "youngs_modulus": 1e5 })"));
-  EXPECT_NE(e.find("exactly one mesh form of: box, sphere, gmsh, tetgen"), std::string::npos) << e;
+  EXPECT_NE(e.find("exactly one mesh form of: box, sphere, torus, capsule, gmsh, tetgen"), std::string::npos) << e;
 }
 
 // A scene without deformables schedules none of their systems.
