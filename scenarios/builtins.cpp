@@ -9,6 +9,7 @@
 #include "components/spring_mount.h"
 #include "ecs/registry.h"
 #include "scenarios/contact_components.h"
+#include "scenarios/cloth_components.h"
 #include "scenarios/deformable_components.h"
 #include "scenarios/fluid_components.h"
 #include "scenarios/joint_components.h"
@@ -168,6 +169,8 @@ void registerDimension(Registry& r) {
   if constexpr (d == 3) registerJointComponents(r);
   registerSurfaceTensionComponents<d>(r);
   registerDeformableComponents<d>(r);
+  if constexpr (d == 3) registerClothComponents(r);
+  registerSurfaceCollision<d>(r);
   registerFluidCouplingComponent<d>(r);
 
   r.addSystem<d>({"clear_rigid_forces", "zero the force accumulators before each force evaluation",
@@ -224,7 +227,9 @@ void registerDimension(Registry& r) {
   r.addSystem<d>({"surface_tension_flow",
                   "two-phase flow with implicit surface tension on a Lagrangian front (Ch. 6, eq. 6.33)",
                   [] { return single<SurfaceTensionFlow<d>>(); }, ""});
+  if constexpr (d == 3) registerClothSystems(r);  // before the particles' contact of each stage
   registerDeformableSystems<d>(r);
+  registerSelfCollisionSystems<d>(r);
 }
 
 }  // namespace

@@ -25,11 +25,13 @@ std::string resolvePath(const Config& c, const std::string& file) {
 }
 
 // "mesh": {"box": {half_extents, edge_length | cells}} | {"sphere": {radius, edge_length}} |
+//         {"torus": {major_radius, minor_radius, edge_length}} | {"capsule": {radius, half_length, edge_length}} |
 //         {"gmsh": "file.msh"} | {"tetgen": "base"} (3-D; base.node + base.ele)
 template <int d>
 dm::MeshData<d> parseMesh(const Config& c, std::string& origin) {
-  const std::vector<std::string> forms = d == 3 ? std::vector<std::string>{"box", "sphere", "gmsh", "tetgen"}
-                                                : std::vector<std::string>{"box", "sphere", "gmsh"};
+  const std::vector<std::string> forms = d == 3
+                                             ? std::vector<std::string>{"box", "sphere", "torus", "capsule", "gmsh", "tetgen"}
+                                             : std::vector<std::string>{"box", "sphere", "torus", "capsule", "gmsh"};
   int given = 0;
   for (const auto& f : forms) given += c.has(f);
   std::string list;
@@ -65,6 +67,23 @@ dm::MeshData<d> parseMesh(const Config& c, std::string& origin) {
       origin = "built-in sphere";
       return dm::sphereMesh<d>(r, h);
     }
+    if (c.has("torus")) {
+      const Config b = c.child("torus");
+      const double R = b.number("major_radius", Bound::Positive), r = b.number("minor_radius", Bound::Positive);
+      if (!(R > r)) b.failAt("major_radius", "a major radius above the minor radius", std::to_string(R));
+      const double h = b.number("edge_length", Bound::Positive);
+      b.finish();
+      origin = "built-in torus";
+      return dm::torusMesh<d>(R, r, h);
+    }
+    if (c.has("capsule")) {
+      const Config b = c.child("capsule");
+      const double r = b.number("radius", Bound::Positive), L = b.number("half_length", Bound::NonNegative);
+      const double h = b.number("edge_length", Bound::Positive);
+      b.finish();
+      origin = "built-in capsule";
+      return dm::capsuleMesh<d>(r, L, h);
+    }
     if (c.has("gmsh")) {
       origin = resolvePath(c, c.string("gmsh"));
       return dm::readGmsh<d>(origin);
@@ -78,6 +97,92 @@ dm::MeshData<d> parseMesh(const Config& c, std::string& origin) {
   }
   c.fail("a mesh", "none");
 }
+
+}  // namespace
+
+template <int d>
+void parseFixedParticles(const Config& c, Particles<d>& p) {
+  // "fixed": [{"min": [...], "max": [...]}, ...]: particles inside any of these world boxes.
+  if (c.has("fixed")) {
+    const Config list(c.raw()["fixed"], c.file(), c.pathOf("fixed"));
+    c.markUsed("fixed");
+    for (std::size_t k = 0; k < list.arraySize(); ++k) {
+      const Config box = list.element(k);
+      const Vec<d> lo = box.vector("min", d), hi = box.vector("max", d);
+      box.finish();
+      int count = 0;
+      for (std::size_t i = 0; i < p.fixed.size(); ++i) {
+        const Vec<d> x = Eigen::Map<const Vec<d>>(&p.x[d * i]);
+        if ((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all()) {
+          p.fixed[i] = 1;
+          for (int a = 0; a < d; ++a) p.v[d * i + a] = 0;
+          ++count;
+        }
+      }
+      if (count == 0) box.fail("a box containing at least one particle of the mesh", "a box containing none");
+    }
+  }
+}
+
+template <int d>
+void parseRigidBindings(World<d>& world, Entity e, const Config& c, Particles<d>& p, bool dynamicBodies) {
+  // "bind": [{"body": NAME, "min": [...], "max": [...]}, ...]: particles inside the world box are
+  // hard-bound to the rigid body NAME (listed before this entity); their mass and inertia about
+  // the body's centre join a dynamic body's (the shift of its centre of mass is neglected).
+  if (c.has("bind")) {
+    const Config list(c.raw()["bind"], c.file(), c.pathOf("bind"));
+    c.markUsed("bind");
+    RigidBinding<d> binding;
+    for (std::size_t k = 0; k < list.arraySize(); ++k) {
+      const Config item = list.element(k);
+      const std::string name = item.string("body");
+      const auto target = world.find(name);
+      RigidBody<d>* body = target ? world.template get<RigidBody<d>>(*target) : nullptr;
+      if (!body) item.failAt("body", "the name of a rigid body listed before this entity", "\"" + name + "\"");
+      const Vec<d> lo = item.vector("min", d), hi = item.vector("max", d);
+      item.finish();
+      const bool heavy = !body->isStatic && !world.template has<KinematicMotion<d>>(*target);
+      if (heavy && !dynamicBodies)
+        item.failAt("body", "a static or kinematic rigid body (cloth forces are not passed to dynamic bodies)",
+                    "\"" + name + "\", a dynamic body");
+      const Eigen::Matrix<double, d, d> Rb = body->rotation();
+      int count = 0;
+      for (std::size_t i = 0; i < p.fixed.size(); ++i) {
+        const Vec<d> x = Eigen::Map<const Vec<d>>(&p.x[d * i]);
+        if (!((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all()) || p.fixed[i]) continue;
+        p.fixed[i] = 2;
+        const Vec<d> r = Rb.transpose() * (x - body->x);
+        binding.particle.push_back(static_cast<int>(i));
+        binding.body.push_back(static_cast<int>(k));
+        for (int a = 0; a < d; ++a) binding.offset.push_back(r(a));
+        if (heavy) {
+          body->mass += p.m[i];
+          if constexpr (d == 3)
+            body->inertiaBody += p.m[i] * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+          else
+            body->inertiaBody(0) += p.m[i] * r.squaredNorm();
+        }
+        ++count;
+      }
+      if (count == 0) item.fail("a box containing at least one free particle of the mesh", "a box containing none");
+      if (heavy) body->refresh();
+      binding.bodies += (k ? "\n" : "") + name;
+      // The bound particles start with the body's point velocity.
+      for (std::size_t q = 0; q < binding.particle.size(); ++q) {
+        if (binding.body[q] != static_cast<int>(k)) continue;
+        const int i = binding.particle[q];
+        const Vec<d> r = Rb * Vec<d>(Eigen::Map<const Vec<d>>(&binding.offset[d * q]));
+        Vec<d> w = Vec<d>::Zero();
+        if constexpr (d == 3) w = body->omega().cross(r);
+        else w = Vec<d>(-body->omega()(0) * r.y(), body->omega()(0) * r.x());
+        for (int a = 0; a < d; ++a) p.v[d * i + a] = body->isStatic ? 0.0 : body->v(a) + w(a);
+      }
+    }
+    world.add(e, binding);
+  }
+}
+
+namespace {
 
 template <int d>
 void parseDeformable(World<d>& world, Entity e, const Config& c) {
@@ -131,26 +236,7 @@ void parseDeformable(World<d>& world, Entity e, const Config& c) {
     }
   }
   p.fixed.assign(mesh.x.size(), 0);
-  // "fixed": [{"min": [...], "max": [...]}, ...]: particles inside any of these world boxes.
-  if (c.has("fixed")) {
-    const Config list(c.raw()["fixed"], c.file(), c.pathOf("fixed"));
-    c.markUsed("fixed");
-    for (std::size_t k = 0; k < list.arraySize(); ++k) {
-      const Config box = list.element(k);
-      const Vec<d> lo = box.vector("min", d), hi = box.vector("max", d);
-      box.finish();
-      int count = 0;
-      for (std::size_t i = 0; i < mesh.x.size(); ++i) {
-        const Vec<d> x = Eigen::Map<const Vec<d>>(&p.x[d * i]);
-        if ((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all()) {
-          p.fixed[i] = 1;
-          for (int a = 0; a < d; ++a) p.v[d * i + a] = 0;
-          ++count;
-        }
-      }
-      if (count == 0) box.fail("a box containing at least one particle of the mesh", "a box containing none");
-    }
-  }
+  parseFixedParticles<d>(c, p);
   // Lumped masses from the density (the force model's own computation).
   dm::Material mat;
   mat.density = el.density;
@@ -158,57 +244,7 @@ void parseDeformable(World<d>& world, Entity e, const Config& c) {
   // "particle_mass": every particle the same mass instead (a mass-spring model's lumping, as the
   // thesis's beam, Sec. 5.11.5).
   if (c.has("particle_mass")) p.m.assign(mesh.x.size(), c.number("particle_mass", Bound::Positive));
-  // "bind": [{"body": NAME, "min": [...], "max": [...]}, ...]: particles inside the world box are
-  // hard-bound to the rigid body NAME (listed before this entity); their mass and inertia about
-  // the body's centre join a dynamic body's (the shift of its centre of mass is neglected).
-  if (c.has("bind")) {
-    const Config list(c.raw()["bind"], c.file(), c.pathOf("bind"));
-    c.markUsed("bind");
-    RigidBinding<d> binding;
-    for (std::size_t k = 0; k < list.arraySize(); ++k) {
-      const Config item = list.element(k);
-      const std::string name = item.string("body");
-      const auto target = world.find(name);
-      RigidBody<d>* body = target ? world.template get<RigidBody<d>>(*target) : nullptr;
-      if (!body) item.failAt("body", "the name of a rigid body listed before this entity", "\"" + name + "\"");
-      const Vec<d> lo = item.vector("min", d), hi = item.vector("max", d);
-      item.finish();
-      const bool heavy = !body->isStatic && !world.template has<KinematicMotion<d>>(*target);
-      const Eigen::Matrix<double, d, d> Rb = body->rotation();
-      int count = 0;
-      for (std::size_t i = 0; i < mesh.x.size(); ++i) {
-        const Vec<d> x = Eigen::Map<const Vec<d>>(&p.x[d * i]);
-        if (!((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all()) || p.fixed[i]) continue;
-        p.fixed[i] = 2;
-        const Vec<d> r = Rb.transpose() * (x - body->x);
-        binding.particle.push_back(static_cast<int>(i));
-        binding.body.push_back(static_cast<int>(k));
-        for (int a = 0; a < d; ++a) binding.offset.push_back(r(a));
-        if (heavy) {
-          body->mass += p.m[i];
-          if constexpr (d == 3)
-            body->inertiaBody += p.m[i] * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
-          else
-            body->inertiaBody(0) += p.m[i] * r.squaredNorm();
-        }
-        ++count;
-      }
-      if (count == 0) item.fail("a box containing at least one free particle of the mesh", "a box containing none");
-      if (heavy) body->refresh();
-      binding.bodies += (k ? "\n" : "") + name;
-      // The bound particles start with the body's point velocity.
-      for (std::size_t q = 0; q < binding.particle.size(); ++q) {
-        if (binding.body[q] != static_cast<int>(k)) continue;
-        const int i = binding.particle[q];
-        const Vec<d> r = Rb * Vec<d>(Eigen::Map<const Vec<d>>(&binding.offset[d * q]));
-        Vec<d> w = Vec<d>::Zero();
-        if constexpr (d == 3) w = body->omega().cross(r);
-        else w = Vec<d>(-body->omega()(0) * r.y(), body->omega()(0) * r.x());
-        for (int a = 0; a < d; ++a) p.v[d * i + a] = body->isStatic ? 0.0 : body->v(a) + w(a);
-      }
-    }
-    world.add(e, binding);
-  }
+  parseRigidBindings<d>(world, e, c, p, true);
   world.add(e, p);
   world.add(e, sm);
   world.add(e, el);
@@ -230,20 +266,14 @@ void parseParticle(World<d>& world, Entity e, const Config& c) {
   world.add(e, p);
 }
 
-template <class S, class... Args>
-auto single(Args... args) {
-  std::vector<std::unique_ptr<System<S::dimension>>> v;
-  v.push_back(std::make_unique<S>(args...));
-  return v;
-}
-
 }  // namespace
 
 template <int d>
 void registerDeformableComponents(Registry& r) {
   r.addComponent<d>(ComponentType<d>{
       "deformable",
-      "deformable solid: mesh {box {half_extents, edge_length | cells} | sphere {radius, edge_length} | gmsh FILE" +
+      "deformable solid: mesh {box {half_extents, edge_length | cells} | sphere {radius, edge_length} | torus "
+      "{major_radius, minor_radius, edge_length} | capsule {radius, half_length, edge_length} | gmsh FILE" +
           std::string(d == 3 ? " | tetgen BASE" : "") +
           "}, model (corotated | neo_hookean | springs), youngs_modulus, poisson_ratio, density, rayleigh_alpha, "
           "rayleigh_beta, overdamping, altitude_stiffness, particle_mass, clamp, position, " +
@@ -269,12 +299,12 @@ template <int d>
 void registerDeformableSystems(Registry& r) {
   r.addSystem<d>({"advance_deformable_velocity_half",
                   "Step I (Sec. 4.3) for deformables: (M - dt/2 D) v^{n+1/2} = M v^n + dt/2 f(x^n), CG",
-                  [] { return single<AdvanceDeformableVelocity<d>>(Stage::AdvanceVelocityHalf); }, ""});
+                  [] { return singleSystem<AdvanceDeformableVelocity<d>>(Stage::AdvanceVelocityHalf); }, ""});
   r.addSystem<d>({"advance_deformable_positions", "Step IV (Sec. 4.6) for deformables: x^{n+1} = x^n + dt v^{n+1/2}",
-                  [] { return single<AdvanceDeformablePositions<d>>(); }, ""});
+                  [] { return singleSystem<AdvanceDeformablePositions<d>>(); }, ""});
   r.addSystem<d>({"advance_deformable_velocity",
                   "Step V (Sec. 4.7) for deformables: trapezoid in the damping as backward Euler + extrapolation, CG",
-                  [] { return single<AdvanceDeformableVelocity<d>>(Stage::AdvanceVelocity); }, ""});
+                  [] { return singleSystem<AdvanceDeformableVelocity<d>>(Stage::AdvanceVelocity); }, ""});
   r.addSystem<d>({"particle_bindings",
                   "particles hard-bound to rigid bodies: binding_forces@n/@n+1 (elastic forces on the bodies), "
                   "follow_bound_bodies (Step IV, Step V)",
@@ -292,7 +322,7 @@ void registerDeformableSystems(Registry& r) {
                   "particle_push_out (Step IV), particle_velocity_contact (Step V, two-way)",
                   [] { return makeParticleContactSystems<d>(); }, ""});
   r.addSystem<d>({"deformable_diagnostics", "energies (kinetic, gravity, elastic) and momenta of deformables",
-                  [] { return single<DeformableDiagnostics<d>>(); }, ""});
+                  [] { return singleSystem<DeformableDiagnostics<d>>(); }, ""});
 }
 
 template <int d>
@@ -302,6 +332,10 @@ void registerParticleCollisionSystems(Registry& r) {
                   [] { return makeParticleCollisionSystems<d>(); }, ""});
 }
 
+template void parseFixedParticles<2>(const Config&, Particles<2>&);
+template void parseFixedParticles<3>(const Config&, Particles<3>&);
+template void parseRigidBindings<2>(World<2>&, Entity, const Config&, Particles<2>&, bool);
+template void parseRigidBindings<3>(World<3>&, Entity, const Config&, Particles<3>&, bool);
 template void registerParticleCollisionSystems<2>(Registry&);
 template void registerParticleCollisionSystems<3>(Registry&);
 template void registerDeformableComponents<2>(Registry&);

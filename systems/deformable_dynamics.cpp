@@ -1,5 +1,6 @@
 #include "systems/deformable_dynamics.h"
 
+#include "components/cloth.h"
 #include "components/fluid_coupling.h"
 
 #include "solvers/deformable/simplex_mesh.h"
@@ -160,7 +161,7 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
   // Free particles without a mesh (single mass points) feel gravity only: both stages add
   // dt/2 g (Step V's backward Euler over dt/4 plus extrapolation doubles its dt/4).
   world.template each<Particles<d>>([&](Entity e, Particles<d>& p) {
-    if (world.template has<SimplexMesh<d>>(e)) return;
+    if (world.template has<SimplexMesh<d>>(e) || world.template has<ClothMesh>(e)) return;  // cloth: its own systems
     for (int i = 0; i < p.count(); ++i)
       if (!p.fixed[i])
         for (int a = 0; a < d; ++a) p.v[d * i + a] += 0.5 * ctx.dt * g(a);

@@ -139,15 +139,20 @@ MeshData<d> boxMesh(const VecD<d>& halfExtents, const Eigen::Matrix<int, d, 1>& 
   return gridMesh<d>(-halfExtents, cells, cell, [](const VecD<d>&) { return true; });
 }
 
-template <int d>
-MeshData<d> sphereMesh(double radius, double h) {
-  if (!(h > 0) || !(radius > 0)) throw std::invalid_argument("sphere mesh: sizes must be positive");
-  const int cells = std::max(2, static_cast<int>(std::ceil(2 * radius / h)));
-  const double c = 2 * radius / cells;
-  MeshData<d> m = gridMesh<d>(VecD<d>::Constant(-radius), Eigen::Matrix<int, d, 1>::Constant(cells),
-                              VecD<d>::Constant(c), [&](const VecD<d>& x) { return x.norm() < radius; });
-  // Move the surface vertices onto the sphere, one at a time, keeping a move only if every
-  // element around the vertex keeps at least a fifth of its volume.
+namespace {
+
+// The grid cells (of edge about h, at least two per axis) of the box [-a, a] whose centres are
+// inside, then the surface vertices moved onto the surface by `project`, one at a time, keeping a
+// move only if every element around the vertex keeps at least a fifth of its volume.
+template <int d, class Inside, class Project>
+MeshData<d> implicitMesh(const VecD<d>& half, double h, Inside inside, Project project) {
+  Eigen::Matrix<int, d, 1> cells;
+  VecD<d> c;
+  for (int a = 0; a < d; ++a) {
+    cells(a) = std::max(2, static_cast<int>(std::ceil(2 * half(a) / h)));
+    c(a) = 2 * half(a) / cells(a);
+  }
+  MeshData<d> m = gridMesh<d>(-half, cells, c, inside);
   std::vector<std::vector<int>> around(m.x.size());
   for (int e = 0; e < m.elementCount(); ++e)
     for (int k = 0; k <= d; ++k) around[m.elements[(d + 1) * e + k]].push_back(e);
@@ -155,11 +160,13 @@ MeshData<d> sphereMesh(double radius, double h) {
   for (const auto& f : boundaryFaces(m))
     for (int v : f) onSurface[v] = 1;
   for (std::size_t v = 0; v < m.x.size(); ++v) {
-    if (!onSurface[v] || m.x[v].norm() == 0) continue;
+    if (!onSurface[v]) continue;
+    VecD<d> target;
+    if (!project(m.x[v], target)) continue;
     std::vector<double> before;
     for (int e : around[v]) before.push_back(signedVolume(m, e));
     const VecD<d> old = m.x[v];
-    m.x[v] = radius * old.normalized();
+    m.x[v] = target;
     for (std::size_t k = 0; k < around[v].size(); ++k)
       if (signedVolume(m, around[v][k]) < 0.2 * before[k]) {
         m.x[v] = old;
@@ -167,6 +174,76 @@ MeshData<d> sphereMesh(double radius, double h) {
       }
   }
   return m;
+}
+
+// The point of a sphere of radius r about centre c nearest to x (false at the centre).
+template <int d>
+bool ontoSphere(const VecD<d>& x, const VecD<d>& centre, double r, VecD<d>& out) {
+  const VecD<d> q = x - centre;
+  if (q.norm() == 0) return false;
+  out = centre + r * q.normalized();
+  return true;
+}
+
+// The nearest point of the torus' core circle (radius R about the y axis in the xz-plane; in
+// 2-D the circle about the origin) to x; false on the axis.
+template <int d>
+bool torusCore(const VecD<d>& x, double R, VecD<d>& core) {
+  VecD<d> radial = x;
+  if constexpr (d == 3) radial(1) = 0;
+  if (radial.norm() == 0) return false;
+  core = R * radial.normalized();
+  return true;
+}
+
+template <int d>
+VecD<d> capsuleCore(const VecD<d>& x, double halfLength) {
+  VecD<d> core = VecD<d>::Zero();
+  core(1) = std::clamp(x(1), -halfLength, halfLength);
+  return core;
+}
+
+}  // namespace
+
+template <int d>
+MeshData<d> sphereMesh(double radius, double h) {
+  if (!(h > 0) || !(radius > 0)) throw std::invalid_argument("sphere mesh: sizes must be positive");
+  return implicitMesh<d>(
+      VecD<d>::Constant(radius), h, [&](const VecD<d>& x) { return x.norm() < radius; },
+      [&](const VecD<d>& x, VecD<d>& out) {
+        if (x.norm() == 0) return false;
+        out = radius * x.normalized();
+        return true;
+      });
+}
+
+template <int d>
+MeshData<d> torusMesh(double majorRadius, double minorRadius, double h) {
+  if (!(h > 0) || !(minorRadius > 0) || !(majorRadius > minorRadius))
+    throw std::invalid_argument("torus mesh: need edge length > 0 and major radius > minor radius > 0");
+  VecD<d> half = VecD<d>::Constant(majorRadius + minorRadius);
+  if constexpr (d == 3) half(1) = minorRadius;
+  return implicitMesh<d>(
+      half, h,
+      [&](const VecD<d>& x) {
+        VecD<d> core;
+        return torusCore<d>(x, majorRadius, core) && (x - core).norm() < minorRadius;
+      },
+      [&](const VecD<d>& x, VecD<d>& out) {
+        VecD<d> core;
+        return torusCore<d>(x, majorRadius, core) && ontoSphere<d>(x, core, minorRadius, out);
+      });
+}
+
+template <int d>
+MeshData<d> capsuleMesh(double radius, double halfLength, double h) {
+  if (!(h > 0) || !(radius > 0) || !(halfLength >= 0))
+    throw std::invalid_argument("capsule mesh: need radius, edge length > 0 and half length >= 0");
+  VecD<d> half = VecD<d>::Constant(radius);
+  half(1) = halfLength + radius;
+  return implicitMesh<d>(
+      half, h, [&](const VecD<d>& x) { return (x - capsuleCore<d>(x, halfLength)).norm() < radius; },
+      [&](const VecD<d>& x, VecD<d>& out) { return ontoSphere<d>(x, capsuleCore<d>(x, halfLength), radius, out); });
 }
 
 template <int d>
@@ -484,6 +561,8 @@ ForceModel<d> prepareForceModel(const std::vector<double>& restX, const std::vec
   template MeshData<D> boxMesh<D>(const VecD<D>&, double);                                                        \
   template MeshData<D> boxMesh<D>(const VecD<D>&, const Eigen::Matrix<int, D, 1>&);                                \
   template MeshData<D> sphereMesh<D>(double, double);                                                             \
+  template MeshData<D> torusMesh<D>(double, double, double);                                                      \
+  template MeshData<D> capsuleMesh<D>(double, double, double);                                                             \
   template std::string meshProblem<D>(const MeshData<D>&);                                                        \
   template MeshData<D> readGmsh<D>(const std::string&);                                                           \
   template ForceModel<D> prepareForceModel<D>(const std::vector<double>&, const std::vector<int>&, const Material&, \

@@ -38,6 +38,15 @@ MeshData<d> boxMesh(const VecD<d>& halfExtents, const Eigen::Matrix<int, d, 1>& 
 // radially onto the sphere where no element inverts or flattens by it.
 template <int d>
 MeshData<d> sphereMesh(double radius, double h);
+// Torus about the y axis (its core circle of radius `majorRadius` in the xz-plane, tube radius
+// `minorRadius`); in 2-D an annulus of mid radius `majorRadius` and half width `minorRadius`.
+// Meshed as the ball: grid cells with their centre inside, surface vertices moved onto the torus.
+template <int d>
+MeshData<d> torusMesh(double majorRadius, double minorRadius, double h);
+// Capsule along y: the points within `radius` of the segment from -halfLength to +halfLength on
+// the y axis (a stadium in 2-D), meshed as the ball.
+template <int d>
+MeshData<d> capsuleMesh(double radius, double halfLength, double h);
 
 // "" when the mesh is valid, else what is wrong, naming the first bad element or vertex:
 // indices out of range, repeated vertices in an element, inverted (negative signed volume) or

@@ -19,6 +19,8 @@
 #include "scenarios/checkpoint.h"
 #include "scenarios/simulation.h"
 #include "support/cli_harness.h"
+#include "support/resume_check.h"
+#include "support/scene_error.h"
 #include "support/scenes.h"
 
 using namespace monolith;
@@ -160,33 +162,12 @@ TEST(DeformableScenes, OneAndTwoThreadsAgreeBitwise) {
 // A run resumed from a checkpoint reproduces the straight run bitwise (the force models and
 // prepared shapes are caches rebuilt from checkpointed components).
 TEST(DeformableScenes, ResumedRunMatchesStraightRunBitwise) {
-  namespace fs = std::filesystem;
-  test::TempDir tmp;
-  const fs::path A = tmp.path() / "A", B = tmp.path() / "B";
-  const auto a = test::run({MONOLITH_CLI, "run", kScenes + "deformable_hits_box.json", "--out", A.string(), "--set",
-                            "time.end=0.2", "--no-frames", "--checkpoint-every", "100", "--quiet"},
-                           tmp.logs(), 300);
-  ASSERT_EQ(a.exitCode, 0) << a.err;
-  const auto b = test::run({MONOLITH_CLI, "resume", (A / "checkpoints" / "step_00000100.ckpt").string(), "--out",
-                            B.string(), "--quiet"},
-                           tmp.logs(), 300);
-  ASSERT_EQ(b.exitCode, 0) << b.err;
-  const auto sa = nlohmann::json::parse(test::slurp(A / "summary.json"));
-  const auto sb = nlohmann::json::parse(test::slurp(B / "summary.json"));
-  EXPECT_EQ(sa["state_hash"], sb["state_hash"]);
+  test::expectResumeMatchesStraightRun("deformable_hits_box.json", "0.2");
 }
 
 namespace {
 
-std::string sceneError(const std::string& json) {
-  try {
-    const Registry registry = builtins();
-    Simulation<3> sim(parseScene(json, "bad.json"), registry);
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::sceneError;
 
 std::string deformableScene(const std::string& body) {
   return R"({ "dimension": 3, "time": { "dt": 0.001, "end": 0.01 }, "entities": [ { "name": "b", "deformable": )" + body +
@@ -224,7 +205,7 @@ TEST(DeformableScenes, BadMeshesAreRefusedWithTheirLocation) {
   EXPECT_NE(e.find("entities[0].deformable.mesh.box"), std::string::npos) << e;
   EXPECT_NE(e.find("exactly one of edge_length"), std::string::npos) << e;
   e = sceneError(deformableScene(R"({ "mesh": { "cube": {} }, "youngs_modulus": 1e5 })"));
-  EXPECT_NE(e.find("exactly one mesh form of: box, sphere, gmsh, tetgen"), std::string::npos) << e;
+  EXPECT_NE(e.find("exactly one mesh form of: box, sphere, torus, capsule, gmsh, tetgen"), std::string::npos) << e;
 }
 
 // A scene without deformables schedules none of their systems.
