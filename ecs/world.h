@@ -139,6 +139,7 @@ struct ContactSettings {
     exactManifoldFinish = true;
     stepEnergyClamp = true;
     closeGaps = true;
+    pushOutJointOverlap = 0.02;
   }
   // The thesis code's schedule (the defaults above): ten epsilon-ramped contact sweeps of two
   // level passes, two shock-propagation passes, manifold solves by sweeps alone, no gap closing,
@@ -150,6 +151,7 @@ struct ContactSettings {
     exactManifoldFinish = false;
     stepEnergyClamp = false;
     closeGaps = false;
+    pushOutJointOverlap = 0.05;
   }
 };
 
