@@ -14,6 +14,8 @@
 
 #include "ecs/component_pool.h"
 #include "ecs/entity.h"
+#include "solvers/contact/contact_settings.h"
+#include "solvers/fluid/fluid_settings.h"
 
 namespace monolith {
 
@@ -26,134 +28,8 @@ struct RigidRotationSettings {
   bool energyFix = true;   // kinetic-energy orientation fix, Sec. 2.2.2-2.2.4
 };
 
-// How the fluid step of Ch. 5 is taken (scene "solvers": {"fluid": {...}}).
-struct FluidSolverSettings {
-  enum class Advection { SemiLagrangian, MacCormack, Eno3, Weno5, None };  // None: unsteady Stokes flow (Sec. 5.7)
-  enum class Projection { Coupled, Chorin };            // (5.31) vs pressure/viscosity splitting
-  enum class Preconditioner { None, Jacobi, IC0, MIC0, Multigrid };
-  Advection advection = Advection::SemiLagrangian;
-  Projection projection = Projection::Coupled;
-  Preconditioner preconditioner = Preconditioner::Multigrid;  // flat iteration counts (benchmarks)
-  // The coupled solve's preconditioner around the Poisson one: false (scene
-  // "coupled_preconditioner": "block_diagonal"): the Poisson preconditioner and a Jacobi viscous
-  // block (notes 4.4); true ("cut_corrected", default): the same plus an exact solve on the band
-  // of unknowns around cut faces (solvers/fluid/coupled_preconditioner.h). Identical without cut faces.
-  bool coupledCutCorrection = true;
-  double tolerance = 1e-8;   // relative residual of the Krylov solve
-  int maxIterations = 5000;
-  // Where the viscous operator puts an obstacle's no-slip wall (scene "obstacle_wall"):
-  //  * Face ("face", default): at the obstacle face's centre, the thesis's first-order treatment
-  //    (Sec. 5.4.1, 5.7), up to a cell inside the body;
-  //  * Surface ("surface"): at the body's true surface, found along each pair's direction;
-  //  * CellBoundary ("cell_boundary", staircase only): at the boundary of the solid cells, half a
-  //    cell from the first fluid face, where a finite-volume code on the same staircase puts it.
-  // The last two store wall distances (docs/architecture.md, measured in docs/benchmarks.md).
-  enum class ObstacleWall { Face, Surface, CellBoundary };
-  ObstacleWall obstacleWall = ObstacleWall::Face;
-  bool obstacleWallDistances() const { return obstacleWall != ObstacleWall::Face; }
-  // Where the advection's samples see that wall: false ("advection_wall": "face", default): behind
-  // the first fluid faces they read the obstacle faces' own velocity or, inside the body, extend
-  // the fluid's (velocity_sampling.h rules 3-4, the thesis's clipping of Sec. 5.2); true
-  // ("surface", needs obstacle wall distances): ghost values continue the velocity linearly through
-  // the wall at the distance the viscous operator uses (solvers/advection/wall_ghosts.h).
-  bool advectionWallAtSurface = false;
-  // How obstacles meet the pressure: false (scene "obstacle_cells": "staircase", default): cells
-  // with the centre inside are solid, their faces carry the body's velocity (Sec. 5.4.1); true
-  // ("cut"): faces cut by the body keep their open part as fluid (solvers::cutFaces).
-  bool cutCells = false;
-};
-
-// Collisions, contact and interpenetration resolution (scene "solvers": {"contact": {...}}).
-// The defaults are the thesis code's schedule (notes 1.4, 1.6, 1.7). `"schedule": "short"`
-// (useShortSchedule, docs/rigid_contact.md) is one contact sweep of one level pass, one
-// shock-propagation pass, exact manifold solves, contact that lets a gap close in the step and
-// the step energy clamp: 12-15x cheaper per awake step, not the default because 2-D random
-// drops still sink deeper than 5 % for a step on it (2 of 838; docs/rigid_contact.md).
-struct ContactSettings {
-  int collisionIterations = 5;       // Gauss-Seidel sweeps over the pairs (Step II)
-  int collisionPairIterations = 20;  // impulses per pair per sweep
-  int contactIterations = 10;        // outer contact sweeps (Step III), epsilon-scaled
-  int contactLevelIterations = 2;    // per level and sweep
-  int contactPairIterations = 10;    // Gauss-Seidel sweeps of one pair's manifold solve (measured)
-  bool shockPropagation = true;      // GBF 2003 shock propagation after contact
-  int shockLevelIterations = 2;      // the thesis code's
-  int shockPairIterations = 40;      // measured: a 2-D pyramid's joint solves need them (docs/benchmarks.md)
-  // Manifold and joint solves end with an exact active-set step once it applies
-  // (solvers/contact/manifold_polish.h; not in the thesis, whose sweeps stop at their count).
-  // Off by default: at the thesis's schedule it costs 3-30 % more than it saves on three of five
-  // scenes; on the short schedule it makes the step 3x faster and leaves a standing pyramid
-  // exactly at rest.
-  bool exactManifoldFinish = false;
-  bool pushOut = true;               // interpenetration resolution, Sec. 4.6.1 / App. B
-  int pushOutLevelIterations = 6;    // thesis code: 2; measured on piles (the git history of docs/benchmarks.md ("Six push-out passes"))
-  int pushOutBodyIterations = 5;
-  // Push-out also separates pairs that Steps II-III never saw interpenetrating (not "processed")
-  // but that overlap after Step IV's positions: a body moved by contact or by another push-out
-  // into a neighbour (not in the thesis, whose push-out keeps to the saved pairs; Sec. 4.6.1).
-  bool pushOutNewOverlaps = true;
-  // With pushOutNewOverlaps: rounds of push-out while a push carries a body into one it was not
-  // paired with (found only by the broad phase grown after the round; not in the thesis).
-  int pushOutRounds = 4;
-  // ... and while a pair still overlaps by more than this fraction of its smaller body's size.
-  double pushOutRoundOverlap = 0.02;
-  // ... and then, where the rounds leave a pair overlapping by more than pushOutJointOverlap of
-  // its smaller body's size (a jam), the bodies of those pairs and their overlapping dynamic
-  // neighbours (two rings) pushed apart all at once (solvers/contact/joint_push_out.h; not in the
-  // thesis), pass by pass while each leaves them shallower.
-  bool pushOutJoint = true;
-  double pushOutJointOverlap = 0.05;
-  bool velocityContact = true;       // second contact step in Step V (Sec. 2.3.2 "Contact Clamping")
-  bool energyClamp = true;           // Sec. 2.3.2 for collisions and the second contact step
-  // After Step V, an island of bodies moved only by gravity and contact whose energy (kinetic +
-  // gravity's potential) rose in the step has its velocities scaled down to take the rise back
-  // (not in the thesis, which leaves the first contact step unclamped, Sec. 2.3.2; systems/
-  // step_energy_clamp.cpp). The short schedule needs it: its one inelastic contact pass can lift
-  // a spinning body for the position update without paying for the rise.
-  bool stepEnergyClamp = false;
-  // Contact (Steps III and V) lets each point close the gap its bodies have at the base poses
-  // within the step: v_n >= -gap/dt instead of v_n >= 0 (not in the thesis, whose ramped sweeps
-  // close such gaps approximately). Without it one fully inelastic pass stops a body falling
-  // onto a support closer than its step's fall in the air above it.
-  bool closeGaps = false;
-  // Step II: a pair moving more than half its thinner body's size in the step is tested at its
-  // first contact along the motion instead of at the candidate poses (not in the thesis;
-  // solvers/collision/swept_contact.h).
-  bool sweptCollisions = true;
-  double thickness = 1e-4;           // contact is processed within this separation (m)
-  double pushOutTolerance = 1e-5;    // penetration left alone by push-out (m)
-  double approachTolerance = 1e-9;   // |v_rel.n| below this is "not approaching" (m/s)
-  // Sleeping (not in the thesis; systems/sleep.h): an island of dynamic bodies whose every point
-  // has moved slower than sleepSpeed for sleepTime is held still until an awake or moving body
-  // touches it. Off by default: it stops bodies the thesis's scheme would still move by up to
-  // sleepSpeed. Box2D's defaults are 0.01 m/s (and 2 degrees/s) for 0.5 s.
-  bool sleep = false;
-  double sleepSpeed = 0.01;          // m/s, at the body's farthest point from its centre of mass
-  double sleepTime = 0.5;            // s
-
-  // The short schedule: one contact sweep of one level pass, one shock-propagation pass, manifold
-  // solves finished exactly, gaps closed, and the step energy clamp.
-  void useShortSchedule() {
-    contactIterations = 1;
-    contactLevelIterations = 1;
-    shockLevelIterations = 1;
-    exactManifoldFinish = true;
-    stepEnergyClamp = true;
-    closeGaps = true;
-  }
-  // The thesis code's schedule (the defaults above): ten epsilon-ramped contact sweeps of two
-  // level passes, two shock-propagation passes, manifold solves by sweeps alone, no gap closing,
-  // no step clamp.
-  void useThesisSchedule() {
-    contactIterations = 10;
-    contactLevelIterations = 2;
-    shockLevelIterations = 2;
-    exactManifoldFinish = false;
-    stepEnergyClamp = false;
-    closeGaps = false;
-  }
-};
-
-// Scene-wide physical settings shared by systems (read-only during a step).
+// Scene-wide physical settings shared by systems (read-only during a step). The contact and
+// fluid settings are declared next to the solvers they steer.
 template <int d>
 struct WorldSettings {
   Vec<d> gravity = Vec<d>::Zero();

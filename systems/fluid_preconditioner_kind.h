@@ -1,7 +1,7 @@
 #pragma once
 // The scene's choice of pressure preconditioner (solvers.fluid.preconditioner) as the solvers'
 // kind: one mapping for the fluid's own projection and the coupled fluid-structure solve.
-#include "ecs/world.h"
+#include "solvers/fluid/fluid_settings.h"
 #include "solvers/fluid/poisson_preconditioner.h"
 
 namespace monolith {
