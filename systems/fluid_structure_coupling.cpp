@@ -203,7 +203,7 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
   // particle (R = I there, its rows zero for fixed particles: they are infinitely massive and at
   // rest); J_hat averages the adjacent structures of a face between two (alpha = 1/2) and holds
   // the barycentric weights of the particles around the face centre (Sec. 5.4.3).
-  std::vector<Eigen::Triplet<double>> jhat, jhatParticles, r;
+  std::vector<Eigen::Triplet<double>> jhat, jhatParticles, r, rAll;
   int samples = 0;
   for (int k = 0; k < nc; ++k) {
     const int f = coupling.constrainedFaces[k];
@@ -238,14 +238,26 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
     const Particles<d>& p = *world.template get<Particles<d>>(setup.deformables[k]);
     const int first = (setup.deformableOffset[k] - nb * ndof) / d;
     for (int i = 0; i < p.count(); ++i)
-      if (!p.fixed[i])
-        for (int a = 0; a < d; ++a) r.emplace_back((samples + first + i) * d + a, setup.deformableOffset[k] + d * i + a, 1.0);
+      for (int a = 0; a < d; ++a) {
+        const Eigen::Triplet<double> t((samples + first + i) * d + a, setup.deformableOffset[k] + d * i + a, 1.0);
+        if (!p.fixed[i]) r.push_back(t);
+        rAll.push_back(t);
+      }
   }
   const int allSamples = samples + particleSamples;
   solvers::SparseMatrixR Jhat(nc * d, allSamples * d), R(allSamples * d, dofs);
   Jhat.setFromTriplets(jhat.begin(), jhat.end());
   R.setFromTriplets(r.begin(), r.end());
-  coupling.J = solvers::faceNormalRows(layout, coupling.constrainedFaces) * Jhat * R;
+  const solvers::SparseMatrixR NJhat = solvers::faceNormalRows(layout, coupling.constrainedFaces) * Jhat;
+  coupling.J = NJhat * R;
+  if (nd > 0) {
+    // The rigid bodies' R rows (all of r before the particles') are shared.
+    for (const auto& t : r)
+      if (t.row() < samples * d) rAll.push_back(t);
+    solvers::SparseMatrixR Rall(allSamples * d, dofs);
+    Rall.setFromTriplets(rAll.begin(), rAll.end());
+    setup.forceJ = NJhat * Rall;
+  }
 
   std::vector<Eigen::Triplet<double>> m, minv;
   coupling.velocity.resize(dofs);
@@ -499,15 +511,21 @@ void FluidStructureProjection<d>::run(World<d>& world, StepContext& ctx) {
   out.set("fsi_coupling_faces", setup.coupling.constraintCount());
   static const char* axes[3] = {"_x", "_y", "_z"};
   if (setup.coupling.dampingRows > 0) out.set("fsi_damping_work", report.dampingWork);
+  // The impulse on every structure dof, a deformable's fixed particles included (forceJ).
+  const Eigen::VectorXd allImpulse =
+      setup.deformables.empty() ? report.structureImpulse : Eigen::VectorXd(setup.forceJ.transpose() * report.lambda);
+  Eigen::Matrix<double, d, 1> totalForce = Eigen::Matrix<double, d, 1>::Zero();
   for (std::size_t k = 0; k < setup.deformables.size(); ++k) {
-    // The fluid's force on a deformable body: the sum of -J^T W^T lambda over its particles.
+    // The fluid's force on a deformable body: the sum of -J_all^T W^T lambda over its particles,
+    // fixed ones included (the force its support takes).
     const std::string prefix = "fsi_" + world.name(setup.deformables[k]);
     const int off = setup.deformableOffset[k];
     const int n = world.template get<Particles<d>>(setup.deformables[k])->count();
     for (int a = 0; a < d; ++a) {
       double force = 0;
-      for (int i = 0; i < n; ++i) force -= report.structureImpulse[off + d * i + a];
+      for (int i = 0; i < n; ++i) force -= allImpulse[off + d * i + a];
       out.set(prefix + "_force" + axes[a], force / ctx.dt);
+      totalForce[a] += force / ctx.dt;
     }
     const int track = world.template get<FluidCoupling<d>>(setup.deformables[k])->trackParticle;
     if (track >= 0 && track < n)
@@ -524,6 +542,7 @@ void FluidStructureProjection<d>::run(World<d>& world, StepContext& ctx) {
       out.set(prefix + "_position" + axes[a], x[a]);
       out.set(prefix + "_velocity" + axes[a], v[off + a]);
       out.set(prefix + "_force" + axes[a], force[a]);
+      totalForce[a] += force[a];
     }
     if constexpr (d == 2) {
       out.set(prefix + "_angular_velocity_z", v[off + 2]);
@@ -535,6 +554,8 @@ void FluidStructureProjection<d>::run(World<d>& world, StepContext& ctx) {
       }
     }
   }
+  // The fluid's force on all coupled structures together (a cylinder and its flag: drag, lift).
+  for (int a = 0; a < d; ++a) out.set(std::string("fsi_total_force") + axes[a], totalForce[a]);
 }
 
 template <int d>
