@@ -203,7 +203,7 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
   // particle (R = I there, its rows zero for fixed particles: they are infinitely massive and at
   // rest); J_hat averages the adjacent structures of a face between two (alpha = 1/2) and holds
   // the barycentric weights of the particles around the face centre (Sec. 5.4.3).
-  std::vector<Eigen::Triplet<double>> jhat, jhatParticles, r, rAll;
+  std::vector<Eigen::Triplet<double>> jhat, jhatParticles, r, rAll, rStatic;
   int samples = 0;
   for (int k = 0; k < nc; ++k) {
     const int f = coupling.constrainedFaces[k];
@@ -220,7 +220,9 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
       if (adjacent[i] < nb) {
         const RigidBody<d>& body = geometry[adjacent[i]].body();
         for (int a = 0; a < d; ++a) jhat.emplace_back(k * d + a, samples * d + a, 1.0 / count);
-        solvers::rigidSampleRows<d>(samples, adjacent[i] * ndof, Vec(x - body.x), r);
+        // A static body is an infinite-mass structure: its J columns are zero (u = J v = 0 there), its
+        // rows kept for the force report only.
+        solvers::rigidSampleRows<d>(samples, adjacent[i] * ndof, Vec(x - body.x), body.isStatic ? rStatic : r);
         ++samples;
         continue;
       }
@@ -250,10 +252,11 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
   R.setFromTriplets(r.begin(), r.end());
   const solvers::SparseMatrixR NJhat = solvers::faceNormalRows(layout, coupling.constrainedFaces) * Jhat;
   coupling.J = NJhat * R;
-  if (nd > 0) {
+  if (nd > 0 || !rStatic.empty()) {
     // The rigid bodies' R rows (all of r before the particles') are shared.
     for (const auto& t : r)
       if (t.row() < samples * d) rAll.push_back(t);
+    rAll.insert(rAll.end(), rStatic.begin(), rStatic.end());
     solvers::SparseMatrixR Rall(allSamples * d, dofs);
     Rall.setFromTriplets(rAll.begin(), rAll.end());
     setup.forceJ = NJhat * Rall;
@@ -267,7 +270,7 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
     const double mass = body.mass + extraMass[b];
     for (int a = 0; a < d; ++a) {
       m.emplace_back(off + a, off + a, mass);
-      minv.emplace_back(off + a, off + a, 1.0 / mass);
+      if (!body.isStatic) minv.emplace_back(off + a, off + a, 1.0 / mass);
     }
     InertiaMat<d> I = body.worldInertia(), Iinv = body.worldInverseInertia();
     if (extraMass[b] > 0) {  // the claimed fluid: a square (cube) of side dx about the centre
@@ -277,7 +280,7 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
     for (int i = 0; i < kAngular(d); ++i)
       for (int j = 0; j < kAngular(d); ++j) {
         m.emplace_back(off + d + i, off + d + j, I(i, j));
-        minv.emplace_back(off + d + i, off + d + j, Iinv(i, j));
+        if (!body.isStatic) minv.emplace_back(off + d + i, off + d + j, Iinv(i, j));
       }
     coupling.velocity.segment(off, d) = body.v;
     const AngularVec<d> w = body.omega();
@@ -511,9 +514,9 @@ void FluidStructureProjection<d>::run(World<d>& world, StepContext& ctx) {
   out.set("fsi_coupling_faces", setup.coupling.constraintCount());
   static const char* axes[3] = {"_x", "_y", "_z"};
   if (setup.coupling.dampingRows > 0) out.set("fsi_damping_work", report.dampingWork);
-  // The impulse on every structure dof, a deformable's fixed particles included (forceJ).
-  const Eigen::VectorXd allImpulse =
-      setup.deformables.empty() ? report.structureImpulse : Eigen::VectorXd(setup.forceJ.transpose() * report.lambda);
+  // The impulse on every structure dof, static bodies and a deformable's fixed particles included.
+  const Eigen::VectorXd allImpulse = setup.forceJ.rows() == 0 ? report.structureImpulse
+                                                              : Eigen::VectorXd(setup.forceJ.transpose() * report.lambda);
   Eigen::Matrix<double, d, 1> totalForce = Eigen::Matrix<double, d, 1>::Zero();
   for (std::size_t k = 0; k < setup.deformables.size(); ++k) {
     // The fluid's force on a deformable body: the sum of -J_all^T W^T lambda over its particles,
@@ -536,7 +539,7 @@ void FluidStructureProjection<d>::run(World<d>& world, StepContext& ctx) {
     const std::string prefix = "fsi_" + world.name(setup.bodies[b]);
     const int off = static_cast<int>(b) * ndof;
     // The fluid's impulse on the body is -J^T W^T lambda (eq. 5.11).
-    const Eigen::VectorXd force = -report.structureImpulse.segment(off, ndof) / ctx.dt;
+    const Eigen::VectorXd force = -allImpulse.segment(off, ndof) / ctx.dt;
     const Eigen::Matrix<double, d, 1> x = world.template get<RigidBody<d>>(setup.bodies[b])->x;
     for (int a = 0; a < d; ++a) {
       out.set(prefix + "_position" + axes[a], x[a]);

@@ -51,9 +51,10 @@ struct StructureCouplingSetup {
   std::vector<std::vector<double>> positions;                       // per deformable: x
   std::vector<int> dampingOffset;                                   // per deformable: first row of C
   std::vector<int> cellBody;  // per cell: rigid index, bodies.size() + deformable index, or -1
-  // J with the fixed particles' rows kept (J zeroes them: infinite mass, at rest): J_all^T lambda
-  // is the impulse on every particle, so the force reported on a deformable body includes what its
-  // fixed particles pass on to their support (a clamped flag's root, an all-fixed cylinder).
+  // J with the rows of fixed particles and static bodies kept (J zeroes them: infinite mass, at
+  // rest): J_all^T lambda is the impulse on every structure dof, so the force reported on a body
+  // includes what its fixed parts pass on to their support (a clamped flag's root, a fixed
+  // cylinder). Empty when there are neither.
   solvers::SparseMatrixR forceJ;
 };
 

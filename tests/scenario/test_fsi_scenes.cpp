@@ -144,7 +144,7 @@ TEST(FsiFallingCylinder, OneAndTwoThreadsAgreeBitwise) {
   EXPECT_LT(one[3], -0.01);  // it did fall
 }
 
-// Bad scenes: fluid_coupling needs a dynamic rigid body, not both couplings on one body.
+// Bad scenes: fluid_coupling needs a dynamic or static rigid body, not both couplings on one body.
 TEST(FsiScene, BadCouplingIsRefusedWithItsPath) {
   const Registry registry = builtins();
   const std::string head = R"({"dimension": 2, "time": {"dt": 0.01, "end": 0.1}, "entities": [
@@ -152,7 +152,9 @@ TEST(FsiScene, BadCouplingIsRefusedWithItsPath) {
     {"name": "disk", "shape": {"type": "disk", "radius": 0.2}, )";
   const struct {
     std::string body, expected;
-  } cases[] = {{R"("rigid_body": {"static": true, "position": [0.5, 0.5]}, "fluid_coupling": {}}]})", "static rigid_body"},
+  } cases[] = {{R"("rigid_body": {"mass": 1, "position": [0.5, 0.5]}, "kinematic": {"schedule": [{"velocity": [0, 1]}]},
+                   "fluid_coupling": {}}]})",
+                "kinematic rigid_body"},
                {R"("rigid_body": {"position": [0.5, 0.5]}, "fluid_obstacle": {}, "fluid_coupling": {}}]})", ""},
                {R"("rigid_body": {"position": [0.5, 0.5]}, "fluid_coupling": {"mass": 3}}]})", "mass"}};
   for (const auto& c : cases) {
