@@ -208,7 +208,7 @@ TEST(FsiSphere3D, HeavySphereSinksWithoutEnergyGain) {
 
 // falling_sphere as shipped (24 x 24 x 48, radius 3 cells, dt = 1 s: the steady Stokes state is
 // the step's fixed point): within 10 % of Stokes' law with the Haberman-Sayre factor (measured
-// 7.7 % fast), steady after three solves, and the coupling impulses carry the sphere's weight.
+// 1.9 % fast), steady after three solves, and the coupling impulses carry the sphere's weight.
 // The error is not monotone in the resolution (docs/benchmarks_fsi.md): this checks the shipped
 // resolution, not convergence.
 TEST(FsiFallingSphere, SteadyStokesSpeedWithinTenPercentOfHabermanSayre) {
