@@ -236,8 +236,8 @@ void parseDeformableFluidCoupling(World<d>& world, Entity e, const Config& c, Pa
   world.add(e, coupling);
 }
 
-// Two-way coupling: a dynamic rigid_body with a shape the rasterization knows (or a level_set),
-// or a deformable body.
+// Two-way coupling: a dynamic (or static: infinite mass) rigid_body with a shape the
+// rasterization knows (or a level_set), or a deformable body.
 template <int d>
 void parseFluidCoupling(World<d>& world, Entity e, const Config& c) {
   if (Particles<d>* p = world.template get<Particles<d>>(e); p && !world.template has<RigidBody<d>>(e)) {
@@ -250,10 +250,12 @@ void parseFluidCoupling(World<d>& world, Entity e, const Config& c) {
   const bool levelSet = world.template has<LevelSet<d>>(e);
   if (!shape && !levelSet) c.fail("fluid_coupling on an entity with a \"level_set\" or a \"shape\"", "neither");
   const RigidBody<d>* body = world.template get<RigidBody<d>>(e);
-  if (!body) c.fail("fluid_coupling on an entity with a dynamic \"rigid_body\"", "no rigid_body");
-  if (body->isStatic || world.template has<KinematicMotion<d>>(e))
-    c.fail("fluid_coupling on a dynamic rigid_body (static and kinematic bodies are one-way: \"fluid_obstacle\")",
-           body->isStatic ? "a static rigid_body" : "a kinematic rigid_body");
+  if (!body) c.fail("fluid_coupling on an entity with a dynamic or static \"rigid_body\"", "no rigid_body");
+  // A static body is coupled as an infinite-mass structure (at rest; its force is reported); a
+  // scripted one stays one-way.
+  if (world.template has<KinematicMotion<d>>(e))
+    c.fail("fluid_coupling on a dynamic or static rigid_body (kinematic bodies are one-way: \"fluid_obstacle\")",
+           "a kinematic rigid_body");
   if (world.template has<FluidObstacle>(e))
     c.fail("either fluid_obstacle (one-way) or fluid_coupling (two-way) on one entity", "both");
   if (!levelSet && !ObstacleGeometry<d>::supports(shape->type))

@@ -51,6 +51,11 @@ struct StructureCouplingSetup {
   std::vector<std::vector<double>> positions;                       // per deformable: x
   std::vector<int> dampingOffset;                                   // per deformable: first row of C
   std::vector<int> cellBody;  // per cell: rigid index, bodies.size() + deformable index, or -1
+  // J with the rows of fixed particles and static bodies kept (J zeroes them: infinite mass, at
+  // rest): J_all^T lambda is the impulse on every structure dof, so the force reported on a body
+  // includes what its fixed parts pass on to their support (a clamped flag's root, a fixed
+  // cylinder). Empty when there are neither.
+  solvers::SparseMatrixR forceJ;
 };
 
 // Builds the setup for `grid` from every entity with fluid_coupling and either a rigid_body with

@@ -71,7 +71,7 @@ TEST(FsiChannelPlate, TerminalVelocityConvergesAtFirstOrder) {
   EXPECT_GT(fine.kinetic, 100.0);
 }
 
-// Sec. 5.8 stability: the cylinder's mass scaled by 1e-9 (it rises, carried by buoyancy) and by
+// Sec. 5.8 stability: the cylinder's mass scaled by 1e-9 (it rises to the top, carried by buoyancy) and by
 // 1e9 (it falls freely: the fluid's force is 1e-9 of its weight) runs 200 steps without blowing up.
 TEST(FsiFallingCylinder, ExtremeMassRatiosStayStable) {
   const Registry registry = builtins();
@@ -84,10 +84,11 @@ TEST(FsiFallingCylinder, ExtremeMassRatiosStayStable) {
                                  {"entities.cylinder.rigid_body.mass", value},
                                  {"time.end", "10"}}),
                       registry, 2);
-    double maxEnergyChange = -1e300, time = 0;
+    double maxEnergyChange = -1e300, time = 0, fastestRise = -1e300;
     for (int step = 0; step < 200; ++step) {
       const auto& m = sim.step();
       time = sim.time();
+      fastestRise = std::max(fastestRise, m.at("fsi_cylinder_velocity_y"));
       ASSERT_TRUE(std::isfinite(m.at("fsi_cylinder_velocity_y"))) << "scale " << scale << " step " << step;
       ASSERT_TRUE(std::isfinite(m.at("fluid_kinetic_energy"))) << "scale " << scale << " step " << step;
       maxEnergyChange = std::max(maxEnergyChange, m.at("fsi_energy_change"));
@@ -99,8 +100,12 @@ TEST(FsiFallingCylinder, ExtremeMassRatiosStayStable) {
     if (scale > 1) {
       EXPECT_NEAR(body.v.y(), -9.8 * time, 1e-3 * 9.8 * time);  // free fall
     } else {
-      EXPECT_GT(body.v.y(), 0.0);  // buoyancy lifts a massless cylinder ...
-      EXPECT_LT(body.v.y(), 1.0);  // ... at a Stokes-like speed (0.35 m/s for the same net force)
+      // Buoyancy lifts a massless cylinder at a Stokes-like speed (0.35 m/s for the same net
+      // force; measured 0.27 m/s) until it reaches the outflow at the top (t ~ 0.25 s), where it
+      // stays.
+      EXPECT_GT(fastestRise, 0.1);
+      EXPECT_LT(fastestRise, 1.0);
+      EXPECT_GT(body.x.y(), 0.155);
     }
     EXPECT_LT(umax, scale > 1 ? 20.0 : 2.0) << "scale " << scale;
     EXPECT_LE(maxEnergyChange, 1e-9) << "scale " << scale;
@@ -144,7 +149,7 @@ TEST(FsiFallingCylinder, OneAndTwoThreadsAgreeBitwise) {
   EXPECT_LT(one[3], -0.01);  // it did fall
 }
 
-// Bad scenes: fluid_coupling needs a dynamic rigid body, not both couplings on one body.
+// Bad scenes: fluid_coupling needs a dynamic or static rigid body, not both couplings on one body.
 TEST(FsiScene, BadCouplingIsRefusedWithItsPath) {
   const Registry registry = builtins();
   const std::string head = R"({"dimension": 2, "time": {"dt": 0.01, "end": 0.1}, "entities": [
@@ -152,7 +157,9 @@ TEST(FsiScene, BadCouplingIsRefusedWithItsPath) {
     {"name": "disk", "shape": {"type": "disk", "radius": 0.2}, )";
   const struct {
     std::string body, expected;
-  } cases[] = {{R"("rigid_body": {"static": true, "position": [0.5, 0.5]}, "fluid_coupling": {}}]})", "static rigid_body"},
+  } cases[] = {{R"("rigid_body": {"mass": 1, "position": [0.5, 0.5]}, "kinematic": {"schedule": [{"velocity": [0, 1]}]},
+                   "fluid_coupling": {}}]})",
+                "kinematic rigid_body"},
                {R"("rigid_body": {"position": [0.5, 0.5]}, "fluid_obstacle": {}, "fluid_coupling": {}}]})", ""},
                {R"("rigid_body": {"position": [0.5, 0.5]}, "fluid_coupling": {"mass": 3}}]})", "mass"}};
   for (const auto& c : cases) {
@@ -201,7 +208,7 @@ TEST(FsiSphere3D, HeavySphereSinksWithoutEnergyGain) {
 
 // falling_sphere as shipped (24 x 24 x 48, radius 3 cells, dt = 1 s: the steady Stokes state is
 // the step's fixed point): within 10 % of Stokes' law with the Haberman-Sayre factor (measured
-// 7.7 % fast), steady after three solves, and the coupling impulses carry the sphere's weight.
+// 1.9 % fast), steady after three solves, and the coupling impulses carry the sphere's weight.
 // The error is not monotone in the resolution (docs/benchmarks_fsi.md): this checks the shipped
 // resolution, not convergence.
 TEST(FsiFallingSphere, SteadyStokesSpeedWithinTenPercentOfHabermanSayre) {
