@@ -111,11 +111,13 @@ ImplicitSolveReport implicitDampingSolve(const dm::ForceModel<d>& fm, const Part
   if (dampingForce || !held.empty()) {
     std::vector<double> Du(n, 0.0);
     dm::addDampingForces<d>(fm, R, p.x.data(), u.data(), Du.data());
-    for (const NormalConstraint<d>& c : held)
-      for (int a = 0; a < d; ++a) {
-        const int i = d * c.particle + a;
-        u[i] = p.v[i] + h * (f[i] + Du[i]) / p.m[c.particle];
-      }
+    // With contacts held, the velocity is taken from the forces at the solution, unprojected
+    // (Sec. 4.7.2, step 3: a rather than the projected a-hat): the held particles get back their
+    // constraint's share, and the total momentum changes by exactly h sum f (the damping forces
+    // are internal), not by the solver's residual.
+    if (!held.empty())
+      for (int i = 0; i < n; ++i)
+        if (!constrained(i)) u[i] = p.v[i] + h * (f[i] + Du[i]) / p.m[i / d];
     if (dampingForce) *dampingForce = std::move(Du);
   }
   return report;
