@@ -169,10 +169,10 @@ Eigen::Vector3d centreOf(Simulation<3>& sim, const std::string& name) {
 // over (the top box falls by more than a box size; 0.434 m measured). Rigid and particle overlaps
 // stay within 2 % of the bodies' sizes after every step. The ball starts closer than in the scene
 // (it arrives at 0.5 s instead of 5 s) and the run ends 0.6 s after the strike, to keep the test
-// short. Before the strike no box moves more than 2.1 % of its 0.2 m size: the largest move is
-// the top box's overshoot as the stack first settles elastically under its weight (measured
-// 4.001 mm = 2.0005 % at 0.042 s; its static sag is 2.0 mm), after which the stack stays within
-// 1.6 % through a 5 s stand (docs/benchmarks_deformables.md).
+// short. Before the strike no box moves more than 2 % of its 0.2 m size (the limit): the
+// largest move is the top box's overshoot as the stack first settles elastically under its weight
+// (measured 3.845 mm = 1.92 % with the central-body contact, 4.001 mm = 2.0005 % with the
+// particle-by-particle sweeps before it; its static sag is 2.0 mm).
 TEST(DeformableCoupling, MixedStackStandsThenFalls) {
   const Registry registry = builtins();
   const double standUntil = 0.45;  // the ball touches the bottom box at 0.5 s
@@ -193,7 +193,7 @@ TEST(DeformableCoupling, MixedStackStandsThenFalls) {
   const double fall = start[5].y() - centreOf(sim, "box5").y();
   std::printf("mixed_stack: largest move before the strike %.3e m, top box fell %.3f m, max_penetration_ratio %.3e, %ld "
               "steps\n", moved, fall, ratio, sim.stepsDone());
-  EXPECT_LT(moved, 0.021 * 0.2);
+  EXPECT_LT(moved, 0.02 * 0.2);
   EXPECT_GT(fall, 0.2);
   EXPECT_LE(ratio, 0.02);
 }
