@@ -2,6 +2,7 @@
 
 #include "components/cloth.h"
 #include "components/fluid_coupling.h"
+#include "systems/particle_contact.h"
 
 #include "solvers/deformable/simplex_mesh.h"
 #include "solvers/deformable/stable_step.h"
@@ -51,7 +52,8 @@ template <int d>
 ImplicitSolveReport implicitDampingSolve(const dm::ForceModel<d>& fm, const Particles<d>& p,
                                          const std::vector<double>& f, double h, std::vector<double>& u,
                                          std::vector<double>* dampingForce,
-                                         const std::vector<dm::MatD<d>>* rotations) {
+                                         const std::vector<dm::MatD<d>>* rotations,
+                                         const std::vector<NormalConstraint<d>>* normals) {
   const int n = static_cast<int>(p.x.size());
   ImplicitSolveReport report;
   u.assign(n, 0.0);
@@ -77,9 +79,20 @@ ImplicitSolveReport implicitDampingSolve(const dm::ForceModel<d>& fm, const Part
   // P A P w = P (b - A prescribed), P zeroing the constrained components. P is symmetric, so
   // P A P stays SPD on the free subspace (Sec. 4.7.3 with the constraint rows of the fixed and
   // bound particles).
+  std::vector<NormalConstraint<d>> held;
+  if (normals)
+    for (const NormalConstraint<d>& c : *normals)
+      if (!p.fixed[c.particle]) {
+        held.push_back(c);
+        for (int a = 0; a < d; ++a) prescribed(d * c.particle + a) = c.velocity * c.normal(a);
+      }
   const solvers::Projector project = [&](Eigen::VectorXd& v) {
     for (int i = 0; i < n; ++i)
       if (constrained(i)) v(i) = 0;
+    for (const NormalConstraint<d>& c : held) {
+      Eigen::Map<Vec<d>> vi(v.data() + d * c.particle);
+      vi -= vi.dot(c.normal) * c.normal;
+    }
   };
   Eigen::VectorXd b(n), Ap(n), x(n);
   A(prescribed, Ap);
@@ -96,9 +109,17 @@ ImplicitSolveReport implicitDampingSolve(const dm::ForceModel<d>& fm, const Part
   report.iterations = r.iterations;
   report.relativeResidual = r.relativeResidual();
   for (int i = 0; i < n; ++i) u[i] = x(i) + prescribed(i);
-  if (dampingForce) {
-    dampingForce->assign(n, 0.0);
-    dm::addDampingForces<d>(fm, R, p.x.data(), u.data(), dampingForce->data());
+  if (dampingForce || !held.empty()) {
+    std::vector<double> Du(n, 0.0);
+    dm::addDampingForces<d>(fm, R, p.x.data(), u.data(), Du.data());
+    // With contacts held, the velocity is taken from the forces at the solution, unprojected
+    // (Sec. 4.7.2, step 3: a rather than the projected a-hat): the held particles get back their
+    // constraint's share, and the total momentum changes by exactly h sum f (the damping forces
+    // are internal), not by the solver's residual.
+    if (!held.empty())
+      for (int i = 0; i < n; ++i)
+        if (!constrained(i)) u[i] = p.v[i] + h * (f[i] + Du[i]) / p.m[i / d];
+    if (dampingForce) *dampingForce = std::move(Du);
   }
   return report;
 }
@@ -133,6 +154,13 @@ void applyBoundDamping(World<d>& world, const RigidBinding<d>& b, const Particle
 }  // namespace
 
 template <int d>
+AdvanceDeformableVelocity<d>::AdvanceDeformableVelocity(Stage s)
+    : stage_(s), contacts_(std::make_unique<DampingSolveContacts<d>>()) {}
+
+template <int d>
+AdvanceDeformableVelocity<d>::~AdvanceDeformableVelocity() = default;
+
+template <int d>
 void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
   const bool half = stage_ == Stage::AdvanceVelocityHalf;
   const Vec<d> g = world.settings().gravity;
@@ -149,7 +177,9 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
         const double h = half ? 0.5 * ctx.dt : 0.25 * ctx.dt;
         RigidBinding<d>* binding = world.template get<RigidBinding<d>>(e);
         std::vector<double> Du;
-        const ImplicitSolveReport r = implicitDampingSolve(fm, p, f, h, u, binding ? &Du : nullptr, &R);
+        std::vector<NormalConstraint<d>> held;
+        if (contacts_ && fm.dampingRows() > 0) held = contacts_->of(world, p, ctx.dt, half ? 0.0 : 0.5);
+        const ImplicitSolveReport r = implicitDampingSolve(fm, p, f, h, u, binding ? &Du : nullptr, &R, &held);
         iterations = std::max(iterations, r.iterations);
         // The damping forces the solve put on bound particles act on their bodies: over this
         // stage's velocity change, h (Step I) or 2h (Step V's extrapolation) times D u.
@@ -249,7 +279,8 @@ void DeformableDiagnostics<d>::run(World<d>& world, StepContext& ctx) {
                                                  std::vector<dm::MatD<D>>*);                                    \
   template ImplicitSolveReport implicitDampingSolve<D>(const dm::ForceModel<D>&, const Particles<D>&,          \
                                                        const std::vector<double>&, double, std::vector<double>&, \
-                                                       std::vector<double>*, const std::vector<dm::MatD<D>>*);  \
+                                                       std::vector<double>*, const std::vector<dm::MatD<D>>*,    \
+                                                       const std::vector<NormalConstraint<D>>*);                \
   template class AdvanceDeformableVelocity<D>;                                                                  \
   template class AdvanceDeformablePositions<D>;                                                                 \
   template class DeformableDiagnostics<D>;                                                                      \

@@ -14,14 +14,21 @@
 // constrained in both solves by the projection P (zeroing their velocity components), applied to
 // the right-hand side and inside CG so that P A P stays symmetric (Sec. 4.7.3).
 #include <cstdint>
+#include <memory>
 #include <unordered_map>
 
 #include "components/deformable.h"
+#include "components/collider.h"
+#include "components/kinematic.h"
 #include "components/rigid_body.h"
+#include "components/shape.h"
 #include "ecs/system.h"
 #include "solvers/deformable/elasticity.h"
 
 namespace monolith {
+
+template <int d>
+class DampingSolveContacts;
 
 // The force model of a body, built from its components (rest data, masses, material).
 template <int d>
@@ -43,14 +50,29 @@ struct ImplicitSolveReport {
   double relativeResidual = 0;
 };
 
+// A particle in contact held along one direction during the damping solve (Sec. 4.7.1, 4.7.3:
+// contact as a temporary constraint projected inside CG): u . normal = velocity.
+template <int d>
+struct NormalConstraint {
+  int particle = 0;
+  Vec<d> normal = Vec<d>::Zero();  // unit
+  double velocity = 0;
+};
+
 // Solves (M - h D(x)) u = M v + h f with the fixed and bound particles' u prescribed (their
 // current v) and projected out of the solve; u returned in `u`, and D u in `dampingForce` if given.
 // `rotations`: the damping rotations at the current positions if already known (explicitForces).
+// `normals`: particles whose normal velocity is prescribed inside the solve (P = 1 - n n^T on
+// them, symmetric in the mass inner product); the constraint only steers the damping force: with
+// any held, the returned u is v + h M^{-1} (f + D u), the projection undone (Sec. 4.7.2, notes 2.4
+// step 3), so that contact and friction act afterwards as a post-process that passes momentum
+// both ways.
 template <int d>
 ImplicitSolveReport implicitDampingSolve(const solvers::deformable::ForceModel<d>& fm, const Particles<d>& p,
                                          const std::vector<double>& f, double h, std::vector<double>& u,
                                          std::vector<double>* dampingForce = nullptr,
-                                         const std::vector<solvers::deformable::MatD<d>>* rotations = nullptr);
+                                         const std::vector<solvers::deformable::MatD<d>>* rotations = nullptr,
+                                         const std::vector<NormalConstraint<d>>* normals = nullptr);
 
 // Elastic forces plus gravity at the particles' current positions (zero on fixed particles);
 // with `rotations` given, also the damping rotations there (one decomposition per element).
@@ -62,12 +84,15 @@ std::vector<double> explicitForces(const solvers::deformable::ForceModel<d>& fm,
 template <int d>
 class AdvanceDeformableVelocity final : public System<d> {
  public:
-  explicit AdvanceDeformableVelocity(Stage s) : stage_(s) {}
+  explicit AdvanceDeformableVelocity(Stage s);
+  ~AdvanceDeformableVelocity() override;
   std::string name() const override {
     return stage_ == Stage::AdvanceVelocityHalf ? "advance_deformable_velocity_half" : "advance_deformable_velocity";
   }
   Stage stage() const override { return stage_; }
-  std::vector<std::string> reads() const override { return {SimplexMesh<d>::kName, Elasticity::kName}; }
+  std::vector<std::string> reads() const override {
+    return {SimplexMesh<d>::kName, Elasticity::kName, Shape<d>::kName, Collider<d>::kName, KinematicMotion<d>::kName};
+  }
   std::vector<std::string> writes() const override {
     return {Particles<d>::kName, RigidBody<d>::kName, "diagnostics"};  // bodies: damping on bound particles
   }
@@ -80,6 +105,7 @@ class AdvanceDeformableVelocity final : public System<d> {
  private:
   Stage stage_;
   mutable ForceModelCache<d> cache_;  // rest data only: filling it does not change the state
+  std::unique_ptr<DampingSolveContacts<d>> contacts_;  // particle contacts held in the solve
 };
 
 template <int d>

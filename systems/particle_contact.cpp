@@ -6,15 +6,23 @@
 #include <limits>
 
 #include "solvers/collision/collision_impl.h"
+#include "solvers/collision/narrow_phase.h"
+#include "solvers/contact/central_normal_contact.h"
 #include "systems/contact_workspace.h"
 
 namespace monolith {
 
 namespace col = solvers::collision;
+namespace cc = solvers::contact;
 
 namespace {
 
 constexpr int kContactSweeps = 4;
+// Mass of a static or kinematic support in the central-body solve, relative to the body and
+// its particles: large enough that the support's constraint holds to about 1e-8 relative, small
+// enough that the 6x6 system stays well conditioned in double precision.
+constexpr double kSupportMassRatio = 1e8;
+constexpr double kSupportMargin = 0.01;
 
 template <int d>
 using MatD = Eigen::Matrix<double, d, d>;
@@ -43,6 +51,7 @@ struct BodyView {
   double inverseMass = 0;
   InertiaMat<d> inverseInertia = InertiaMat<d>::Zero();
   double friction = 0;
+  bool infinite = false;  // static or kinematic
 };
 
 template <int d>
@@ -67,6 +76,7 @@ std::vector<BodyView<d>> bodiesOf(World<d>& world, PreparedShapes<d>& shapes, do
     const bool infinite = b.isStatic || world.template has<KinematicMotion<d>>(e);
     v.x = b.x + candidateDt * (b.isStatic ? Vec<d>::Zero() : b.v);
     v.R = b.isStatic || candidateDt == 0 ? b.rotation() : candidateRotation(b, candidateDt);
+    v.infinite = infinite;
     if (!infinite && twoWay) {
       v.inverseMass = 1 / b.mass;
       v.inverseInertia = b.worldInverseInertia();
@@ -95,27 +105,22 @@ Vec<d> bodyResponse(const BodyView<d>& b, const Vec<d>& r, const Vec<d>& j) {
   return b.inverseMass * j + angularAt<d>(AngularVec<d>(b.inverseInertia * crossArm<d>(r, j)), r);
 }
 
-// The impulse on the particle (minus on the body) that stops an approach along n, with
-// Coulomb friction of coefficient mu; zero when not approaching.
+// The tangential impulse on the particle (minus on the body) that stops the relative sliding u_t
+// at the contact, on the Coulomb disc of radius `limit` (mu times the contact's normal impulse).
 template <int d>
-Vec<d> contactImpulse(const BodyView<d>& b, double particleMass, const Vec<d>& r, const Vec<d>& u, const Vec<d>& n) {
-  const double vn = u.dot(n);
-  if (vn >= 0) return Vec<d>::Zero();
+Vec<d> frictionImpulse(const BodyView<d>& b, double particleMass, const Vec<d>& r, const Vec<d>& u, const Vec<d>& n,
+                       double limit) {
+  const Vec<d> ut = u - u.dot(n) * n;
+  if (ut.squaredNorm() == 0 || limit <= 0) return Vec<d>::Zero();
   MatD<d> K;  // relative velocity change per unit impulse on the particle
   for (int k = 0; k < d; ++k) {
     const Vec<d> e = Vec<d>::Unit(k);
     K.col(k) = e / particleMass + bodyResponse(b, r, e);
   }
-  const Vec<d> stick = K.lu().solve(-u);
-  const double jn = stick.dot(n);
-  if ((stick - jn * n).norm() <= b.friction * jn) return stick;
-  const Vec<d> ut = u - vn * n;
-  const Vec<d> t = ut.norm() > 0 ? Vec<d>(ut.normalized()) : Vec<d>::Zero();
-  const Vec<d> dir = n - b.friction * t;
-  double denom = n.dot(K * dir);
-  if (denom > 0) return (-vn / denom) * dir;
-  denom = n.dot(K * n);
-  return (-vn / denom) * n;
+  Vec<d> j = K.lu().solve(-ut);
+  j -= j.dot(n) * n;
+  const double size = j.norm();
+  return size <= limit ? j : Vec<d>((limit / size) * j);
 }
 
 template <int d>
@@ -138,10 +143,12 @@ const col::PreparedGeometry<d>& PreparedShapes<d>::get(Entity e, const Shape<d>&
 
 template <int d>
 void ParticleRigidContact<d>::run(World<d>& world, StepContext& ctx) {
-  const bool candidate = stage_ != Stage::AdvanceVelocity;
+  // Steps II and III test the candidate positions x + dt v^{n+1/2}; Step V the split state
+  // x^{n+1} + dt v^{n+1} as the rigid velocity contact does, so that a particle resting just
+  // outside the contact thickness but approaching is caught before it moves in.
   const bool save = stage_ == Stage::Contact;
   const double dt = ctx.dt;
-  std::vector<BodyView<d>> bodies = bodiesOf(world, shapes_, candidate ? dt : 0.0, !save);
+  std::vector<BodyView<d>> bodies = bodiesOf(world, shapes_, dt, true);
   if (save) {
     scratch_->savedVelocities.clear();
     world.template each<Particles<d>>([&](Entity, Particles<d>& p) { scratch_->savedVelocities.push_back(p.v); });
@@ -151,38 +158,112 @@ void ParticleRigidContact<d>::run(World<d>& world, StepContext& ctx) {
   int impulses = 0;
   std::vector<Particles<d>*> pools;
   world.template each<Particles<d>>([&](Entity, Particles<d>& p) { pools.push_back(&p); });
-  auto visit = [&](BodyView<d>& b, Particles<d>& p, int i) {
-    if (p.fixed[i]) return;
-    Eigen::Map<Vec<d>> v(&p.v[d * i]);
-    const Vec<d> x = Eigen::Map<const Vec<d>>(&p.x[d * i]);
-    const Vec<d> q = candidate ? Vec<d>(x + dt * v) : x;
-    double distance;
-    Vec<d> n;
-    if (!distanceTo(b, q, thickness, distance, n)) return;
-    const Vec<d> r = q - b.x;
-    const Vec<d> bodyV = b.inverseMass == 0 && b.body->isStatic ? Vec<d>::Zero()
-                                                                : Vec<d>(b.body->v + angularAt<d>(b.body->omega(), r));
-    const Vec<d> j = contactImpulse(b, p.m[i], r, Vec<d>(v - bodyV), n);
-    if (j.squaredNorm() == 0) return;
-    v += j / p.m[i];
-    applyImpulse(b, r, j);
-    ++impulses;
+  struct Touch {
+    Particles<d>* pool;
+    int i;
+    Vec<d> r, n;
   };
-  // Forward and backward sweeps in turn (Sec. 4.7.3), the last sweep's direction alternating from
-  // step to step: sweeping one way lets the first particles' friction impulses turn the body
-  // before the later ones are visited, a bias that walked a stack of boxes sideways along the
-  // particle numbering (more sweeps in a fixed order did not remove it: measured with 12).
+  std::vector<Touch> touches;
+  std::vector<cc::CentralNormalOuter<d>> outers;
+  auto pointVelocity = [](const BodyView<d>& b, const Vec<d>& r) {
+    return b.inverseMass == 0 && b.body->isStatic ? Vec<d>::Zero() : Vec<d>(b.body->v + angularAt<d>(b.body->omega(), r));
+  };
+  // Per dynamic body, its contact points with the static and kinematic bodies at this stage's
+  // poses (normals out of the body), found when a particle first touches it.
+  struct Support {
+    const BodyView<d>* other;
+    Vec<d> point, normal;
+    double gap;  // separation at this stage's poses (0 if overlapping)
+  };
+  std::vector<std::vector<Support>> supports(bodies.size());
+  std::vector<char> supportsFound(bodies.size(), 0);
+  std::vector<col::ContactPoint<d>> points;
+  auto supportsOf = [&](const BodyView<d>& b) -> const std::vector<Support>& {
+    const std::size_t k = static_cast<std::size_t>(&b - bodies.data());
+    if (supportsFound[k]) return supports[k];
+    supportsFound[k] = 1;
+    // Points up to 1 % of the body's size apart count, each allowed to close its gap within the
+    // step (target normal velocity -gap/dt): a body floating a little above the ground is not
+    // driven through it by the particles above it, nor held in the air.
+    col::ContactQuery query;
+    query.margin = std::max(thickness, kSupportMargin * b.geometry->minimumSize());
+    for (const BodyView<d>& other : bodies) {
+      if (!other.infinite) continue;
+      points.clear();
+      col::findContacts<d>(*b.geometry, {b.x, b.R}, *other.geometry, {other.x, other.R}, query, points);
+      for (const col::ContactPoint<d>& c : points) supports[k].push_back({&other, c.pointOnA(), Vec<d>(-c.normal), std::max(0.0, -c.depth)});
+    }
+    return supports[k];
+  };
+  // One rigid body as the central body against every particle touching it (Sec. 4.7.3, eq.
+  // 4.3-4.4): the normal impulses of all its contacts solved together, then Coulomb friction on
+  // each contact, bounded by its normal impulse.
+  auto processBody = [&](BodyView<d>& b) {
+    touches.clear();
+    for (Particles<d>* p : pools)
+      for (int i = 0; i < p->count(); ++i) {
+        if (p->fixed[i]) continue;
+        const Vec<d> q = Eigen::Map<const Vec<d>>(&p->x[d * i]) + dt * Eigen::Map<const Vec<d>>(&p->v[d * i]);
+        double distance;
+        Vec<d> n;
+        if (distanceTo(b, q, thickness, distance, n)) touches.push_back({p, i, Vec<d>(q - b.x), n});
+      }
+    if (touches.empty()) return;
+    cc::CentralNormalBody<d> central;
+    central.infinite = b.inverseMass == 0;
+    if (!central.infinite) {
+      central.mass = b.body->mass;
+      central.inertia = b.inverseInertia.inverse();
+    }
+    outers.resize(touches.size());
+    double particleMass = 0;
+    for (std::size_t k = 0; k < touches.size(); ++k) {
+      const Touch& t = touches[k];
+      const Vec<d> u = Eigen::Map<const Vec<d>>(&t.pool->v[d * t.i]) - pointVelocity(b, t.r);
+      outers[k] = {t.pool->m[t.i], t.r, t.n, u.dot(t.n), 0.0};
+      particleMass += t.pool->m[t.i];
+    }
+    // The body's contacts with static and kinematic bodies join as outer bodies of (nearly)
+    // infinite mass (App. B: statics as the limit of heavy bodies), so that a body squeezed
+    // between particles and the ground passes their push to the ground within this one solve
+    // instead of being driven into it (the rigid contact of this stage has already run).
+    if (!central.infinite)
+      for (const Support& s : supportsOf(b)) {
+        const Vec<d> u = pointVelocity(*s.other, s.point - s.other->x) - pointVelocity(b, Vec<d>(s.point - b.x));
+        outers.push_back({kSupportMassRatio * (b.body->mass + particleMass), Vec<d>(s.point - b.x), s.normal,
+                          u.dot(s.normal), -s.gap / dt});
+      }
+    const cc::CentralNormalResult<d> normal = cc::solveCentralNormalContact<d>(central, outers);
+    int pushed = 0;
+    for (std::size_t k = 0; k < touches.size(); ++k)
+      if (normal.lambda[k] > 0) {
+        Eigen::Map<Vec<d>>(&touches[k].pool->v[d * touches[k].i]) += (normal.lambda[k] / touches[k].pool->m[touches[k].i]) * touches[k].n;
+        ++pushed;
+      }
+    if (pushed == 0) return;
+    if (!central.infinite) {
+      b.body->v += normal.bodyImpulse / b.body->mass;
+      b.body->L += normal.bodyAngularImpulse;
+    }
+    impulses += pushed;
+    if (b.friction == 0) return;
+    for (std::size_t k = 0; k < touches.size(); ++k) {
+      if (normal.lambda[k] <= 0) continue;
+      const Touch& t = touches[k];
+      Eigen::Map<Vec<d>> v(&t.pool->v[d * t.i]);
+      const Vec<d> j = frictionImpulse(b, t.pool->m[t.i], t.r, Vec<d>(v - pointVelocity(b, t.r)), t.n,
+                                       b.friction * normal.lambda[k]);
+      if (j.squaredNorm() == 0) continue;
+      v += j / t.pool->m[t.i];
+      applyImpulse(b, t.r, j);
+    }
+  };
+  // Gauss-Seidel over the bodies (a particle may touch several), forward and backward in turn
+  // (Sec. 4.7.3), the last sweep's direction alternating from step to step.
   for (int sweep = 0; sweep < kContactSweeps; ++sweep) {
     const bool forward = (sweep + ctx.step) % 2 == 0;
-    const int nb = static_cast<int>(bodies.size()), np = static_cast<int>(pools.size());
-    for (int bi = 0; bi < nb; ++bi) {
-      BodyView<d>& b = bodies[forward ? bi : nb - 1 - bi];
-      for (int pi = 0; pi < np; ++pi) {
-        Particles<d>& p = *pools[forward ? pi : np - 1 - pi];
-        const int n = p.count();
-        for (int i = 0; i < n; ++i) visit(b, p, forward ? i : n - 1 - i);
-      }
-    }
+    const int nb = static_cast<int>(bodies.size());
+    for (int bi = 0; bi < nb; ++bi) processBody(bodies[forward ? bi : nb - 1 - bi]);
   }
   ctx.diagnostics.set(name() + "_impulses", impulses);
 }
@@ -243,6 +324,34 @@ void ParticlePenetration<d>::run(World<d>& world, StepContext& ctx) {
 }
 
 template <int d>
+std::vector<NormalConstraint<d>> DampingSolveContacts<d>::of(World<d>& world, const Particles<d>& p, double dt,
+                                                             double keep) {
+  std::vector<NormalConstraint<d>> out;
+  if (world.template count<Collider<d>>() == 0) return out;
+  const std::vector<BodyView<d>> bodies = bodiesOf(world, shapes_, dt, false);
+  const double thickness = world.settings().contact.thickness;
+  const double tolerance = world.settings().contact.approachTolerance;
+  std::vector<char> taken(p.count(), 0);
+  for (const BodyView<d>& b : bodies)
+    for (int i = 0; i < p.count(); ++i) {
+      if (p.fixed[i] || taken[i]) continue;  // one contact per particle: the first body's
+      const Vec<d> v = Eigen::Map<const Vec<d>>(&p.v[d * i]);
+      const Vec<d> q = Eigen::Map<const Vec<d>>(&p.x[d * i]) + dt * v;
+      double distance;
+      Vec<d> n;
+      // Resting contacts hover at about the thickness, where contact stopped them: twice it.
+      if (!distanceTo(b, q, 2 * thickness, distance, n)) continue;
+      const Vec<d> r = q - b.x;
+      const Vec<d> bodyV = b.body->isStatic ? Vec<d>::Zero() : Vec<d>(b.body->v + angularAt<d>(b.body->omega(), r));
+      const double approach = (v - bodyV).dot(n);
+      if (approach > tolerance) continue;  // separating; resting contacts are held
+      out.push_back({i, n, bodyV.dot(n) + keep * std::min(approach, 0.0)});
+      taken[i] = 1;
+    }
+  return out;
+}
+
+template <int d>
 std::vector<std::unique_ptr<System<d>>> makeParticleContactSystems() {
   auto scratch = std::make_shared<ParticleContactScratch>();
   std::vector<std::unique_ptr<System<d>>> out;
@@ -260,6 +369,8 @@ std::vector<std::unique_ptr<System<d>>> makeParticleCollisionSystems() {
   return out;
 }
 
+template class DampingSolveContacts<2>;
+template class DampingSolveContacts<3>;
 template class PreparedShapes<2>;
 template class PreparedShapes<3>;
 template class ParticleRigidContact<2>;
