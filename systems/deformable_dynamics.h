@@ -48,6 +48,7 @@ class ForceModelCache {
 struct ImplicitSolveReport {
   int iterations = 0;
   double relativeResidual = 0;
+  bool converged = true;  // CG met its tolerance on the projected system
 };
 
 // A particle in contact held along one direction during the damping solve (Sec. 4.7.1, 4.7.3:
@@ -63,10 +64,11 @@ struct NormalConstraint {
 // current v) and projected out of the solve; u returned in `u`, and D u in `dampingForce` if given.
 // `rotations`: the damping rotations at the current positions if already known (explicitForces).
 // `normals`: particles whose normal velocity is prescribed inside the solve (P = 1 - n n^T on
-// them, symmetric in the mass inner product); the constraint only steers the damping force: with
-// any held, the returned u is v + h M^{-1} (f + D u), the projection undone (Sec. 4.7.2, notes 2.4
-// step 3), so that contact and friction act afterwards as a post-process that passes momentum
-// both ways.
+// them, symmetric in the mass inner product); the constraint only steers the damping force: the
+// free particles' returned u is v + h M^{-1} (f + D u), the projection undone (Sec. 4.7.2, notes
+// 2.4 step 3), so that contact and friction act afterwards as a post-process that passes momentum
+// both ways (without holds this is the solution itself up to CG's tolerance, and makes the
+// momentum change exactly h sum f).
 template <int d>
 ImplicitSolveReport implicitDampingSolve(const solvers::deformable::ForceModel<d>& fm, const Particles<d>& p,
                                          const std::vector<double>& f, double h, std::vector<double>& u,
