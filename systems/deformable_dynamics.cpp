@@ -108,12 +108,11 @@ ImplicitSolveReport implicitDampingSolve(const dm::ForceModel<d>& fm, const Part
   // the free subspace and the stopping test measures the residual of the projected system ("can
   // be solved with conjugate gradient provided the residual is properly projected at each
   // iteration", Sec. 4.7.3). Projecting only the preconditioned residual (enough for a null-space
-  // projector, which A p never leaves) leaves in r the constrained components of A p: the
+  // projector, which A p never leaves) would leave in r the constrained components of A p: the
   // forces that hold the fixed, bound and contact particles, which do not vanish at the
-  // solution. The test never passed then; CG ran on past convergence on round-off until it broke
-  // down by chance, or did not and diverged: drop_sphere_elastic at t = 1.4376 s, a ball resting
-  // on six held contacts, went 2000 iterations in Step I to a residual of 1e50 and a velocity of
-  // 1e51 m/s.
+  // solution. The test would never pass, and CG would run on past convergence on round-off until
+  // it broke down by chance, or diverge: drop_sphere_elastic at t = 1.4376 s (a ball resting on six
+  // held contacts) then takes 2000 iterations in Step I to a residual of 1e50 and blows up.
   const solvers::LinearOperator projectedA = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
     A(in, out);
     project(out);
