@@ -99,6 +99,54 @@ double fluidViscosity(const World<d>& world, Entity grid) {
   return m ? m->viscosity : 0.0;
 }
 
+// "obstacle_wall": "surface" or "cell_boundary" for the coupled rigid bodies too: the viscous row
+// between a fluid face and a structure face (the tangential coupling of Sec. 5.7 sits on faces half
+// a cell inside the staircase, Fig. 5.2) measures the shear against a wall theta cells from the
+// fluid face, at the body's true surface along the pair (or at the structure cells' boundary),
+// instead of at the structure face one cell away: row weight w / sqrt(theta), the obstacles'
+// symmetric Dirichlet treatment (solvers/fluid/operators.h). The wall moves with the structure
+// face's velocity (exact for translation; a rotating body's wall speed is taken at the face,
+// theta' dx deeper). With "face" (default) nothing is stored and the rows stay the thesis's.
+// Deformable structures keep theta = 1 (no surface to measure against here).
+template <int d>
+void placeStructureWalls(FluidSolverSettings::ObstacleWall where, const std::vector<ObstacleGeometry<d>>& geometry,
+                         StructureCouplingSetup<d>& setup) {
+  if (where == FluidSolverSettings::ObstacleWall::Face || geometry.empty()) return;
+  auto& domain = setup.domain;
+  const auto& layout = domain.layout;
+  const int nf = layout.totalFaces(), nb = static_cast<int>(geometry.size());
+  if (domain.wallDistance.empty()) domain.wallDistance.assign(static_cast<std::size_t>(nf) * 2 * d, 1.0);
+  for (int f = 0; f < nf; ++f) {
+    if (domain.faces[f] != solvers::FaceKind::Free || domain.structureFace[f]) continue;
+    const auto [a, fc] = layout.faceCoord(f);
+    const auto dims = layout.faceDims(a);
+    for (int b = 0; b < d; ++b)
+      for (int s = 0; s < 2; ++s) {
+        auto g = fc;
+        g[b] += s ? 1 : -1;
+        if (g[b] < 0 || g[b] >= dims[b]) {
+          if (!layout.periodic[b]) continue;
+          g[b] = (g[b] + dims[b]) % dims[b];
+        }
+        const int other = layout.faceIndex(a, g);
+        if (!domain.structureFace[other]) continue;
+        double t = std::numeric_limits<double>::infinity();
+        Eigen::Matrix<double, d, 1> e = Eigen::Matrix<double, d, 1>::Zero();
+        e[b] = s ? 1.0 : -1.0;
+        for (int which = 0; which < 2; ++which) {
+          int cell = -1;
+          if (!domain.faceCell(other, which, cell) || setup.cellBody[cell] < 0 || setup.cellBody[cell] >= nb) continue;
+          t = where == FluidSolverSettings::ObstacleWall::CellBoundary
+                  ? (b == a ? layout.dx : 0.5 * layout.dx)
+                  : std::min(t, geometry[setup.cellBody[cell]].rayEntry(layout.faceCenter(a, fc), e, layout.dx));
+        }
+        if (!std::isfinite(t)) continue;
+        domain.wallDistance[solvers::FluidDomain<d>::wallDistanceIndex(f, b, s)] =
+            std::clamp(t / layout.dx, solvers::FluidDomain<d>::kMinWallDistance, 1.0);
+      }
+  }
+}
+
 }  // namespace
 
 template <int d>
@@ -202,6 +250,7 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
   }
   auto& coupling = setup.coupling;
   coupling.constrainedFaces = solvers::markStructure(setup.domain, mask, viscous);
+  if (viscous) placeStructureWalls(world.settings().fluid.obstacleWall, geometry, setup);
   const int nc = static_cast<int>(coupling.constrainedFaces.size());
 
   // J = N J_hat R: one sample per (face, adjacent rigid body) at the face centre, and one per
