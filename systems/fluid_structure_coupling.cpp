@@ -88,6 +88,14 @@ double fluidShare(const solvers::FluidDomain<d>& domain, int f) {
   return fluid == 0 ? 0.0 : fluid == 1 ? 0.5 : 1.0;
 }
 
+// A body's own volume (area in 2-D) where its shape gives it simply (disk/sphere, box), else 0.
+template <int d>
+double shapeVolume(const Shape<d>* shape) {
+  if (shape && shape->type == ShapeType::Sphere) return d == 2 ? M_PI * std::pow(shape->radius, 2) : 4.0 / 3.0 * M_PI * std::pow(shape->radius, 3);
+  if (shape && shape->type == ShapeType::Box) return std::pow(2.0, d) * shape->halfExtents.prod();
+  return 0.0;
+}
+
 template <int d>
 double fluidDensity(const World<d>& world, Entity grid) {
   const FluidMaterial* m = world.template get<FluidMaterial>(grid);
@@ -225,11 +233,7 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
   for (int b = 0; b < nb; ++b)
     if (std::find(setup.cellBody.begin(), setup.cellBody.end(), b) == setup.cellBody.end()) {
       claim(geometry[b].body().x, b);
-      const Shape<d>* shape = world.template get<Shape<d>>(setup.bodies[b]);
-      double volume = 0;  // the body's own volume (area in 2-D), where the shape gives it simply
-      if (shape && shape->type == ShapeType::Sphere) volume = d == 2 ? M_PI * std::pow(shape->radius, 2) : 4.0 / 3.0 * M_PI * std::pow(shape->radius, 3);
-      if (shape && shape->type == ShapeType::Box) volume = std::pow(2.0, d) * shape->halfExtents.prod();
-      extraMass[b] = std::max(0.0, rhoFluid * (claimed[b] * layout.cellVolume() - volume));
+      extraMass[b] = std::max(0.0, rhoFluid * (claimed[b] * layout.cellVolume() - shapeVolume(world.template get<Shape<d>>(setup.bodies[b]))));
     }
   for (int k = 0; k < nd; ++k) {
     const std::vector<int> inside = setup.locators[k].cellsInside();
@@ -337,6 +341,18 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
         if (!body.isStatic) minv.emplace_back(off + d + i, off + d + j, Iinv(i, j));
       }
     coupling.velocity.segment(off, d) = body.v;
+    // "buoyancy": "body_volume": the pressure lifts the body by the weight of its structure cells'
+    // fluid, rho_f g V_cells; v* takes the difference to its own volume's, dt rho_f (V_cells - V) g / m,
+    // so that the net force is (m - rho_f V) g whatever the staircase. The weight the system holds is
+    // then exactly the body's plus the fluid's outside the body (the fluid counted in V - V_cells
+    // weighs on the walls through the pressure, the same amount taken off the body). Not for a body
+    // that claims its cell (its composite mass already balances the claimed fluid) or a shape of
+    // unknown volume.
+    const double volume = shapeVolume(world.template get<Shape<d>>(setup.bodies[b]));
+    if (fsiSolverOf(world).bodyVolumeBuoyancy && !body.isStatic && claimed[b] == 0 && volume > 0) {
+      const double cells = static_cast<double>(std::count(setup.cellBody.begin(), setup.cellBody.end(), b));
+      coupling.velocity.segment(off, d) += dt * rhoFluid * (cells * layout.cellVolume() - volume) / mass * world.settings().gravity;
+    }
     const AngularVec<d> w = body.omega();
     for (int i = 0; i < kAngular(d); ++i) coupling.velocity[off + d + i] = w[i];
   }
