@@ -304,7 +304,7 @@ TEST(FsiSphere3D, HeavySphereSinksWithoutEnergyGain) {
 // surfaces, the sphere's own volume for its buoyancy, dt = 1 s: the steady Stokes state is the
 // step's fixed point): within 10 % of Stokes' law with the Haberman-Sayre factor (measured 4.0 % fast), steady after three solves, and the
 // coupling impulses carry the sphere's weight. The error follows the staircase sphere's volume,
-// which jumps with r / dx (docs/benchmarks_fsi.md: -9.0 ... +7.1 % from 16 to 48 cells).
+// which jumps with r / dx (docs/benchmarks_fsi.md: -5.3 ... +4.2 % from 16 to 32 cells).
 TEST(FsiFallingSphere, SteadyStokesSpeedWithinTenPercentOfHabermanSayre) {
   const Registry registry = builtins();
   Simulation<3> sim(loadScene(kScenes + "falling_sphere.json", {{"time.end", "3"}}), registry, 2);
