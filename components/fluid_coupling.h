@@ -42,12 +42,18 @@ struct FsiSolver {
   enum class Preconditioner : int { None = 0, BlockJacobi = 1, BlockExact = 2, Schur = 3 };
   Preconditioner preconditioner = Preconditioner::Schur;
   bool halfStep = true;  // Sec. 5.4 steps 1-3: a coupled solve over dt/2 gives the velocity that moves the body
+  // "buoyancy": "structure_cells" (false, default): a coupled rigid body feels the buoyancy of its
+  // staircase, rho_f g V_cells, through the pressure; "body_volume" (true): its weight is corrected
+  // by rho_f g (V_cells - V) so that weight and buoyancy together are (m - rho_f V) g for the
+  // body's own volume V (disk/sphere and box shapes; docs/fsi.md).
+  bool bodyVolumeBuoyancy = false;
   template <class V>
   void visitFields(V& visit) {
     int p = static_cast<int>(preconditioner);
     visit("preconditioner", p);
     preconditioner = static_cast<Preconditioner>(p);
     visit("half_step", halfStep);
+    visit("body_volume_buoyancy", bodyVolumeBuoyancy);
   }
 };
 

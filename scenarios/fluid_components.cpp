@@ -276,6 +276,7 @@ void parseFsiSolver(World<d>& world, Entity e, const Config& c) {
                      : p == "schur"        ? FsiSolver::Preconditioner::Schur
                                            : FsiSolver::Preconditioner::BlockExact;
   s.halfStep = c.boolean("half_step", true);
+  s.bodyVolumeBuoyancy = c.oneOf("buoyancy", {"structure_cells", "body_volume"}, "structure_cells") == "body_volume";
   c.finish();
   world.add(e, s);
 }

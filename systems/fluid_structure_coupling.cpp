@@ -88,6 +88,14 @@ double fluidShare(const solvers::FluidDomain<d>& domain, int f) {
   return fluid == 0 ? 0.0 : fluid == 1 ? 0.5 : 1.0;
 }
 
+// A body's own volume (area in 2-D) where its shape gives it simply (disk/sphere, box), else 0.
+template <int d>
+double shapeVolume(const Shape<d>* shape) {
+  if (shape && shape->type == ShapeType::Sphere) return d == 2 ? M_PI * std::pow(shape->radius, 2) : 4.0 / 3.0 * M_PI * std::pow(shape->radius, 3);
+  if (shape && shape->type == ShapeType::Box) return std::pow(2.0, d) * shape->halfExtents.prod();
+  return 0.0;
+}
+
 template <int d>
 double fluidDensity(const World<d>& world, Entity grid) {
   const FluidMaterial* m = world.template get<FluidMaterial>(grid);
@@ -97,6 +105,54 @@ template <int d>
 double fluidViscosity(const World<d>& world, Entity grid) {
   const FluidMaterial* m = world.template get<FluidMaterial>(grid);
   return m ? m->viscosity : 0.0;
+}
+
+// "obstacle_wall": "surface" or "cell_boundary" for the coupled rigid bodies too: the viscous row
+// between a fluid face and a structure face (the tangential coupling of Sec. 5.7 sits on faces half
+// a cell inside the staircase, Fig. 5.2) measures the shear against a wall theta cells from the
+// fluid face, at the body's true surface along the pair (or at the structure cells' boundary),
+// instead of at the structure face one cell away: row weight w / sqrt(theta), the obstacles'
+// symmetric Dirichlet treatment (solvers/fluid/operators.h). The wall moves with the structure
+// face's velocity (exact for translation; a rotating body's wall speed is taken at the face,
+// theta' dx deeper). With "face" (default) nothing is stored and the rows stay the thesis's.
+// Deformable structures keep theta = 1 (no surface to measure against here).
+template <int d>
+void placeStructureWalls(FluidSolverSettings::ObstacleWall where, const std::vector<ObstacleGeometry<d>>& geometry,
+                         StructureCouplingSetup<d>& setup) {
+  if (where == FluidSolverSettings::ObstacleWall::Face || geometry.empty()) return;
+  auto& domain = setup.domain;
+  const auto& layout = domain.layout;
+  const int nf = layout.totalFaces(), nb = static_cast<int>(geometry.size());
+  if (domain.wallDistance.empty()) domain.wallDistance.assign(static_cast<std::size_t>(nf) * 2 * d, 1.0);
+  for (int f = 0; f < nf; ++f) {
+    if (domain.faces[f] != solvers::FaceKind::Free || domain.structureFace[f]) continue;
+    const auto [a, fc] = layout.faceCoord(f);
+    const auto dims = layout.faceDims(a);
+    for (int b = 0; b < d; ++b)
+      for (int s = 0; s < 2; ++s) {
+        auto g = fc;
+        g[b] += s ? 1 : -1;
+        if (g[b] < 0 || g[b] >= dims[b]) {
+          if (!layout.periodic[b]) continue;
+          g[b] = (g[b] + dims[b]) % dims[b];
+        }
+        const int other = layout.faceIndex(a, g);
+        if (!domain.structureFace[other]) continue;
+        double t = std::numeric_limits<double>::infinity();
+        Eigen::Matrix<double, d, 1> e = Eigen::Matrix<double, d, 1>::Zero();
+        e[b] = s ? 1.0 : -1.0;
+        for (int which = 0; which < 2; ++which) {
+          int cell = -1;
+          if (!domain.faceCell(other, which, cell) || setup.cellBody[cell] < 0 || setup.cellBody[cell] >= nb) continue;
+          t = where == FluidSolverSettings::ObstacleWall::CellBoundary
+                  ? (b == a ? layout.dx : 0.5 * layout.dx)
+                  : std::min(t, geometry[setup.cellBody[cell]].rayEntry(layout.faceCenter(a, fc), e, layout.dx));
+        }
+        if (!std::isfinite(t)) continue;
+        domain.wallDistance[solvers::FluidDomain<d>::wallDistanceIndex(f, b, s)] =
+            std::clamp(t / layout.dx, solvers::FluidDomain<d>::kMinWallDistance, 1.0);
+      }
+  }
 }
 
 }  // namespace
@@ -177,11 +233,7 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
   for (int b = 0; b < nb; ++b)
     if (std::find(setup.cellBody.begin(), setup.cellBody.end(), b) == setup.cellBody.end()) {
       claim(geometry[b].body().x, b);
-      const Shape<d>* shape = world.template get<Shape<d>>(setup.bodies[b]);
-      double volume = 0;  // the body's own volume (area in 2-D), where the shape gives it simply
-      if (shape && shape->type == ShapeType::Sphere) volume = d == 2 ? M_PI * std::pow(shape->radius, 2) : 4.0 / 3.0 * M_PI * std::pow(shape->radius, 3);
-      if (shape && shape->type == ShapeType::Box) volume = std::pow(2.0, d) * shape->halfExtents.prod();
-      extraMass[b] = std::max(0.0, rhoFluid * (claimed[b] * layout.cellVolume() - volume));
+      extraMass[b] = std::max(0.0, rhoFluid * (claimed[b] * layout.cellVolume() - shapeVolume(world.template get<Shape<d>>(setup.bodies[b]))));
     }
   for (int k = 0; k < nd; ++k) {
     const std::vector<int> inside = setup.locators[k].cellsInside();
@@ -202,6 +254,7 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
   }
   auto& coupling = setup.coupling;
   coupling.constrainedFaces = solvers::markStructure(setup.domain, mask, viscous);
+  if (viscous) placeStructureWalls(world.settings().fluid.obstacleWall, geometry, setup);
   const int nc = static_cast<int>(coupling.constrainedFaces.size());
 
   // J = N J_hat R: one sample per (face, adjacent rigid body) at the face centre, and one per
@@ -288,6 +341,18 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
         if (!body.isStatic) minv.emplace_back(off + d + i, off + d + j, Iinv(i, j));
       }
     coupling.velocity.segment(off, d) = body.v;
+    // "buoyancy": "body_volume": the pressure lifts the body by the weight of its structure cells'
+    // fluid, rho_f g V_cells; v* takes the difference to its own volume's, dt rho_f (V_cells - V) g / m,
+    // so that the net force is (m - rho_f V) g whatever the staircase. The weight the system holds is
+    // then exactly the body's plus the fluid's outside the body (the fluid counted in V - V_cells
+    // weighs on the walls through the pressure, the same amount taken off the body). Not for a body
+    // that claims its cell (its composite mass already balances the claimed fluid) or a shape of
+    // unknown volume.
+    const double volume = shapeVolume(world.template get<Shape<d>>(setup.bodies[b]));
+    if (fsiSolverOf(world).bodyVolumeBuoyancy && !body.isStatic && claimed[b] == 0 && volume > 0) {
+      const double cells = static_cast<double>(std::count(setup.cellBody.begin(), setup.cellBody.end(), b));
+      coupling.velocity.segment(off, d) += dt * rhoFluid * (cells * layout.cellVolume() - volume) / mass * world.settings().gravity;
+    }
     const AngularVec<d> w = body.omega();
     for (int i = 0; i < kAngular(d); ++i) coupling.velocity[off + d + i] = w[i];
   }

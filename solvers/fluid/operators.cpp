@@ -179,6 +179,14 @@ void buildViscousRows(FluidOperators<d>& ops) {
             c = w / std::sqrt(theta(e1, 0));
             e0.value = wallVelocity(e1, 0, e0.value);
           }
+          // A pair from a fluid face to a coupled structure's face: the same, the wall moving with
+          // the structure face (theta = 1 unless the coupling asked for its walls at the surface).
+          if (!domain.structureFace.empty() && e0.kind == PairEnd::Unknown && e1.kind == PairEnd::Unknown) {
+            const bool s0 = domain.structureFace[ops.dofs.velocityToFace[e0.velocity]];
+            const bool s1 = domain.structureFace[ops.dofs.velocityToFace[e1.velocity]];
+            if (!s0 && s1) c = w / std::sqrt(theta(e0, 1));
+            if (s0 && !s1) c = w / std::sqrt(theta(e1, 0));
+          }
         }
         ViscousRow row;
         double h = 0;

@@ -34,7 +34,7 @@ struct Rig {
 };
 
 template <int d>
-Rig<d> makeRig(int n, double mu, double mass, bool outflowTop = true) {
+Rig<d> makeRig(int n, double mu, double mass, bool outflowTop = true, double wallTheta = 0) {
   Rig<d> rig;
   typename MacLayout<d>::Index cells = MacLayout<d>::Index::Constant(n);
   const double dx = 1.0 / n;
@@ -50,6 +50,8 @@ Rig<d> makeRig(int n, double mu, double mass, bool outflowTop = true) {
   for (int c = 0; c < layout.cellCount(); ++c)
     mask[c] = (layout.cellCenter(layout.cellCoord(c)) - rig.centre).norm() < radius;
   const std::vector<int> faces = markStructure(rig.domain, mask, mu > 0);
+  // Walls theta cells from every free face ("obstacle_wall": "surface" for the structure's faces).
+  if (wallTheta > 0) rig.domain.wallDistance.assign(static_cast<std::size_t>(layout.totalFaces()) * 2 * d, wallTheta);
   rig.ops = std::make_unique<FluidOperators<d>>(buildFluidOperators(rig.domain, FluidParameters{1.3, mu, 0.05}));
   const int ndof = rigidDofs(d);
   std::vector<Eigen::Triplet<double>> r, jhat;
@@ -84,8 +86,8 @@ Rig<d> makeRig(int n, double mu, double mass, bool outflowTop = true) {
 }
 
 template <int d>
-void expectSymmetricPositiveDefinite(double mu) {
-  Rig<d> rig = makeRig<d>(d == 2 ? 10 : 5, mu, 0.7);
+void expectSymmetricPositiveDefinite(double mu, double wallTheta = 0) {
+  Rig<d> rig = makeRig<d>(d == 2 ? 10 : 5, mu, 0.7, true, wallTheta);
   ASSERT_GT(rig.coupling.constraintCount(), 0);
   FsiOperator<d> A(*rig.ops, rig.coupling);
   std::mt19937 rng(7);
@@ -120,6 +122,40 @@ TEST(FsiSystem, SymmetricPositiveDefinite3D) {
   expectSymmetricPositiveDefinite<3>(0.4);
   expectSymmetricPositiveDefinite<3>(0.0);
 }
+
+// Walls at the surface: a viscous row from a fluid face to a structure face measures the shear
+// against a wall theta cells away, weight w / sqrt(theta); theta = 1 gives the thesis's rows exactly.
+// The operator stays symmetric positive definite.
+template <int d>
+void expectStructureWallRows() {
+  const int n = d == 2 ? 10 : 5;
+  const Rig<d> plain = makeRig<d>(n, 0.4, 0.7), one = makeRig<d>(n, 0.4, 0.7, true, 1.0),
+               quarter = makeRig<d>(n, 0.4, 0.7, true, 0.25);
+  ASSERT_EQ(plain.ops->viscousRows.size(), one.ops->viscousRows.size());
+  ASSERT_EQ(plain.ops->viscousRows.size(), quarter.ops->viscousRows.size());
+  const auto& structure = plain.domain.structureFace;
+  const double w = plain.ops->viscousWeight;
+  int scaled = 0;
+  for (std::size_t r = 0; r < plain.ops->viscousRows.size(); ++r) {
+    const auto &a = plain.ops->viscousRows[r], &b = one.ops->viscousRows[r], &q = quarter.ops->viscousRows[r];
+    EXPECT_EQ(a.c0, b.c0);
+    EXPECT_EQ(a.c1, b.c1);
+    if (a.u0 < 0 || a.u1 < 0) continue;
+    const bool s0 = structure[plain.ops->dofs.velocityToFace[a.u0]], s1 = structure[plain.ops->dofs.velocityToFace[a.u1]];
+    if (s0 == s1) {
+      EXPECT_EQ(q.c1, a.c1);
+      continue;
+    }
+    EXPECT_DOUBLE_EQ(q.c1, 2 * w);
+    EXPECT_DOUBLE_EQ(q.c0, -2 * w);
+    ++scaled;
+  }
+  EXPECT_GT(scaled, 8);
+  expectSymmetricPositiveDefinite<d>(0.4, 0.25);
+}
+
+TEST(FsiSystem, StructureWallsAtTheSurfaceScaleTheirRowsAndStaySpd2D) { expectStructureWallRows<2>(); }
+TEST(FsiSystem, StructureWallsAtTheSurfaceScaleTheirRowsAndStaySpd3D) { expectStructureWallRows<3>(); }
 
 // J v is the rigid velocity n . (v + w x r) at each face centre (what a one-way obstacle's face
 // gets, components/mac_grid.h ObstacleMotion::velocityAt), and J^T lambda is the force and torque
