@@ -18,8 +18,7 @@ void Contact<d>::run(World<d>& world, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (ws.bodies.empty()) return;
   // Joint post-stabilization (Step II.2) and PD (Step III.2) ran since collisions unpacked.
-  if constexpr (d == 3)
-    if (world.template count<Joint>() > 0) ws.reloadVelocities();
+  if (world.template count<ArticulationJoint<d>>() > 0) ws.reloadVelocities();
   ws.updateAllCandidates();
   std::vector<int> impulses(ws.islands.members.size(), 0);
   ws.forEachIsland(

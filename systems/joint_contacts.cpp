@@ -20,7 +20,7 @@ constexpr double kStepFiveMargin = 5e-3;
 
 // Per body of `ws`: its body in the assembly if it is jointed and can move, else 0 (the world,
 // held still).
-std::vector<int> assemblyBodies(const JointAssembly& a, const ContactWorkspace<3>& ws) {
+std::vector<int> assemblyBodies(const JointAssembly<3>& a, const ContactWorkspace<3>& ws) {
   std::vector<int> bodyOf(ws.bodies.size(), 0);
   for (std::size_t i = 0; i < ws.bodies.size(); ++i) {
     const auto it = a.index.find(ws.entityOf(i).index);
@@ -35,7 +35,7 @@ std::vector<int> assemblyBodies(const JointAssembly& a, const ContactWorkspace<3
 // the row's gain. With `partnerMotion`, a partner held still in the solve moves with its own
 // velocity at the point (Step V).
 template <typename GainOf>
-std::vector<solvers::ContactRow> contactRows(const JointAssembly& a, const ContactWorkspace<3>& ws,
+std::vector<solvers::ContactRow> contactRows(const JointAssembly<3>& a, const ContactWorkspace<3>& ws,
                                              const std::vector<int>& bodyOf, double margin, GainOf&& gainOf,
                                              bool partnerMotion) {
   auto poseOf = [&](std::size_t i) {
@@ -82,7 +82,7 @@ std::vector<solvers::ContactRow> contactRows(const JointAssembly& a, const Conta
 
 void postStabilizeWithContacts(World<3>& world, const ContactWorkspace<3>& ws, StepContext& ctx) {
   const ArticulationSolver s = articulationSettings(world);
-  JointAssembly a(world);
+  JointAssembly<3> a(world);
   const std::vector<int> bodyOf = assemblyBodies(a, ws);
   const double dt = ws.dt;
   // Touching or overlapping: no approach (push-out's business); apart: the gap in one step.
@@ -97,7 +97,7 @@ void postStabilizeWithContacts(World<3>& world, const ContactWorkspace<3>& ws, S
 
 void resolveJointedInterpenetration(World<3>& world, ContactWorkspace<3>& ws, StepContext& ctx) {
   const ArticulationSolver s = articulationSettings(world);
-  JointAssembly a(world);
+  JointAssembly<3> a(world);
   const std::vector<int> bodyOf = assemblyBodies(a, ws);
   // The joint error push-out's own poses would leave.
   std::vector<solvers::ConstraintBody> pushed = a.bodies;
