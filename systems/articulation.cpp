@@ -171,7 +171,6 @@ void PreStabilizeJoints<d>::run(World<d>& world, StepContext& ctx) {
 
 template <int d>
 int jointContactRounds(const World<d>& world) {
-  if constexpr (d == 2) return 0;  // 2-D contact does not take the joints' rounds
   return world.template count<ArticulationJoint<d>>() > 0 && articulationSettings(world).preStabilization
              ? articulationSettings(world).contactRounds
              : 0;

@@ -7,9 +7,8 @@
 //   post_stabilize_velocities  Step V.4    project the final velocities
 //   joint_diagnostics          joint_error_max, joint_angle_error_max, joint_velocity_error_max
 // A scene without joints schedules none of them. The numerics are in solvers/articulation; the
-// stages are the same in 2-D (the joints of the plane, systems/joint_assembly.h), where the
-// joint-and-contact coupling of Steps III-V below is not done: pre-stabilization runs once in
-// its own stage and contact does not see the joints.
+// stages, and their coupling with contact below, are the same in 2-D (the joints and contact
+// points of the plane z = 0, systems/joint_assembly.h).
 #include "components/joint.h"
 #include "components/rigid_body.h"
 #include "ecs/system.h"
@@ -84,7 +83,7 @@ class JointDiagnostics final : public JointSystem<d> {
 
 // Pre-stabilization on the bodies' velocities (what pre_stabilize_joints runs), and how many
 // rounds of it Step III's contact interleaves with its sweeps (0 without joints or with
-// pre-stabilization off; 0 in 2-D). Step III.3 of Sec. 4.5 processes contact and
+// pre-stabilization off). Step III.3 of Sec. 4.5 processes contact and
 // pre-stabilization together; with rounds, pre_stabilize_joints itself does nothing in a scene
 // with colliders.
 template <int d>
@@ -108,14 +107,16 @@ void postStabilizeJointVelocities(World<d>& world, StepContext& ctx);
 // joint error at push-out's poses), joint_push_out_contacts, joint_push_out_error_left.
 template <int d>
 class ContactWorkspace;
-void resolveJointedInterpenetration(World<3>& world, ContactWorkspace<3>& ws, StepContext& ctx);
+template <int d>
+void resolveJointedInterpenetration(World<d>& world, ContactWorkspace<d>& ws, StepContext& ctx);
 
 // Step V, in velocity_contact before its sweeps (systems/joint_contacts.cpp; Sec. 4.7.1/4.7.3:
 // contacts as temporary joints in the constrained solve): the jointed bodies' velocities
 // projected onto their joints and their contacts together (normal rows, friction in the cone;
 // solvers::projectWithContacts), the other bodies held still with their own velocities. Before
 // the sweeps, since after them the contacts carry no normal impulse for friction to lean on.
-void postStabilizeWithContacts(World<3>& world, const ContactWorkspace<3>& ws, StepContext& ctx);
+template <int d>
+void postStabilizeWithContacts(World<d>& world, const ContactWorkspace<d>& ws, StepContext& ctx);
 
 // All the joint systems, sharing one velocity memory.
 template <int d>
