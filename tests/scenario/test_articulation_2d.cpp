@@ -6,6 +6,7 @@
 // predict, angle limits, checkpoints, and validation at JSON paths.
 #include <gtest/gtest.h>
 
+#include "support/oscillation.h"
 #include "support/resume_check.h"
 #include "support/scene_error.h"
 #include "support/scenes.h"
@@ -62,16 +63,16 @@ TEST(Articulation2d, PendulumPeriodMatchesTheClosedForm) {
   const double I = (1.0 / 12 * (1.0 + 0.0004) + 0.25) + (0.5 * 2 * 0.01 + 2.0);
   const double m = 3, d = (0.5 * 1 + 1.0 * 2) / 3;
   const double expected = 2 * kPi * std::sqrt(I / (m * kG * d));
-  std::vector<double> crossings;  // downward zero crossings of the angle
-  double previous = pendulumAngle(sim), tPrevious = 0, worst = 0;
+  std::vector<double> t{0.0}, angle{pendulumAngle(sim)};
+  double worst = 0;
   while (!sim.finished()) {
     worst = std::max(worst, sim.step().at("joint_error_max"));
-    const double a = pendulumAngle(sim);
-    if (previous > 0 && a <= 0) crossings.push_back(tPrevious + (sim.time() - tPrevious) * previous / (previous - a));
-    previous = a, tPrevious = sim.time();
+    t.push_back(sim.time());
+    angle.push_back(pendulumAngle(sim));
   }
-  ASSERT_GE(crossings.size(), 4u);
-  const double period = (crossings.back() - crossings.front()) / (crossings.size() - 1);
+  const test::Oscillation swing = test::analyseOscillation(t, angle, 0.0);
+  ASSERT_GE(swing.crossings, 4);
+  const double period = swing.period;
   std::cout << "[measured] pendulum_2d period " << period << " s, closed form " << expected << " s ("
             << 100 * (period / expected - 1) << " %), joint_error_max " << worst << " m\n";
   // 0.5 %: the bound; the 5 degree amplitude alone lengthens the period by 0.048 %.
