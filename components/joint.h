@@ -1,9 +1,9 @@
 #pragma once
-// Joint: one articulation joint between a parent and a child rigid body (3-D), in maximal
-// coordinates (thesis Sec. 4.4-4.7, App. C; Weinstein, Teran and Fedkiw 2006). The parent may
-// be "world". Each body carries a joint frame (a point and an orientation in the body's frame);
-// the joint type says which relative motions of the child's frame against the parent's are
-// allowed:
+// ArticulationJoint<d> (Joint in 3-D, Joint2 in 2-D): one articulation joint between a parent
+// and a child rigid body, in maximal coordinates (thesis Sec. 4.4-4.7, App. C; Weinstein, Teran
+// and Fedkiw 2006). The parent may be "world". Each body carries a joint frame (a point and an
+// orientation -- a quaternion in 3-D, an angle in 2-D -- in the body's frame); the joint type
+// says which relative motions of the child's frame against the parent's are allowed:
 //   fixed      none
 //   revolute   rotation about the frames' z axis (a hinge); optional PD drive of the angle
 //   spherical  any rotation about the common point
@@ -11,12 +11,17 @@
 //   universal  rotation about the parent frame's x axis and the child frame's y axis
 //   twist      rotation about and translation along the parent frame's z axis (the twist joint
 //              of Fig. 4.5; PhysBAM's prismatic twist joint, here with a free slide)
+// In 2-D (three DOFs a body) only fixed, revolute (a pin: rotation in the plane) and prismatic
+// (translation along the parent frame's x axis) exist; the solvers see a 2-D joint as the 3-D
+// joint of the plane with its out-of-plane rows dropped (systems/joint_assembly.h).
 // Bodies are named, not held as entity handles: the names survive checkpoints as they are.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cmath>
 #include <string>
 #include <vector>
+
+#include "components/rigid_body.h"
 
 namespace monolith {
 
@@ -39,16 +44,18 @@ inline const char* jointTypeName(JointType t) {
 // and held outside their span.
 enum class PdTarget : int { None = 0, Constant, Sinusoid, Keyframes };
 
-struct Joint {
+template <int d>
+struct ArticulationJoint {
   static constexpr const char* kName = "joint";
+  using VecD = Eigen::Matrix<double, d, 1>;
 
   JointType type = JointType::Spherical;
   std::string parent = "world";  // entity name, or "world"
   std::string child;             // entity name
-  Eigen::Vector3d parentAnchor = Eigen::Vector3d::Zero();  // in the parent's body frame (world frame for "world")
-  Eigen::Vector3d childAnchor = Eigen::Vector3d::Zero();   // in the child's body frame
-  Eigen::Quaterniond parentFrame = Eigen::Quaterniond::Identity();  // joint frame orientation on the parent
-  Eigen::Quaterniond childFrame = Eigen::Quaterniond::Identity();   // ... on the child
+  VecD parentAnchor = VecD::Zero();  // in the parent's body frame (world frame for "world")
+  VecD childAnchor = VecD::Zero();   // in the child's body frame
+  Orientation<d> parentFrame = RigidBody<d>::identityOrientation();  // joint frame orientation on the parent
+  Orientation<d> childFrame = RigidBody<d>::identityOrientation();   // ... on the child
 
   // Angle limits of a revolute joint (rad, lower < upper): a one-sided row about the hinge,
   // active while the joint is at or past a limit and moving (or predicted) further out.
@@ -63,9 +70,10 @@ struct Joint {
   std::vector<double> keyTimes, keyAngles;
 
   // Scene input given in the world frame at the initial poses ("anchor", "axis"), turned into
-  // the body-frame fields above when the scene is loaded; not state.
+  // the body-frame fields above when the scene is loaded; not state. The axis is the frames' z
+  // in 3-D, their x (a prismatic joint's slide) in 2-D.
   bool anchorInWorld = false, axisInWorld = false;
-  Eigen::Vector3d worldAnchor = Eigen::Vector3d::Zero(), worldAxis = Eigen::Vector3d::UnitZ();
+  VecD worldAnchor = VecD::Zero(), worldAxis = VecD::Unit(d == 3 ? 2 : 0);
 
   template <class V>
   void visitFields(V& visit) {
@@ -134,7 +142,11 @@ struct ArticulationSolver {
   }
 };
 
-inline void Joint::targetAt(double t, double& angle, double& rate) const {
+using Joint = ArticulationJoint<3>;
+using Joint2 = ArticulationJoint<2>;
+
+template <int d>
+inline void ArticulationJoint<d>::targetAt(double t, double& angle, double& rate) const {
   angle = 0;
   rate = 0;
   switch (pd) {

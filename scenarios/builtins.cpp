@@ -166,7 +166,7 @@ void registerDimension(Registry& r) {
   r.addComponentOf<d, RigidForces<d>>("(internal) force/torque accumulator of a dynamic rigid body", nullptr);
   registerContactComponents<d>(r);
   registerFluidComponents<d>(r);
-  if constexpr (d == 3) registerJointComponents(r);
+  registerJointComponents<d>(r);
   registerSurfaceTensionComponents<d>(r);
   registerDeformableComponents<d>(r);
   if constexpr (d == 3) registerClothComponents(r);
@@ -191,24 +191,20 @@ void registerDimension(Registry& r) {
                   [] { return single<RigidHalfKick<d>>(Stage::AdvanceVelocity); }, ""});
   r.addSystem<d>({"advance_kinematic_positions", "Step IV for kinematic bodies: x += dt v, R = exp(dt w) R",
                   [] { return single<AdvanceKinematicPositions<d>>(); }, ""});
-  if constexpr (d == 3) {
-    // Before rigid_contact: PD is Step III.2, ahead of contact (III.3).
-    r.addSystem<d>({"joint_pd_control", "Step III.2 (Sec. 4.5): PD drive of revolute joints as impulses",
-                    [] { return single<JointPdControl>(); }, ""});
-  }
+  // Before rigid_contact: PD is Step III.2, ahead of contact (III.3).
+  r.addSystem<d>({"joint_pd_control", "Step III.2 (Sec. 4.5): PD drive of revolute joints as impulses",
+                  [] { return single<JointPdControl<d>>(); }, ""});
   registerParticleCollisionSystems<d>(r);
   r.addSystem<d>({"rigid_contact",
                   "Steps II-V contact (Sec. 4.4-4.7, App. B): collisions, contact, shock_propagation, "
                   "resolve_interpenetration, velocity_contact",
                   [] { return makeRigidContactSystems<d>(); }, ""});
-  if constexpr (d == 3) {
-    // After rigid_contact: each runs after the contact system of its stage.
-    r.addSystem<d>({"joint_stages",
-                    "joint stages (Sec. 4.4-4.7, App. C): post-stabilization at Steps II, IV and V, "
-                    "pre-stabilization at Step III, joint diagnostics",
-                    [] { return makeJointSystems(); },
-                    ""});
-  }
+  // After rigid_contact: each runs after the contact system of its stage.
+  r.addSystem<d>({"joint_stages",
+                  "joint stages (Sec. 4.4-4.7, App. C): post-stabilization at Steps II, IV and V, "
+                  "pre-stabilization at Step III, joint diagnostics",
+                  [] { return makeJointSystems<d>(); },
+                  ""});
   r.addSystem<d>({"advect_fluid", "fluid advection u* = u - dt (u.grad)u (semi-Lagrangian, MacCormack, ENO3 or WENO5 with RK3)",
                   [] { return single<FluidAdvection<d>>(); }, ""});
   r.addSystem<d>({"fluid_gravity", "gravity on the fluid's free faces", [] { return single<FluidGravity<d>>(); }, ""});

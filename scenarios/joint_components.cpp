@@ -9,6 +9,7 @@
 #include "components/rigid_body.h"
 #include "ecs/config.h"
 #include "solvers/articulation/joint_constraints.h"
+#include "systems/joint_assembly.h"
 
 namespace monolith {
 
@@ -26,12 +27,19 @@ Eigen::Quaterniond quaternionAt(const Config& c, const std::string& key) {
   return Eigen::Quaterniond(q(0), q(1), q(2), q(3)).normalized();
 }
 
-void parseFrame(const Config& c, Eigen::Vector3d& position, Eigen::Quaterniond& orientation) {
-  position = c.vector("position", Eigen::VectorXd::Zero(3));
-  if (c.has("orientation")) orientation = quaternionAt(c, "orientation");
+// A joint frame in a body's frame: position and orientation (3-D, a quaternion) or angle (2-D).
+template <int d>
+void parseFrame(const Config& c, Eigen::Matrix<double, d, 1>& position, Orientation<d>& orientation) {
+  position = c.vector("position", Eigen::VectorXd::Zero(d));
+  if constexpr (d == 3) {
+    if (c.has("orientation")) orientation = quaternionAt(c, "orientation");
+  } else {
+    orientation = c.number("angle", 0.0);
+  }
 }
 
-void parsePd(const Config& c, Joint& j) {
+template <int d>
+void parsePd(const Config& c, ArticulationJoint<d>& j) {
   j.kp = c.number("kp", Bound::NonNegative);
   j.kd = c.number("kd", 0.0, Bound::NonNegative);
   const Json& target = c.raw()["target"];
@@ -57,7 +65,8 @@ void parsePd(const Config& c, Joint& j) {
   t.finish();
 }
 
-void parseKeyframes(const Config& t, Joint& j) {
+template <int d>
+void parseKeyframes(const Config& t, ArticulationJoint<d>& j) {
   const Json& raw = t.raw()["keyframes"];
   const std::string path = t.pathOf("keyframes");
   if (!raw.is_array() || raw.empty())
@@ -76,10 +85,24 @@ void parseKeyframes(const Config& t, Joint& j) {
   j.pd = PdTarget::Keyframes;
 }
 
-void parseJoint(World<3>& world, Entity e, const Config& c) {
-  Joint j;
-  const std::string type = c.oneOf("type", {"fixed", "revolute", "spherical", "prismatic", "universal", "twist"}, "");
-  if (type.empty()) c.failAt("type", "one of fixed, revolute, spherical, prismatic, universal, twist", "none");
+// The joint types of a dimension: all six in 3-D; in 2-D (three DOFs a body) fixed, revolute
+// (a pin) and prismatic.
+template <int d>
+std::vector<std::string> jointTypes() {
+  if constexpr (d == 3) return {"fixed", "revolute", "spherical", "prismatic", "universal", "twist"};
+  else return {"fixed", "revolute", "prismatic"};
+}
+
+template <int d>
+void parseJoint(World<d>& world, Entity e, const Config& c) {
+  ArticulationJoint<d> j;
+  const std::vector<std::string> types = jointTypes<d>();
+  const std::string type = c.oneOf("type", types, "");
+  if (type.empty()) {
+    std::string list;
+    for (const auto& t : types) list += (list.empty() ? "" : ", ") + t;
+    c.failAt("type", "one of " + list, "none");
+  }
   j.type = type == "fixed"       ? JointType::Fixed
            : type == "revolute"  ? JointType::Revolute
            : type == "spherical" ? JointType::Spherical
@@ -108,14 +131,17 @@ void parseJoint(World<3>& world, Entity e, const Config& c) {
     if (!c.has("anchor"))
       c.failAt("anchor", "the joint's world point at the initial poses, or parent_frame and child_frame", "none");
     j.anchorInWorld = true;
-    j.worldAnchor = c.vector("anchor", 3);
+    j.worldAnchor = c.vector("anchor", d);
+    // In 2-D a pin turns about z whatever its frames; only the slide needs a direction.
+    const bool axisNeeded = d == 3 ? j.type == JointType::Revolute || j.type == JointType::Prismatic ||
+                                         j.type == JointType::Universal || j.type == JointType::Twist
+                                   : j.type == JointType::Prismatic;
     if (c.has("axis")) {
       j.axisInWorld = true;
-      j.worldAxis = c.vector("axis", 3);
+      j.worldAxis = c.vector("axis", d);
       if (!(j.worldAxis.norm() > 1e-12)) c.failAt("axis", "a non-zero direction", "a zero vector");
       j.worldAxis.normalize();
-    } else if (j.type == JointType::Revolute || j.type == JointType::Prismatic || j.type == JointType::Universal ||
-               j.type == JointType::Twist) {
+    } else if (axisNeeded) {
       c.failAt("axis", std::string("the ") + type + " joint's axis (a world direction)", "none");
     } else {
       j.axisInWorld = true;  // frames aligned with the world at the initial poses
@@ -149,7 +175,8 @@ void parseJoint(World<3>& world, Entity e, const Config& c) {
   world.add(e, j);
 }
 
-void parseArticulation(World<3>& world, Entity e, const Config& c) {
+template <int d>
+void parseArticulation(World<d>& world, Entity e, const Config& c) {
   ArticulationSolver s;
   auto method = [&](const char* key) {
     return c.oneOf(key, {"pairwise", "global"}, "pairwise") == "global" ? ArticulationSolver::Method::Global
@@ -180,7 +207,8 @@ struct Groups {
 // planar ring of hinges with parallel axes, a spherical joint closing a rigid ring): the
 // Newton of pre-stabilization then asks for corrections no impulse can give, and the global
 // form (App. C.2) diverges. Checked on the rows at the initial poses.
-void refuseRedundantLoops(World<3>& world, const std::string& file, const std::vector<Entity>& created) {
+template <int d>
+void refuseRedundantLoops(World<d>& world, const std::string& file, const std::vector<Entity>& created) {
   std::vector<solvers::ConstraintBody> bodies(1);  // 0: the world
   std::map<std::uint32_t, int> index;
   std::vector<solvers::JointDefinition> joints;
@@ -190,32 +218,24 @@ void refuseRedundantLoops(World<3>& world, const std::string& file, const std::v
     const Entity e = *world.find(name);
     const auto [it, inserted] = index.emplace(e.index, static_cast<int>(bodies.size()));
     if (inserted) {
-      const RigidBody<3>& b = *world.get<RigidBody<3>>(e);
-      solvers::ConstraintBody c;
-      c.x = b.x;
-      c.q = b.orientation;
-      if (!b.isStatic && !world.get<KinematicMotion<3>>(e)) c.invMass = 1 / b.mass;
-      bodies.push_back(c);
+      const RigidBody<d>& b = *world.template get<RigidBody<d>>(e);
+      bodies.push_back(constraintBody<d>(b, !b.isStatic && !world.template get<KinematicMotion<d>>(e)));
     }
     return it->second;
   };
   for (std::size_t i = 0; i < created.size(); ++i) {
-    const Joint* j = world.get<Joint>(created[i]);
+    const ArticulationJoint<d>* j = world.template get<ArticulationJoint<d>>(created[i]);
     if (!j) continue;
-    solvers::JointDefinition d;
-    d.type = static_cast<solvers::JointKind>(j->type);
-    d.parent = bodyOf(j->parent);
-    d.child = bodyOf(j->child);
-    d.parentAnchor = j->parentAnchor;
-    d.childAnchor = j->childAnchor;
-    d.parentFrame = j->parentFrame;
-    d.childFrame = j->childFrame;
-    joints.push_back(d);
+    solvers::JointDefinition def = jointDefinition<d>(*j);
+    def.limited = false;
+    def.parent = bodyOf(j->parent);
+    def.child = bodyOf(j->child);
+    joints.push_back(def);
     entityOf.push_back(i);
   }
   const solvers::RedundantJoint r = solvers::firstRedundantJoint(joints, bodies);
   if (r.joint < 0) return;
-  const Joint& j = *world.get<Joint>(created[entityOf[r.joint]]);
+  const ArticulationJoint<d>& j = *world.template get<ArticulationJoint<d>>(created[entityOf[r.joint]]);
   throw SceneError(file, "entities[" + std::to_string(entityOf[r.joint]) + "].joint",
                    "a joint whose rows the loop it closes does not already impose (such a loop over-constrains its bodies)",
                    "a " + std::string(jointTypeName(j.type)) + " joint between \"" + j.parent + "\" and \"" + j.child +
@@ -224,62 +244,85 @@ void refuseRedundantLoops(World<3>& world, const std::string& file, const std::v
 
 }  // namespace
 
+template <int d>
 void registerJointComponents(Registry& r) {
-  r.addComponentOf<3, Joint>(
-      "articulation joint: type (fixed, revolute, spherical, prismatic, universal, twist), parent (entity or \"world\"), "
-      "child (default: this entity), anchor + axis (world, at the initial poses) or parent_frame/child_frame "
-      "{position, orientation}; limits [lower, upper] and pd {kp, kd, target} on revolute joints",
-      parseJoint);
-  r.addComponentOf<3, ArticulationSolver>(
+  r.addComponentOf<d, ArticulationJoint<d>>(
+      d == 3 ? "articulation joint: type (fixed, revolute, spherical, prismatic, universal, twist), parent (entity or "
+               "\"world\"), child (default: this entity), anchor + axis (world, at the initial poses) or "
+               "parent_frame/child_frame {position, orientation}; limits [lower, upper] and pd {kp, kd, target} on "
+               "revolute joints"
+             : "articulation joint of the plane: type (fixed, revolute (a pin), prismatic (slides along axis)), parent "
+               "(entity or \"world\"), child (default: this entity), anchor + axis (world, at the initial poses) or "
+               "parent_frame/child_frame {position, angle}; limits [lower, upper] and pd {kp, kd, target} on revolute "
+               "joints",
+      parseJoint<d>);
+  r.addComponentOf<d, ArticulationSolver>(
       "how the scene's joints are solved (one per scene): post_stabilization/pre_stabilization \"pairwise\" or "
       "\"global\", pre_stabilize, post_iterations, post_tolerance, pre_iterations, pre_tolerance, contact_rounds, "
       "push_out_contact_sweeps, push_out_contact_passes",
-      parseArticulation);
+      parseArticulation<d>);
 }
 
-void resolveJoints(World<3>& world, const std::string& file, const std::vector<Entity>& created) {
+namespace {
+
+// A world point as a point in a body's frame (pose x, orientation q).
+Eigen::Vector3d toBodyFrame(const Eigen::Vector3d& p, const Eigen::Vector3d& x, const Eigen::Quaterniond& q) {
+  return q.conjugate() * (p - x);
+}
+Eigen::Vector2d toBodyFrame(const Eigen::Vector2d& p, const Eigen::Vector2d& x, double angle) {
+  return Eigen::Rotation2Dd(-angle) * (p - x);
+}
+// A joint frame in a body's frame whose z (3-D) or x (2-D) is the world axis.
+Eigen::Quaterniond frameAlong(const Eigen::Vector3d& axis, const Eigen::Quaterniond& q) {
+  return (q.conjugate() * Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis)).normalized();
+}
+double frameAlong(const Eigen::Vector2d& axis, double angle) { return std::atan2(axis.y(), axis.x()) - angle; }
+
+}  // namespace
+
+template <int d>
+void resolveJoints(World<d>& world, const std::string& file, const std::vector<Entity>& created) {
   std::map<std::uint32_t, int> bodyIndex;  // entity index -> union-find node (0: immovable)
   Groups groups{{0}};
   bool settingsSeen = false;
   for (std::size_t i = 0; i < created.size(); ++i) {
     const std::string at = "entities[" + std::to_string(i) + "]";
-    if (world.get<ArticulationSolver>(created[i])) {
+    if (world.template get<ArticulationSolver>(created[i])) {
       if (settingsSeen)
         throw SceneError(file, at + ".articulation", "one \"articulation\" component in the scene", "a second one");
       settingsSeen = true;
     }
-    Joint* j = world.get<Joint>(created[i]);
+    ArticulationJoint<d>* j = world.template get<ArticulationJoint<d>>(created[i]);
     if (!j) continue;
     const std::string path = at + ".joint";
-    auto body = [&](const std::string& name, const char* key) -> RigidBody<3>* {
+    auto body = [&](const std::string& name, const char* key) -> RigidBody<d>* {
       if (name == "world") return nullptr;
       const auto e = world.find(name);
-      RigidBody<3>* b = e ? world.get<RigidBody<3>>(*e) : nullptr;
+      RigidBody<d>* b = e ? world.template get<RigidBody<d>>(*e) : nullptr;
       if (!b)
         throw SceneError(file, path + "." + key, "the name of an entity with a rigid_body, or \"world\"",
                          "\"" + name + "\"" + (e ? " (no rigid_body)" : " (no such entity)"));
       return b;
     };
-    RigidBody<3>* parent = body(j->parent, "parent");
-    RigidBody<3>* child = body(j->child, "child");
-    auto immovable = [&](const std::string& name, const RigidBody<3>* b) {
-      return !b || b->isStatic || world.get<KinematicMotion<3>>(*world.find(name));
+    RigidBody<d>* parent = body(j->parent, "parent");
+    RigidBody<d>* child = body(j->child, "child");
+    auto immovable = [&](const std::string& name, const RigidBody<d>* b) {
+      return !b || b->isStatic || world.template get<KinematicMotion<d>>(*world.find(name));
     };
     if (immovable(j->parent, parent) && immovable(j->child, child))
       throw SceneError(file, path, "a joint with at least one dynamic body",
                        "\"" + j->parent + "\" and \"" + j->child + "\", neither of which can move");
 
-    const Eigen::Vector3d xp = parent ? parent->x : Eigen::Vector3d::Zero();
-    const Eigen::Quaterniond qp = parent ? parent->orientation : Eigen::Quaterniond::Identity();
+    const Eigen::Matrix<double, d, 1> xp = parent ? parent->x : Eigen::Matrix<double, d, 1>::Zero();
+    const Orientation<d> qp = parent ? parent->orientation : RigidBody<d>::identityOrientation();
     if (j->anchorInWorld) {
-      j->parentAnchor = qp.conjugate() * (j->worldAnchor - xp);
-      j->childAnchor = child->orientation.conjugate() * (j->worldAnchor - child->x);
+      j->parentAnchor = toBodyFrame(j->worldAnchor, xp, qp);
+      j->childAnchor = toBodyFrame(j->worldAnchor, child->x, child->orientation);
       j->anchorInWorld = false;
     }
     if (j->axisInWorld) {
-      const Eigen::Quaterniond world = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), j->worldAxis);
-      j->parentFrame = (qp.conjugate() * world).normalized();
-      j->childFrame = (child->orientation.conjugate() * world).normalized();
+      j->parentFrame = frameAlong(j->worldAxis, qp);
+      j->childFrame = frameAlong(j->worldAxis, child->orientation);
       j->axisInWorld = false;
     }
 
@@ -303,5 +346,10 @@ void resolveJoints(World<3>& world, const std::string& file, const std::vector<E
   }
   refuseRedundantLoops(world, file, created);
 }
+
+template void registerJointComponents<2>(Registry&);
+template void registerJointComponents<3>(Registry&);
+template void resolveJoints<2>(World<2>&, const std::string&, const std::vector<Entity>&);
+template void resolveJoints<3>(World<3>&, const std::string&, const std::vector<Entity>&);
 
 }  // namespace monolith

@@ -1,6 +1,6 @@
 #pragma once
 // Scene parsers of the articulation components (components/joint.h): "joint" and
-// "articulation", 3-D only.
+// "articulation", in 3-D and (fixed, revolute and prismatic joints) in 2-D.
 #include <string>
 #include <vector>
 
@@ -8,6 +8,7 @@
 
 namespace monolith {
 
+template <int d>
 void registerJointComponents(Registry& registry);
 
 // After all entities of a scene exist: resolves the joints' body names, turns world-frame
@@ -15,6 +16,7 @@ void registerJointComponents(Registry& registry);
 // between two bodies that cannot move, a second "articulation" component and loops of fixed
 // joints (they over-constrain), each at its JSON path (entities[i]...). `created` are the
 // scene's entities in file order.
-void resolveJoints(World<3>& world, const std::string& file, const std::vector<Entity>& created);
+template <int d>
+void resolveJoints(World<d>& world, const std::string& file, const std::vector<Entity>& created);
 
 }  // namespace monolith

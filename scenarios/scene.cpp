@@ -543,7 +543,7 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
         config.finish();
       }
     }
-    if constexpr (d == 3) resolveJoints(world, scene.file, created);
+    resolveJoints<d>(world, scene.file, created);
     // A body's sleep state needs the scene's sleeping on; a fluid obstacle never sleeps (the
     // fluid's forces on it change while it rests).
     for (std::size_t i = 0; i < created.size(); ++i) {

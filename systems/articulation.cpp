@@ -15,24 +15,30 @@
 namespace monolith {
 
 
-ArticulationSolver articulationSettings(const World<3>& world) {
-  const auto* pool = world.findPool<ArticulationSolver>();
+template <int d>
+ArticulationSolver articulationSettings(const World<d>& world) {
+  const auto* pool = world.template findPool<ArticulationSolver>();
   return pool && pool->size() > 0 ? pool->components()[0] : ArticulationSolver{};
 }
 
-std::vector<std::string> JointSystem::reads() const {
-  return {Joint::kName, ArticulationSolver::kName, KinematicMotion<3>::kName, Sleep<3>::kName};
+template <int d>
+std::vector<std::string> JointSystem<d>::reads() const {
+  return {ArticulationJoint<d>::kName, ArticulationSolver::kName, KinematicMotion<d>::kName, Sleep<d>::kName};
 }
-std::vector<std::string> JointSystem::writes() const { return {RigidBody<3>::kName}; }
+template <int d>
+std::vector<std::string> JointSystem<d>::writes() const {
+  return {RigidBody<d>::kName};
+}
 
 namespace {
 
 // PD drive of the revolute joints with a target (Step III.2): an angular impulse about the
 // hinge, dt (kp (a* - a) + kd (a*' - a')), on the child and its opposite on the parent.
-void applyPd(JointAssembly& a, double t, double dt) {
+template <int d>
+void applyPd(JointAssembly<d>& a, double t, double dt) {
   constexpr double kPi = 3.14159265358979323846;
   for (std::size_t k = 0; k < a.joints.size(); ++k) {
-    const Joint& joint = *a.components[k];
+    const ArticulationJoint<d>& joint = *a.components[k];
     if (joint.pd == PdTarget::None) continue;
     const auto& def = a.joints[k];
     auto& P = a.bodies[def.parent];
@@ -51,16 +57,18 @@ void applyPd(JointAssembly& a, double t, double dt) {
   }
 }
 
-bool anyPd(const World<3>& w) {
-  const auto* pool = w.findPool<Joint>();
+template <int d>
+bool anyPd(const World<d>& w) {
+  const auto* pool = w.template findPool<ArticulationJoint<d>>();
   if (!pool) return false;
-  for (const Joint& j : pool->components())
+  for (const ArticulationJoint<d>& j : pool->components())
     if (j.pd != PdTarget::None) return true;
   return false;
 }
 
 // Post-stabilization proper: the mass-weighted projection of the velocities onto the joints.
-void project(JointAssembly& a, const ArticulationSolver& s, StepContext& ctx) {
+template <int d>
+void project(JointAssembly<d>& a, const ArticulationSolver& s, StepContext& ctx) {
   const auto rows = a.rows();
   const std::vector<solvers::Vector6d> zero(rows.size(), solvers::Vector6d::Zero());
   const solvers::ProjectionReport r =
@@ -74,12 +82,14 @@ void project(JointAssembly& a, const ArticulationSolver& s, StepContext& ctx) {
 
 }  // namespace
 
-void postStabilizeJointVelocities(World<3>& world, StepContext& ctx) {
-  JointAssembly a(world);
+template <int d>
+void postStabilizeJointVelocities(World<d>& world, StepContext& ctx) {
+  JointAssembly<d> a(world);
   project(a, articulationSettings(world), ctx);
 }
 
-std::string PostStabilizeJoints::name() const {
+template <int d>
+std::string PostStabilizeJoints<d>::name() const {
   switch (place_) {
     case Place::AfterCollisions: return "post_stabilize_collisions";
     case Place::AfterPositions: return "post_stabilize_positions";
@@ -88,7 +98,8 @@ std::string PostStabilizeJoints::name() const {
   return "?";
 }
 
-Stage PostStabilizeJoints::stage() const {
+template <int d>
+Stage PostStabilizeJoints<d>::stage() const {
   switch (place_) {
     case Place::AfterCollisions: return Stage::Collisions;
     case Place::AfterPositions: return Stage::AdvancePositions;
@@ -97,16 +108,17 @@ Stage PostStabilizeJoints::stage() const {
   return Stage::Count;
 }
 
-void PostStabilizeJoints::run(World<3>& world, StepContext& ctx) {
+template <int d>
+void PostStabilizeJoints<d>::run(World<d>& world, StepContext& ctx) {
   const ArticulationSolver s = articulationSettings(world);
   if (place_ == Place::AfterPositions && !memory_->entity.empty()) {
     for (std::size_t i = 0; i < memory_->entity.size(); ++i) {
-      RigidBody<3>* b = world.get<RigidBody<3>>(memory_->entity[i]);
+      RigidBody<d>* b = world.template get<RigidBody<d>>(memory_->entity[i]);
       b->v = memory_->v[i];
       b->L = memory_->L[i];
     }
   }
-  JointAssembly a(world);
+  JointAssembly<d> a(world);
   if (place_ == Place::AfterVelocities) applyPd(a, ctx.time + 0.5 * ctx.dt, ctx.dt);
   project(a, s, ctx);
   if (place_ == Place::AfterCollisions) {
@@ -120,49 +132,60 @@ void PostStabilizeJoints::run(World<3>& world, StepContext& ctx) {
   }
 }
 
-bool JointPdControl::needed(const World<3>& w) const { return anyPd(w); }
+template <int d>
+bool JointPdControl<d>::needed(const World<d>& w) const {
+  return anyPd(w);
+}
 
-void JointPdControl::run(World<3>& world, StepContext& ctx) {
-  JointAssembly a(world);
+template <int d>
+void JointPdControl<d>::run(World<d>& world, StepContext& ctx) {
+  JointAssembly<d> a(world);
   applyPd(a, ctx.time + 0.5 * ctx.dt, ctx.dt);
   a.writeBack();
 }
 
-std::vector<std::unique_ptr<System<3>>> makeJointSystems() {
-  auto memory = std::make_shared<JointVelocityMemory>();
-  using Place = PostStabilizeJoints::Place;
-  std::vector<std::unique_ptr<System<3>>> v;
-  v.push_back(std::make_unique<PostStabilizeJoints>(Place::AfterCollisions, memory));
-  v.push_back(std::make_unique<PreStabilizeJoints>());
-  v.push_back(std::make_unique<PostStabilizeJoints>(Place::AfterPositions, memory));
-  v.push_back(std::make_unique<PostStabilizeJoints>(Place::AfterVelocities, memory));
-  v.push_back(std::make_unique<JointDiagnostics>());
+template <int d>
+std::vector<std::unique_ptr<System<d>>> makeJointSystems() {
+  auto memory = std::make_shared<JointVelocityMemory<d>>();
+  using Place = typename PostStabilizeJoints<d>::Place;
+  std::vector<std::unique_ptr<System<d>>> v;
+  v.push_back(std::make_unique<PostStabilizeJoints<d>>(Place::AfterCollisions, memory));
+  v.push_back(std::make_unique<PreStabilizeJoints<d>>());
+  v.push_back(std::make_unique<PostStabilizeJoints<d>>(Place::AfterPositions, memory));
+  v.push_back(std::make_unique<PostStabilizeJoints<d>>(Place::AfterVelocities, memory));
+  v.push_back(std::make_unique<JointDiagnostics<d>>());
   return v;
 }
 
-bool PreStabilizeJoints::needed(const World<3>& w) const {
-  return JointSystem::needed(w) && articulationSettings(w).preStabilization;
+template <int d>
+bool PreStabilizeJoints<d>::needed(const World<d>& w) const {
+  return JointSystem<d>::needed(w) && articulationSettings(w).preStabilization;
 }
 
-void PreStabilizeJoints::run(World<3>& world, StepContext& ctx) {
+template <int d>
+void PreStabilizeJoints<d>::run(World<d>& world, StepContext& ctx) {
   // With colliders and contact rounds, contact ran pre-stabilization between its sweeps.
-  if (world.count<Collider<3>>() > 0 && articulationSettings(world).contactRounds > 0) return;
+  if (jointContactRounds(world) > 0 && world.template count<Collider<d>>() > 0) return;
   preStabilizeJointVelocities(world, ctx);
 }
 
-int jointContactRounds(const World<3>& world) {
-  return world.count<Joint>() > 0 && articulationSettings(world).preStabilization ? articulationSettings(world).contactRounds
-                                                                                     : 0;
+template <int d>
+int jointContactRounds(const World<d>& world) {
+  return world.template count<ArticulationJoint<d>>() > 0 && articulationSettings(world).preStabilization
+             ? articulationSettings(world).contactRounds
+             : 0;
 }
 
-void preStabilizeJointVelocities(World<3>& world, StepContext& ctx) {
+template <int d>
+void preStabilizeJointVelocities(World<d>& world, StepContext& ctx) {
   const ArticulationSolver s = articulationSettings(world);
-  JointAssembly a(world);
+  JointAssembly<d> a(world);
   const double dt = ctx.dt;
   const RigidRotationSettings rule = world.settings().rigidRotation;
   std::vector<solvers::BodyInertia> inertia(a.bodies.size());
-  for (std::size_t i = 1; i < a.bodies.size(); ++i)
-    if (a.bodies[i].invMass > 0) inertia[i] = bodyInertia(*a.rigid[i]);
+  if constexpr (d == 3)
+    for (std::size_t i = 1; i < a.bodies.size(); ++i)
+      if (a.bodies[i].invMass > 0) inertia[i] = bodyInertia(*a.rigid[i]);
   // Exactly what Step IV will do with these velocities (advance_positions.cpp,
   // kinematic_motion.cpp), so that the joints close on the poses the step ends at.
   const solvers::PosePredictor predict = [&](int i, const solvers::ConstraintBody& b, Eigen::Vector3d& x,
@@ -180,10 +203,15 @@ void preStabilizeJointVelocities(World<3>& world, StepContext& ctx) {
       x = b.x;
       return;
     }
-    const Eigen::Vector3d L = a.rigid[i]->L + b.angularImpulse;
-    const double energyBefore = solvers::rotationalKineticEnergy(inertia[i], b.q, L);
-    q = solvers::advanceOrientation(static_cast<solvers::RotationOrder>(rule.order), dt, inertia[i], b.q, L);
-    if (rule.energyFix) solvers::correctOrientationForKineticEnergy(q, inertia[i], L, energyBefore);
+    if constexpr (d == 2) {  // the angle advances by dt w (advance_positions.cpp)
+      const double angle = a.rigid[i]->orientation + dt * b.w.z();
+      q = Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()));
+    } else {
+      const Eigen::Vector3d L = a.rigid[i]->L + b.angularImpulse;
+      const double energyBefore = solvers::rotationalKineticEnergy(inertia[i], b.q, L);
+      q = solvers::advanceOrientation(static_cast<solvers::RotationOrder>(rule.order), dt, inertia[i], b.q, L);
+      if (rule.energyFix) solvers::correctOrientationForKineticEnergy(q, inertia[i], L, energyBefore);
+    }
   };
   const solvers::PreStabilizationReport r =
       solvers::preStabilize(a.joints, a.bodies, predict, dt, s.pre == ArticulationSolver::Method::Global,
@@ -193,8 +221,9 @@ void preStabilizeJointVelocities(World<3>& world, StepContext& ctx) {
   ctx.diagnostics.max("joint_pre_error_left", r.errorAfter);
 }
 
-void JointDiagnostics::run(World<3>& world, StepContext& ctx) {
-  JointAssembly a(world);
+template <int d>
+void JointDiagnostics<d>::run(World<d>& world, StepContext& ctx) {
+  JointAssembly<d> a(world);
   double position = 0, angle = 0, velocity = 0;
   for (const auto& def : a.joints) {
     const auto& P = a.bodies[def.parent];
@@ -209,5 +238,20 @@ void JointDiagnostics::run(World<3>& world, StepContext& ctx) {
   ctx.diagnostics.set("joint_angle_error_max", angle);
   ctx.diagnostics.set("joint_velocity_error_max", velocity);
 }
+
+#define MONOLITH_JOINT_STAGES(d)                                                          \
+  template class JointSystem<d>;                                                         \
+  template class PostStabilizeJoints<d>;                                                 \
+  template class JointPdControl<d>;                                                      \
+  template class PreStabilizeJoints<d>;                                                  \
+  template class JointDiagnostics<d>;                                                    \
+  template ArticulationSolver articulationSettings<d>(const World<d>&);                  \
+  template void preStabilizeJointVelocities<d>(World<d>&, StepContext&);                 \
+  template void postStabilizeJointVelocities<d>(World<d>&, StepContext&);                \
+  template int jointContactRounds<d>(const World<d>&);                                   \
+  template std::vector<std::unique_ptr<System<d>>> makeJointSystems<d>();
+MONOLITH_JOINT_STAGES(2)
+MONOLITH_JOINT_STAGES(3)
+#undef MONOLITH_JOINT_STAGES
 
 }  // namespace monolith

@@ -18,8 +18,7 @@ void Contact<d>::run(World<d>& world, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (ws.bodies.empty()) return;
   // Joint post-stabilization (Step II.2) and PD (Step III.2) ran since collisions unpacked.
-  if constexpr (d == 3)
-    if (world.template count<Joint>() > 0) ws.reloadVelocities();
+  if (world.template count<ArticulationJoint<d>>() > 0) ws.reloadVelocities();
   ws.updateAllCandidates();
   std::vector<int> impulses(ws.islands.members.size(), 0);
   ws.forEachIsland(
@@ -28,28 +27,27 @@ void Contact<d>::run(World<d>& world, StepContext& ctx) {
   // Joints (systems/articulation.h): rounds of pre-stabilization, then contact again, so that
   // contact has the last word and the joints close on what it leaves (Sec. 4.5).
   std::vector<std::pair<double, std::array<double, 3>>> stageSums;
-  if constexpr (d == 3)
-    for (int round = 0, rounds = jointContactRounds(world); round < rounds; ++round) {
-      preStabilizeJointVelocities(world, ctx);
-      ws.reloadVelocities();
-      ws.updateAllCandidates();
-      // The rounds' sweeps go on with Step III's stage: its sums (ContactPairState::stageNormal)
-      // keep the first sweeps' impulses, which carry the bodies' weight, so that shock
-      // propagation's friction leans on them (contactSweeps starts the sums anew). Leaning on
-      // the last round's alone, shock propagation let the limbs of a resting ragdoll pile roll
-      // and slide by 1.8 cm a second (4 ragdolls, 3-4 s), 1.2 cm with the whole stage.
-      stageSums.assign(ws.pairs.size(), {});
-      for (std::size_t k = 0; k < ws.pairs.size(); ++k)
-        stageSums[k] = {ws.pairs[k].stageNormal, ws.pairs[k].stageFriction};
-      ws.forEachIsland([&](int island) {
-        impulses[island] += ws.contactSweeps(island, ImpulseMode::Contact, false, nullptr, nullptr);
-      });
-      for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
-        ws.pairs[k].stageNormal += stageSums[k].first;
-        for (int c = 0; c < 3; ++c) ws.pairs[k].stageFriction[c] += stageSums[k].second[c];
-      }
-      ws.unpack(false);
+  for (int round = 0, rounds = jointContactRounds(world); round < rounds; ++round) {
+    preStabilizeJointVelocities(world, ctx);
+    ws.reloadVelocities();
+    ws.updateAllCandidates();
+    // The rounds' sweeps go on with Step III's stage: its sums (ContactPairState::stageNormal)
+    // keep the first sweeps' impulses, which carry the bodies' weight, so that shock
+    // propagation's friction leans on them (contactSweeps starts the sums anew). Leaning on
+    // the last round's alone, shock propagation let the limbs of a resting ragdoll pile roll
+    // and slide by 1.8 cm a second (4 ragdolls, 3-4 s), 1.2 cm with the whole stage.
+    stageSums.assign(ws.pairs.size(), {});
+    for (std::size_t k = 0; k < ws.pairs.size(); ++k)
+      stageSums[k] = {ws.pairs[k].stageNormal, ws.pairs[k].stageFriction};
+    ws.forEachIsland([&](int island) {
+      impulses[island] += ws.contactSweeps(island, ImpulseMode::Contact, false, nullptr, nullptr);
+    });
+    for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
+      ws.pairs[k].stageNormal += stageSums[k].first;
+      for (int c = 0; c < 3; ++c) ws.pairs[k].stageFriction[c] += stageSums[k].second[c];
     }
+    ws.unpack(false);
+  }
   int total = 0;
   for (int n : impulses) total += n;
   ctx.diagnostics.set("contact_impulses", total);

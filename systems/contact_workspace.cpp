@@ -284,22 +284,20 @@ void ContactWorkspace<d>::ensureGeometry(World<d>& world) {
     geometries_.push_back(std::make_unique<col::PreparedGeometry<d>>(g));
   }
   jointedPairs_.clear();
-  if constexpr (d == 3) {
-    if (const auto* joints = world.template findPool<Joint>()) {
-      std::map<std::uint32_t, int> index;
-      for (std::size_t i = 0; i < entities_.size(); ++i) index[entities_[i].index] = static_cast<int>(i);
-      auto bodyOf = [&](const std::string& name) {
-        const auto e = world.find(name);
-        const auto it = e ? index.find(e->index) : index.end();
-        return it == index.end() ? -1 : it->second;
-      };
-      for (const Joint& j : joints->components()) {
-        const int a = bodyOf(j.parent), b = bodyOf(j.child);
-        if (a >= 0 && b >= 0) jointedPairs_.emplace_back(std::min(a, b), std::max(a, b));
-      }
-      std::sort(jointedPairs_.begin(), jointedPairs_.end());
-      jointedPairs_.erase(std::unique(jointedPairs_.begin(), jointedPairs_.end()), jointedPairs_.end());
+  if (const auto* joints = world.template findPool<ArticulationJoint<d>>()) {
+    std::map<std::uint32_t, int> index;
+    for (std::size_t i = 0; i < entities_.size(); ++i) index[entities_[i].index] = static_cast<int>(i);
+    auto bodyOf = [&](const std::string& name) {
+      const auto e = world.find(name);
+      const auto it = e ? index.find(e->index) : index.end();
+      return it == index.end() ? -1 : it->second;
+    };
+    for (const ArticulationJoint<d>& j : joints->components()) {
+      const int a = bodyOf(j.parent), b = bodyOf(j.child);
+      if (a >= 0 && b >= 0) jointedPairs_.emplace_back(std::min(a, b), std::max(a, b));
     }
+    std::sort(jointedPairs_.begin(), jointedPairs_.end());
+    jointedPairs_.erase(std::unique(jointedPairs_.begin(), jointedPairs_.end()), jointedPairs_.end());
   }
 }
 

@@ -669,8 +669,7 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
   }
   ctx.diagnostics.set("rotation_energy_clamps", clampRotation ? clampEnergyOfRestoredMomentum(ws) : 0);
   // Jointed bodies: their poses come from the joints and contacts together (systems/articulation.h).
-  if constexpr (d == 3)
-    if (world.template count<Joint>() > 0) resolveJointedInterpenetration(world, ws, ctx);
+  if (world.template count<ArticulationJoint<d>>() > 0) resolveJointedInterpenetration(world, ws, ctx);
   ws.unpack(true);
   ctx.diagnostics.set("push_out_solves", solves);
   ctx.diagnostics.set("push_out_new_overlaps", newOverlaps);

@@ -1,6 +1,7 @@
 // Interpenetration resolution of the jointed bodies (Step IV; not in the thesis): joints and
 // contacts in one position solve (solvers/articulation/joint_closing.h).
 #include <algorithm>
+#include <cmath>
 
 #include "solvers/articulation/joint_closing.h"
 #include "solvers/collision/narrow_phase.h"
@@ -20,7 +21,8 @@ constexpr double kStepFiveMargin = 5e-3;
 
 // Per body of `ws`: its body in the assembly if it is jointed and can move, else 0 (the world,
 // held still).
-std::vector<int> assemblyBodies(const JointAssembly& a, const ContactWorkspace<3>& ws) {
+template <int d>
+std::vector<int> assemblyBodies(const JointAssembly<d>& a, const ContactWorkspace<d>& ws) {
   std::vector<int> bodyOf(ws.bodies.size(), 0);
   for (std::size_t i = 0; i < ws.bodies.size(); ++i) {
     const auto it = a.index.find(ws.entityOf(i).index);
@@ -34,28 +36,49 @@ std::vector<int> assemblyBodies(const JointAssembly& a, const ContactWorkspace<3
 // IV, time n+1 in Step V; a static body's collision pose, grounded_box.h). `gainOf(depth)` is
 // the row's gain. With `partnerMotion`, a partner held still in the solve moves with its own
 // velocity at the point (Step V).
-template <typename GainOf>
-std::vector<solvers::ContactRow> contactRows(const JointAssembly& a, const ContactWorkspace<3>& ws,
+// A body of the assembly as a pose of dimension d (2-D: the plane's part of the lifted pose).
+template <int d>
+col::Pose<d> poseOfBody(const solvers::ConstraintBody& b) {
+  col::Pose<d> p;
+  p.x = b.x.head<d>();
+  p.R = b.q.toRotationMatrix().topLeftCorner<d, d>();
+  return p;
+}
+
+// The orientation of a lifted body as the dimension's orientation; in 2-D the angle nearest to
+// `near` (the body's angle is a state that may have turned many times).
+template <int d>
+Orientation<d> orientationOf(const Eigen::Quaterniond& q, const Orientation<d>& near) {
+  if constexpr (d == 3) {
+    return q;
+  } else {
+    constexpr double kTwoPi = 2 * 3.14159265358979323846;
+    const double angle = 2 * std::atan2(q.z(), q.w());
+    return near + std::remainder(angle - near, kTwoPi);
+  }
+}
+
+template <int d, typename GainOf>
+std::vector<solvers::ContactRow> contactRows(const JointAssembly<d>& a, const ContactWorkspace<d>& ws,
                                              const std::vector<int>& bodyOf, double margin, GainOf&& gainOf,
                                              bool partnerMotion) {
   auto poseOf = [&](std::size_t i) {
-    col::Pose<3> p = ws.bodies[i].candidate;
+    col::Pose<d> p = ws.bodies[i].candidate;
     if (bodyOf[i] > 0) {
-      p.x = a.bodies[bodyOf[i]].x;
-      p.R = a.bodies[bodyOf[i]].q.toRotationMatrix();
+      p = poseOfBody<d>(a.bodies[bodyOf[i]]);
     } else if (!ws.bodies[i].still()) {
       p.x = ws.bodies[i].x0;
       p.R = ws.bodies[i].R0;
     }
     return p;
   };
-  auto pointVelocity = [&](std::size_t i, const Eigen::Vector3d& point) -> Eigen::Vector3d {
-    const ContactBody<3>& b = ws.bodies[i];
+  auto pointVelocity = [&](std::size_t i, const Eigen::Matrix<double, d, 1>& point) -> Eigen::Vector3d {
+    const ContactBody<d>& b = ws.bodies[i];
     if (!partnerMotion || b.still()) return Eigen::Vector3d::Zero();
-    return b.v + b.omega().cross(point - b.x0);
+    return liftVector<d>(b.pointVelocity(point - b.x0));
   };
   std::vector<solvers::ContactRow> rows;
-  std::vector<col::ContactPoint<3>> points;
+  std::vector<col::ContactPoint<d>> points;
   col::ContactQuery query;
   query.margin = margin;
   for (const ContactPairState& p : ws.pairs) {
@@ -66,8 +89,8 @@ std::vector<solvers::ContactRow> contactRows(const JointAssembly& a, const Conta
       solvers::ContactRow r;
       r.a = bodyOf[p.a];
       r.b = bodyOf[p.b];
-      r.point = cp.point;
-      r.normal = cp.normal;
+      r.point = liftVector<d>(cp.point);
+      r.normal = liftVector<d>(cp.normal);
       r.gain = gainOf(cp.depth);
       r.friction = std::min(ws.bodies[p.a].friction, ws.bodies[p.b].friction);
       if (r.a == 0) r.offset += pointVelocity(p.a, cp.point);
@@ -80,9 +103,10 @@ std::vector<solvers::ContactRow> contactRows(const JointAssembly& a, const Conta
 
 }  // namespace
 
-void postStabilizeWithContacts(World<3>& world, const ContactWorkspace<3>& ws, StepContext& ctx) {
+template <int d>
+void postStabilizeWithContacts(World<d>& world, const ContactWorkspace<d>& ws, StepContext& ctx) {
   const ArticulationSolver s = articulationSettings(world);
-  JointAssembly a(world);
+  JointAssembly<d> a(world);
   const std::vector<int> bodyOf = assemblyBodies(a, ws);
   const double dt = ws.dt;
   // Touching or overlapping: no approach (push-out's business); apart: the gap in one step.
@@ -95,15 +119,17 @@ void postStabilizeWithContacts(World<3>& world, const ContactWorkspace<3>& ws, S
   ctx.diagnostics.max("joint_post_iterations", r.iterations);
 }
 
-void resolveJointedInterpenetration(World<3>& world, ContactWorkspace<3>& ws, StepContext& ctx) {
+template <int d>
+void resolveJointedInterpenetration(World<d>& world, ContactWorkspace<d>& ws, StepContext& ctx) {
   const ArticulationSolver s = articulationSettings(world);
-  JointAssembly a(world);
+  JointAssembly<d> a(world);
   const std::vector<int> bodyOf = assemblyBodies(a, ws);
   // The joint error push-out's own poses would leave.
   std::vector<solvers::ConstraintBody> pushed = a.bodies;
   {
     for (std::size_t i = 0; i < ws.bodies.size(); ++i)
-      if (bodyOf[i] > 0) pushed[bodyOf[i]].x = ws.bodies[i].x0, pushed[bodyOf[i]].q = ws.bodies[i].q0;
+      if (bodyOf[i] > 0)
+        pushed[bodyOf[i]].x = liftVector<d>(ws.bodies[i].x0), pushed[bodyOf[i]].q = liftOrientation<d>(ws.bodies[i].q0);
     double open = 0;
     for (const auto& def : a.joints) {
       const solvers::JointError e =
@@ -151,16 +177,21 @@ void resolveJointedInterpenetration(World<3>& world, ContactWorkspace<3>& ws, St
   }
   for (std::size_t i = 0; i < ws.bodies.size(); ++i) {
     if (bodyOf[i] == 0) continue;
-    ContactBody<3>& b = ws.bodies[i];
-    b.x0 = a.bodies[bodyOf[i]].x;
-    b.q0 = a.bodies[bodyOf[i]].q;
-    b.R0 = b.q0.toRotationMatrix();
-    b.candidate.x = b.x0;
-    b.candidate.R = b.R0;
+    ContactBody<d>& b = ws.bodies[i];
+    const col::Pose<d> pose = poseOfBody<d>(a.bodies[bodyOf[i]]);
+    b.x0 = pose.x;
+    b.q0 = orientationOf<d>(a.bodies[bodyOf[i]].q, b.q0);
+    b.R0 = pose.R;
+    b.candidate = pose;
   }
   ctx.diagnostics.set("joint_push_out_overlap_left", deepest);
   ctx.diagnostics.set("joint_push_out_contacts", static_cast<double>(rows));
   ctx.diagnostics.set("joint_push_out_error_left", r.errorAfter);
 }
+
+template void postStabilizeWithContacts<2>(World<2>&, const ContactWorkspace<2>&, StepContext&);
+template void postStabilizeWithContacts<3>(World<3>&, const ContactWorkspace<3>&, StepContext&);
+template void resolveJointedInterpenetration<2>(World<2>&, ContactWorkspace<2>&, StepContext&);
+template void resolveJointedInterpenetration<3>(World<3>&, ContactWorkspace<3>&, StepContext&);
 
 }  // namespace monolith

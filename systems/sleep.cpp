@@ -81,22 +81,21 @@ int ContactWorkspace<d>::wakeTouchedSleepers(World<d>& world) {
     }
     // A joint between a sleeping body and an awake dynamic one (a group started asleep by the
     // scene, or woken by a pair): the jointed bodies wake as one.
-    if constexpr (d == 3)
-      if (world.template count<Joint>() > 0) {
-        std::unordered_map<std::uint32_t, std::size_t> bodyOf;
-        for (std::size_t i = 0; i < bodies.size(); ++i) bodyOf.emplace(entities_[i].index, i);
-        auto indexOf = [&](const std::string& name) -> long {
-          const auto e = name == "world" ? std::nullopt : world.find(name);
-          const auto it = e ? bodyOf.find(e->index) : bodyOf.end();
-          return it == bodyOf.end() ? -1 : static_cast<long>(it->second);
-        };
-        for (const Joint& j : world.template pool<Joint>().components()) {
-          const long p = indexOf(j.parent), c = indexOf(j.child);
-          if (p < 0 || c < 0) continue;
-          if (bodies[p].asleep && !bodies[c].infinite()) groups.push_back(groupOf(p));
-          if (bodies[c].asleep && !bodies[p].infinite()) groups.push_back(groupOf(c));
-        }
+    if (world.template count<ArticulationJoint<d>>() > 0) {
+      std::unordered_map<std::uint32_t, std::size_t> bodyOf;
+      for (std::size_t i = 0; i < bodies.size(); ++i) bodyOf.emplace(entities_[i].index, i);
+      auto indexOf = [&](const std::string& name) -> long {
+        const auto e = name == "world" ? std::nullopt : world.find(name);
+        const auto it = e ? bodyOf.find(e->index) : bodyOf.end();
+        return it == bodyOf.end() ? -1 : static_cast<long>(it->second);
+      };
+      for (const ArticulationJoint<d>& j : world.template pool<ArticulationJoint<d>>().components()) {
+        const long p = indexOf(j.parent), c = indexOf(j.child);
+        if (p < 0 || c < 0) continue;
+        if (bodies[p].asleep && !bodies[c].infinite()) groups.push_back(groupOf(p));
+        if (bodies[c].asleep && !bodies[p].infinite()) groups.push_back(groupOf(c));
       }
+    }
     // A moving kinematic body: its box (over the step's motion, findPairs) against the sleepers'.
     for (std::size_t k = 0; k < bodies.size(); ++k) {
       const ContactBody<d>& K = bodies[k];
@@ -181,39 +180,38 @@ void FallAsleep<d>::run(World<d>& world, StepContext& ctx) {
     const int ra = rootOf(parent_, p.a), rb = rootOf(parent_, p.b);
     if (ra != rb) parent_[std::max(ra, rb)] = std::min(ra, rb);
   }
-  // Joints (3-D): the bodies a joint links are one island, so that they fall asleep and wake
+  // Joints: the bodies a joint links are one island, so that they fall asleep and wake
   // together (a jointed body asleep alone would hold its awake partner as if welded to the
   // world). A joint to the world, a static body or a sleeping one holds the island; one to a
   // body that cannot sleep (a kinematic one, or a dynamic one outside the workspace) blocks it.
-  if constexpr (d == 3)
-    if (world.template count<Joint>() > 0) {
-      std::unordered_map<std::uint32_t, int> bodyOf;
-      for (int i = 0; i < n; ++i) bodyOf.emplace(ws.entityOf(i).index, i);
-      // The body index of a joint's end; -1: the world or a static body outside the workspace,
-      // -2: a body that cannot sleep.
-      auto endOf = [&](const std::string& name) {
-        if (name == "world") return -1;
-        const auto e = world.find(name);
-        const auto it = e ? bodyOf.find(e->index) : bodyOf.end();
-        if (it != bodyOf.end()) return ws.bodies[it->second].kinematic ? -2 : it->second;
-        const RigidBody<d>* b = e ? world.template get<RigidBody<d>>(*e) : nullptr;
-        return b && b->isStatic ? -1 : -2;
-      };
-      for (const Joint& j : world.template pool<Joint>().components()) {
-        const int p = endOf(j.parent), c = endOf(j.child);
-        const bool ap = p >= 0 && awakeDynamic(p), ac = c >= 0 && awakeDynamic(c);
-        if (ap && ac) {
-          const int rp = rootOf(parent_, p), rc = rootOf(parent_, c);
-          if (rp != rc) parent_[std::max(rp, rc)] = std::min(rp, rc);
-          continue;
-        }
-        for (const auto& [mine, awake, other] : {std::tuple{p, ap, c}, std::tuple{c, ac, p}}) {
-          if (!awake) continue;
-          if (other == -2) blocked_[mine] = 1;
-          else held_[mine] = 1;  // the world, a static body, or a sleeping one
-        }
+  if (world.template count<ArticulationJoint<d>>() > 0) {
+    std::unordered_map<std::uint32_t, int> bodyOf;
+    for (int i = 0; i < n; ++i) bodyOf.emplace(ws.entityOf(i).index, i);
+    // The body index of a joint's end; -1: the world or a static body outside the workspace,
+    // -2: a body that cannot sleep.
+    auto endOf = [&](const std::string& name) {
+      if (name == "world") return -1;
+      const auto e = world.find(name);
+      const auto it = e ? bodyOf.find(e->index) : bodyOf.end();
+      if (it != bodyOf.end()) return ws.bodies[it->second].kinematic ? -2 : it->second;
+      const RigidBody<d>* b = e ? world.template get<RigidBody<d>>(*e) : nullptr;
+      return b && b->isStatic ? -1 : -2;
+    };
+    for (const ArticulationJoint<d>& j : world.template pool<ArticulationJoint<d>>().components()) {
+      const int p = endOf(j.parent), c = endOf(j.child);
+      const bool ap = p >= 0 && awakeDynamic(p), ac = c >= 0 && awakeDynamic(c);
+      if (ap && ac) {
+        const int rp = rootOf(parent_, p), rc = rootOf(parent_, c);
+        if (rp != rc) parent_[std::max(rp, rc)] = std::min(rp, rc);
+        continue;
+      }
+      for (const auto& [mine, awake, other] : {std::tuple{p, ap, c}, std::tuple{c, ac, p}}) {
+        if (!awake) continue;
+        if (other == -2) blocked_[mine] = 1;
+        else held_[mine] = 1;  // the world, a static body, or a sleeping one
       }
     }
+  }
   // An island sleeps only if something holds it: a body paired with an immovable one, or none
   // pushed by a force. Else it is slow but accelerating: a weak force (under sleep_speed per
   // sleep_time) would otherwise be stopped for good before it got the body moving.

@@ -22,11 +22,10 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
   const auto energyBefore = ws.readEnergy();
   // Joints (systems/articulation.h): the jointed bodies' velocities first projected onto their
   // joints and contacts together (with friction, while the contacts still carry the weight).
-  if constexpr (d == 3)
-    if (jointContactRounds(world) > 0) {
-      postStabilizeWithContacts(world, ws, ctx);
-      ws.reloadVelocities();
-    }
+  if (jointContactRounds(world) > 0) {
+    postStabilizeWithContacts(world, ws, ctx);
+    ws.reloadVelocities();
+  }
   std::vector<int> impulses(ws.islands.members.size(), 0), clamps(ws.islands.members.size(), 0);
   std::vector<double> change(ws.islands.members.size(), 0.0);
   ws.forEachIsland([&](int island) {
@@ -41,20 +40,19 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
   });
   // Then rounds of post-stabilization and contact again, so that neither leaves the other a
   // velocity to undo; post_stabilize_velocities closes the joints last.
-  if constexpr (d == 3)
-    for (int round = 0, rounds = jointContactRounds(world); round < rounds; ++round) {
-      ws.unpack(false);
-      postStabilizeJointVelocities(world, ctx);
-      ws.reloadVelocities();
-      ws.updateAllCandidates();
-      ws.forEachIsland([&](int island) {
+  for (int round = 0, rounds = jointContactRounds(world); round < rounds; ++round) {
+    ws.unpack(false);
+    postStabilizeJointVelocities(world, ctx);
+    ws.reloadVelocities();
+    ws.updateAllCandidates();
+    ws.forEachIsland([&](int island) {
+      impulses[island] +=
+          ws.contactSweeps(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
+      if (s.shockPropagation)
         impulses[island] +=
-            ws.contactSweeps(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
-        if (s.shockPropagation)
-          impulses[island] +=
-              ws.propagateShock(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
-      });
-    }
+            ws.propagateShock(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
+    });
+  }
   const auto energyAfter = ws.readEnergy();
   // The whole step's energy (systems/step_energy_clamp.cpp); measured after the diagnostics
   // above, which are about this stage's impulses alone.

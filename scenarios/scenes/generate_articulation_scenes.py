@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the articulation scenes (docs/articulation.md): pendulum, chain_hanging, loop_six,
-pd_arm and ragdoll_pile. Run from this folder: python3 generate_articulation_scenes.py"""
+pd_arm, ragdoll_pile, twisting_chain_rigid and the 2-D pendulum_2d and chain_2d. Run from this folder: python3 generate_articulation_scenes.py"""
 import json
 import math
 
@@ -282,12 +282,92 @@ def twisting_chain_rigid(loops=(1, 3, 5), rings=7, end=2.0):
                         "statistic": "max", "reference": 0, "tolerance": 0.01}]}
 
 
+def pendulum_2d_period():
+    """2 pi sqrt(I_pivot / (m g d)) of pendulum_2d: rod 0.02 x 1 m (1 kg), disk r 0.1 (2 kg) at 1 m."""
+    inertia = (1.0 * (0.02 ** 2 + 1.0) / 12 + 1.0 * 0.5 ** 2) + (0.5 * 2.0 * 0.1 ** 2 + 2.0 * 1.0 ** 2)
+    return 2 * math.pi * math.sqrt(inertia / (3.0 * 9.81 * (2.5 / 3.0)))
+
+
+def pendulum_2d():
+    # The 2-D pendulum: the rod and bob of `pendulum` in the plane, the bob a disk.
+    a = math.radians(5)
+    down = (math.sin(a), -math.cos(a))
+    period = pendulum_2d_period()
+    swing = 3.0 * 9.81 * (2.5 / 3.0) * (1 - math.cos(a))
+    start_energy = 9.81 * (1.0 * 0.5 * down[1] + 2.0 * 1.0 * down[1])
+    # At t = (4 + 1/4) T the rod passes through the vertical; a period off by a fraction eps puts
+    # its centre at 0.5 sin(a sin(2 pi 4.25 eps)) from it: 5.8 mm for eps = 0.5 %.
+    crossing = 4.25 * period
+    tolerance = 0.5 * math.sin(a * math.sin(2 * math.pi * 4.25 * 0.005))
+    scene = {
+        "description": "2-D rod and bob pendulum on a pin, 5 degree amplitude",
+        "dimension": 2,
+        "time": {"dt": 1 / 240, "end": 10.0, "frame_rate": 30},
+        "gravity": [0, -9.81],
+        "entities": [
+            {"name": "rod", "shape": {"type": "box", "half_extents": [0.01, 0.5]},
+             "rigid_body": {"mass": 1.0, "position": r([0.5 * x for x in down]), "angle": round(a, 12)},
+             "joint": {"type": "revolute", "parent": "world", "anchor": [0, 0]}},
+            {"name": "bob", "shape": {"type": "disk", "radius": 0.1},
+             "rigid_body": {"mass": 2.0, "position": r(down), "angle": round(a, 12)},
+             "joint": {"type": "fixed", "parent": "rod", "anchor": r(down)}},
+        ],
+        "checks": [
+            {"name": "period", "kind": "body", "body": "rod", "field": "position", "axis": 0,
+             "at": round(crossing, 9), "reference": 0, "tolerance": round(tolerance, 6)},
+            {"name": "energy_rise", "kind": "diagnostic", "diagnostic": "total_energy", "statistic": "max",
+             "reference": round(start_energy, 9), "tolerance": round(1e-3 * swing, 9)},
+            {"name": "joints_closed", "kind": "diagnostic", "diagnostic": "joint_error_max",
+             "statistic": "max", "reference": 0, "tolerance": 1e-8},
+        ],
+    }
+    write("pendulum_2d", """
+2-D pendulum (thesis Sec. 4.5, App. C, in the plane): a 1 m rod (box 0.02 x 1 m, 1 kg) with a
+2 kg disk (r 0.1 m) fixed to its end by a fixed joint, pinned to the world at the top by a
+revolute joint, released at 5 degrees. Period 2 pi sqrt(I_pivot / (m g d)) = %.6f s.
+Checks: the rod's centre at t = 4.25 periods within %.4f m of the vertical (a period within
+0.5 %%), the total energy never above its start by 0.1 %% of the swing, joints closed to 1e-8 m.""" % (
+        period, tolerance), scene)
+
+
+def chain_2d():
+    n, length = 20, 0.1
+    entities = []
+    for i in range(n):
+        entities.append({
+            "name": "link%d" % i,
+            "shape": {"type": "box", "half_extents": [0.5 * length, 0.01]},
+            "rigid_body": {"mass": 0.1, "position": [(i + 0.5) * length, 0]},
+            "joint": {"type": "revolute", "parent": "world" if i == 0 else "link%d" % (i - 1),
+                      "anchor": [i * length, 0]},
+        })
+    entities.append({"name": "solver", "articulation": {"post_stabilization": "global", "pre_stabilization": "global"}})
+    start_energy = 0.0  # all links at y = 0
+    scale = n * 0.1 * 9.81 * n * length  # the chain's weight times its length
+    scene = {"description": "2-D chain of 20 links on pins released horizontally",
+             "dimension": 2, "time": {"dt": 1 / 240, "end": 2.0, "frame_rate": 30},
+             "gravity": [0, -9.81], "entities": entities,
+             "checks": [
+                 {"name": "joints_closed", "kind": "diagnostic", "diagnostic": "joint_error_max",
+                  "statistic": "max", "reference": 0, "tolerance": 1e-4 * length},
+                 {"name": "energy_rise", "kind": "diagnostic", "diagnostic": "total_energy", "statistic": "max",
+                  "reference": start_energy, "tolerance": 1e-3 * scale},
+             ]}
+    write("chain_2d", """
+2-D chain: 20 box links (0.1 x 0.02 m, 0.1 kg) on pins, the first pinned to the world, released
+horizontally (global pre- and post-stabilization). Checks: joint_error_max below 1e-4 of a link's
+length in every step; the total energy never above its start by 0.1 % of the chain's weight
+times its length.""", scene)
+
+
 if __name__ == "__main__":
     pendulum()
     chain_hanging()
     loop_six()
     pd_arm()
     ragdoll_pile()
+    pendulum_2d()
+    chain_2d()
     scene = twisting_chain_rigid()
     write("twisting_chain_rigid", """
 Rigid part of the twisting chain (thesis Fig. 4.1): seven hexagonal rings of six capsules (0.3 m

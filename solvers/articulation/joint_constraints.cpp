@@ -62,6 +62,19 @@ Vector6d solveRows(const Ldlt6& K, const Vector6d& rhs, int k) {
   return out;
 }
 
+// A planar joint's frames turn about z only, so each of its row directions lies in the plane or
+// along z (to rounding): keep the linear rows in the plane and the angular rows about z.
+void keepInPlane(JointRows& rows) {
+  int kept = 0;
+  for (int i = 0; i < rows.linear; ++i)
+    if (std::abs(rows.linearDirs(2, i)) < 0.5) rows.linearDirs.col(kept++) = rows.linearDirs.col(i);
+  rows.linear = kept;
+  kept = 0;
+  for (int i = 0; i < rows.angular; ++i)
+    if (std::abs(rows.angularDirs(2, i)) > 0.5) rows.angularDirs.col(kept++) = rows.angularDirs.col(i);
+  rows.angular = kept;
+}
+
 }  // namespace
 
 double largestEntry(const Vector6d& v, int n) {
@@ -125,6 +138,7 @@ JointRows jointRows(const JointDefinition& joint, const std::vector<ConstraintBo
       break;
     }
   }
+  if (joint.planar) keepInPlane(rows);
   return rows;
 }
 

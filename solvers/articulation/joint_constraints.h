@@ -42,6 +42,10 @@ struct JointDefinition {
   Eigen::Quaterniond parentFrame = Eigen::Quaterniond::Identity(), childFrame = Eigen::Quaterniond::Identity();
   bool limited = false;  // revolute: angle limits [lower, upper]
   double lower = 0, upper = 0;
+  // A joint of the plane z = 0 between bodies that move in it (2-D scenes): its frames turn about
+  // z only, and the rows that leave the plane (linear along z, angular about x and y) are dropped;
+  // a pin is then a revolute joint about z, a 2-D slider a prismatic joint along an in-plane z.
+  bool planar = false;
 };
 
 // A joint's rows at given poses.

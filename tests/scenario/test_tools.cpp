@@ -91,7 +91,7 @@ TEST(Checks, AFailedCheckIsExitCodeFiveOnlyWithCheck) {
 TEST(Checks, ShortShippedScenesWithAKnownAnswerPass) {
   // The long ones (pyramid_20, cavity_re100, poiseuille, dfg_2d1) run in tests/support/check_scenes.sh.
   TempDir tmp;
-  for (const std::string scene : {"incline_friction", "bounce", "pyramid_2d_10"}) {
+  for (const std::string scene : {"incline_friction", "bounce", "pyramid_2d_10", "pendulum_2d", "chain_2d"}) {
     const CommandResult r = run({MONOLITH_CLI, "run", kScenes + scene + ".json", "--out", (tmp.path() / scene).string(),
                                  "--quiet", "--no-frames", "--check"},
                                 tmp.logs());
