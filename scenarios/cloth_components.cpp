@@ -9,6 +9,7 @@
 #include "solvers/deformable/cloth.h"
 #include "systems/cloth_dynamics.h"
 #include "systems/deformable_self_collision.h"
+#include "systems/rigid_surface_contact.h"
 
 namespace monolith {
 
@@ -113,6 +114,11 @@ void registerSurfaceCollision(Registry& r) {
 
 template <int d>
 void registerSelfCollisionSystems(Registry& r) {
+  r.addSystem<d>({"rigid_surface_contact",
+                  "rigid bodies against the faces of colliding surfaces (a body's deepest point in each nearby cloth or "
+                  "surface triangle, impulses on the face's particles by barycentric weights): Steps II (two-way), III, "
+                  "IV (push-out) and V (two-way)",
+                  [] { return makeRigidSurfaceContactSystems<d>(); }, ""});
   r.addSystem<d>({"deformable_self_collisions",
                   "deformable-deformable and self collisions (Bridson et al. 2002): proximity repulsion and "
                   "continuous collision passes at Step II, collision passes again at Step III; surface_crossings counts "
