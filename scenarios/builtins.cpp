@@ -197,6 +197,7 @@ void registerDimension(Registry& r) {
                     [] { return single<JointPdControl>(); }, ""});
   }
   registerParticleCollisionSystems<d>(r);
+  registerRigidSurfaceCollisionSystems<d>(r);
   r.addSystem<d>({"rigid_contact",
                   "Steps II-V contact (Sec. 4.4-4.7, App. B): collisions, contact, shock_propagation, "
                   "resolve_interpenetration, velocity_contact",

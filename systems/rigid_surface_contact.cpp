@@ -78,16 +78,16 @@ void RigidSurfaceContact<d>::run(World<d>& world, StepContext& ctx) {
 }
 
 template <int d>
-std::vector<std::unique_ptr<System<d>>> makeRigidSurfaceContactSystems() {
+std::vector<std::unique_ptr<System<d>>> makeRigidSurfaceContactSystems(const std::vector<Stage>& stages) {
   std::vector<std::unique_ptr<System<d>>> out;
-  for (Stage s : {Stage::Collisions, Stage::Contact, Stage::AdvancePositions, Stage::AdvanceVelocity})
+  for (Stage s : stages)
     out.push_back(std::make_unique<RigidSurfaceContact<d>>(s));
   return out;
 }
 
 template class RigidSurfaceContact<2>;
 template class RigidSurfaceContact<3>;
-template std::vector<std::unique_ptr<System<2>>> makeRigidSurfaceContactSystems<2>();
-template std::vector<std::unique_ptr<System<3>>> makeRigidSurfaceContactSystems<3>();
+template std::vector<std::unique_ptr<System<2>>> makeRigidSurfaceContactSystems<2>(const std::vector<Stage>&);
+template std::vector<std::unique_ptr<System<3>>> makeRigidSurfaceContactSystems<3>(const std::vector<Stage>&);
 
 }  // namespace monolith

@@ -7,7 +7,9 @@
 // body smaller than a face cannot pass between them. One system per stage, as the particles':
 //  * rigid_surface_collisions (Step II, Sec. 4.4): at the candidate positions x^n + dt v^{n+1/2}
 //    and the bodies' candidate poses, two-way (equal and opposite impulses, the body with its
-//    mass and inertia), before the surface collisions so that these see the changed velocities;
+//    mass and inertia), registered with the particles' collisions before the rigid contact (whose
+//    workspace holds the bodies' velocities from its Step II to Step IV) and so before the
+//    surface collisions, which see the changed velocities;
 //  * rigid_surface_contact (Step III, Sec. 4.5): the same with the bodies immovable; the
 //    particles' velocities only steer the position update (particle_push_out restores them);
 //  * rigid_surface_push_out (Step IV, Sec. 4.6.1): a face point inside a body at x^{n+1} is moved
@@ -55,7 +57,8 @@ class RigidSurfaceContact final : public System<d> {
   solvers::deformable::Bvh<d> tree_;
 };
 
+// One system per stage listed (Collisions, Contact, AdvancePositions, AdvanceVelocity).
 template <int d>
-std::vector<std::unique_ptr<System<d>>> makeRigidSurfaceContactSystems();
+std::vector<std::unique_ptr<System<d>>> makeRigidSurfaceContactSystems(const std::vector<Stage>& stages);
 
 }  // namespace monolith
