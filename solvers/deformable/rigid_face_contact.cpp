@@ -6,11 +6,13 @@
 #include <limits>
 
 #include "solvers/collision/collision_impl.h"
+#include "solvers/contact/rigid_math.h"
 #include "solvers/deformable/face_geometry.h"
 
 namespace monolith::solvers::deformable {
 
 namespace col = solvers::collision;
+namespace ct = solvers::contact;
 
 namespace {
 
@@ -21,18 +23,6 @@ using Mat = Eigen::Matrix<double, d, d>;
 
 // Alternating projections from one seed: at most this many face points per seed.
 constexpr int kProjections = 4;
-
-// r x j as the body's angular quantity (a number about z in 2-D), and w x r.
-template <int d>
-AngularD<d> crossArm(const Vec<d>& r, const Vec<d>& j) {
-  if constexpr (d == 3) return r.cross(j);
-  else return AngularD<2>(r.x() * j.y() - r.y() * j.x());
-}
-template <int d>
-Vec<d> angularAt(const AngularD<d>& w, const Vec<d>& r) {
-  if constexpr (d == 3) return w.cross(r);
-  else return Vec<2>(-w(0) * r.y(), w(0) * r.x());
-}
 
 // The face point closest to q, with its weights.
 template <int d>
@@ -194,12 +184,12 @@ int applyFaceContactImpulses(std::vector<RigidFaceBody<d>>& bodies, FaceSet<d>& 
         faceV += c.weights[a] * at<d>(v, idx[a]);
       }
       const Vec<d> r = c.point - b.x;
-      const Vec<d> u = faceV - (b.v + angularAt<d>(b.omega, r));
+      const Vec<d> u = faceV - (b.v + ct::angularCross<d>(b.omega, r));
       if (u.dot(c.normal) >= 0) continue;
       Mat<d> K = faceInverseMass * Mat<d>::Identity();
       for (int a = 0; a < d; ++a) {
         const Vec<d> e = Vec<d>::Unit(a);
-        K.col(a) += b.inverseMass * e + angularAt<d>(AngularD<d>(b.inverseInertia * crossArm<d>(r, e)), r);
+        K.col(a) += b.inverseMass * e + ct::angularCross<d>(AngularD<d>(b.inverseInertia * ct::cross<d>(r, e)), r);
       }
       if (!(K.norm() > 0)) continue;  // both sides immovable
       const Vec<d> j = stoppingImpulse<d>(K, u, c.normal, c.friction);
@@ -207,9 +197,9 @@ int applyFaceContactImpulses(std::vector<RigidFaceBody<d>>& bodies, FaceSet<d>& 
         Eigen::Map<Vec<d>>(&v[d * idx[a]]) += (c.weights[a] * w[idx[a]]) * j;
       if (b.inverseMass > 0) {
         b.v -= b.inverseMass * j;
-        b.omega -= b.inverseInertia * crossArm<d>(r, j);
+        b.omega -= b.inverseInertia * ct::cross<d>(r, j);
         b.impulse -= j;
-        b.angularImpulse -= crossArm<d>(r, j);
+        b.angularImpulse -= ct::cross<d>(r, j);
       }
       ++impulses;
     }

@@ -16,14 +16,15 @@
 #include <vector>
 
 #include "solvers/collision/geometry.h"
+#include "solvers/contact/rigid_math.h"
 #include "solvers/deformable/bvh.h"
 
 namespace monolith::solvers::deformable {
 
 template <int d>
-using AngularD = Eigen::Matrix<double, d == 3 ? 3 : 1, 1>;
+using AngularD = solvers::contact::AngVec<d>;
 template <int d>
-using InertiaD = Eigen::Matrix<double, d == 3 ? 3 : 1, d == 3 ? 3 : 1>;
+using InertiaD = solvers::contact::AngMat<d>;
 
 // One rigid body as the face contact sees it. Velocities are updated as impulses are applied
 // (Gauss-Seidel); `impulse` and `angularImpulse` sum what it received (about its centre x), for

@@ -15,16 +15,8 @@
 
 using namespace monolith;
 using test::builtins;
+using test::diagnostic;
 using test::kScenes;
-
-namespace {
-
-double value(const std::map<std::string, double>& m, const std::string& key) {
-  const auto it = m.find(key);
-  return it == m.end() ? 0.0 : it->second;
-}
-
-}  // namespace
 
 // small_bodies_on_cloth.json without its deformable ball: a rigid ball (r = 0.03 m) and cube
 // (0.04 m, corner first) on a sheet of 0.1 m cells, 0.8 s.
@@ -38,11 +30,11 @@ TEST(RigidSurfaceContact, BodiesSmallerThanACellAreCaughtByTheSheet) {
   auto body = [&](const char* name) { return sim.world().get<RigidBody<3>>(*sim.world().find(name)); };
   while (!sim.finished()) {
     const auto& m = sim.step();
-    crossings = std::max(crossings, value(m, "surface_crossings"));
-    faceImpulses += value(m, "rigid_surface_collisions_impulses") + value(m, "rigid_surface_velocity_contact_impulses");
+    crossings = std::max(crossings, diagnostic(m, "surface_crossings"));
+    faceImpulses += diagnostic(m, "rigid_surface_collisions_impulses") + diagnostic(m, "rigid_surface_velocity_contact_impulses");
     // The soft ball falls freely far away: its energy stays constant up to the integrator's.
-    if (energy0 < 0) energy0 = value(m, "total_energy");
-    energyMax = std::max(energyMax, value(m, "total_energy"));
+    if (energy0 < 0) energy0 = diagnostic(m, "total_energy");
+    energyMax = std::max(energyMax, diagnostic(m, "total_energy"));
     for (int k = 0; k < 2; ++k) lowest[k] = std::min(lowest[k], body(names[k])->x.y());
   }
   std::printf("small bodies on cloth: %ld steps, %g face impulses, %g crossings, lowest y ball %.4f cube %.4f, "
@@ -69,7 +61,7 @@ TEST(RigidSurfaceContact, OneAndTwoThreadsAgreeBitwise) {
   Simulation<3> two(loadScene(kScenes + "small_bodies_on_cloth.json", o), registry, 2);
   double impulses = 0;
   while (!one.finished()) {
-    impulses += value(one.step(), "rigid_surface_collisions_impulses");
+    impulses += diagnostic(one.step(), "rigid_surface_collisions_impulses");
     two.step();
     ASSERT_EQ(stateHash(one.world()), stateHash(two.world())) << "step " << one.stepsDone();
   }
