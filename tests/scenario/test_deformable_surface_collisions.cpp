@@ -27,7 +27,6 @@ using test::kScenes;
 
 namespace {
 
-
 Particles<3>& particlesOf(Simulation<3>& sim, const std::string& name) {
   return *sim.world().get<Particles<3>>(*sim.world().find(name));
 }
@@ -178,9 +177,7 @@ TEST(DeformableSurfaceCollisions, FoldedSheetDoesNotPassThroughItself) {
 // Fig. 4.4 reduced to 0.32 s (all bodies dropped from 0.25–0.3 m) and coarser tori: the balls
 // and tori fall onto the cloth and are caught; no rigid body centre or torus particle passes through the cloth in any step, every
 // collision pass ends collision-free, and the balls come to lie on the cloth (above the frame
-// level minus the sag, below where they started). The cloth keeps the scene's edge length: the
-// rigid balls touch only its particles, and with 0.1 m edges a ball of radius 0.07 m slips
-// through a cell (surface_crossings counted it).
+// level minus the sag, below where they started).
 TEST(DeformableSurfaceCollisions, TrampolineCatchesBallsAndToriWithoutPassThrough) {
   const Registry registry = builtins();
   Simulation<3> sim(loadScene(kScenes + "trampoline.json",
