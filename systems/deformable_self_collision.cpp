@@ -77,20 +77,12 @@ SurfaceParticles<d>::SurfaceParticles(World<d>& world) {
 }
 
 template <int d>
-void SurfaceParticles<d>::writeVelocities() const {
+void SurfaceParticles<d>::scatter(const std::vector<double>& joined, std::vector<double> Particles<d>::*field) const {
   std::size_t offset = 0;
   for (Particles<d>* p : pools) {
-    std::copy(v.begin() + offset, v.begin() + offset + p->v.size(), p->v.begin());
-    offset += p->v.size();
-  }
-}
-
-template <int d>
-void SurfaceParticles<d>::writePositions() const {
-  std::size_t offset = 0;
-  for (Particles<d>* p : pools) {
-    std::copy(x.begin() + offset, x.begin() + offset + p->x.size(), p->x.begin());
-    offset += p->x.size();
+    std::vector<double>& out = p->*field;
+    std::copy(joined.begin() + offset, joined.begin() + offset + out.size(), out.begin());
+    offset += out.size();
   }
 }
 

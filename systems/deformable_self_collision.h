@@ -50,8 +50,11 @@ struct SurfaceParticles {
   std::vector<Particles<d>*> pools;
   std::vector<double> x, v, inverseMass;
   explicit SurfaceParticles(World<d>& world);
-  void writeVelocities() const;
-  void writePositions() const;
+  void writeVelocities() const { scatter(v, &Particles<d>::v); }
+  void writePositions() const { scatter(x, &Particles<d>::x); }
+
+ private:
+  void scatter(const std::vector<double>& joined, std::vector<double> Particles<d>::*field) const;
 };
 
 template <int d>
