@@ -195,6 +195,7 @@ void registerDimension(Registry& r) {
   r.addSystem<d>({"joint_pd_control", "Step III.2 (Sec. 4.5): PD drive of revolute joints as impulses",
                   [] { return single<JointPdControl<d>>(); }, ""});
   registerParticleCollisionSystems<d>(r);
+  registerRigidSurfaceCollisionSystems<d>(r);
   r.addSystem<d>({"rigid_contact",
                   "Steps II-V contact (Sec. 4.4-4.7, App. B): collisions, contact, shock_propagation, "
                   "resolve_interpenetration, velocity_contact",

@@ -9,6 +9,7 @@
 #include "solvers/deformable/cloth.h"
 #include "systems/cloth_dynamics.h"
 #include "systems/deformable_self_collision.h"
+#include "systems/rigid_surface_contact.h"
 
 namespace monolith {
 
@@ -112,7 +113,23 @@ void registerSurfaceCollision(Registry& r) {
 }
 
 template <int d>
+void registerRigidSurfaceCollisionSystems(Registry& r) {
+  r.addSystem<d>({"rigid_surface_collisions",
+                  "Step II (Sec. 4.4) rigid bodies against the faces of colliding surfaces, two-way, restitution zero, "
+                  "Coulomb friction",
+                  [] { return makeRigidSurfaceContactSystems<d>({Stage::Collisions}); }, ""});
+}
+
+template <int d>
 void registerSelfCollisionSystems(Registry& r) {
+  r.addSystem<d>({"rigid_surface_contact",
+                  "rigid bodies against the faces of colliding surfaces (a body's deepest point in each nearby cloth or "
+                  "surface triangle, impulses on the face's particles by barycentric weights): Steps III (steering), IV "
+                  "(push-out) and V (two-way)",
+                  [] {
+                    return makeRigidSurfaceContactSystems<d>({Stage::Contact, Stage::AdvancePositions, Stage::AdvanceVelocity});
+                  },
+                  ""});
   r.addSystem<d>({"deformable_self_collisions",
                   "deformable-deformable and self collisions (Bridson et al. 2002): proximity repulsion and "
                   "continuous collision passes at Step II, collision passes again at Step III; surface_crossings counts "
@@ -142,6 +159,8 @@ void registerClothSystems(Registry& r) {
 
 template void registerSurfaceCollision<2>(Registry&);
 template void registerSurfaceCollision<3>(Registry&);
+template void registerRigidSurfaceCollisionSystems<2>(Registry&);
+template void registerRigidSurfaceCollisionSystems<3>(Registry&);
 template void registerSelfCollisionSystems<2>(Registry&);
 template void registerSelfCollisionSystems<3>(Registry&);
 

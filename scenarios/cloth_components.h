@@ -11,6 +11,10 @@ void registerClothComponents(Registry& r);
 void registerClothSystems(Registry& r);
 template <int d>
 void registerSurfaceCollision(Registry& r);
+// Step II of the rigid bodies against surface faces: registered with the particles' Step II,
+// before the rigid contact (whose workspace carries the bodies' velocities from its Step II on).
+template <int d>
+void registerRigidSurfaceCollisionSystems(Registry& r);
 // Registered after the deformables' systems: each runs after particle contact in its stage.
 template <int d>
 void registerSelfCollisionSystems(Registry& r);

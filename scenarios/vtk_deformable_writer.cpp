@@ -1,8 +1,10 @@
 #include "scenarios/vtk_deformable_writer.h"
 
+#include <Eigen/Eigenvalues>
 #include <iomanip>
 #include <sstream>
 
+#include "components/cloth.h"
 #include "components/deformable.h"
 #include "scenarios/vtk_writer.h"
 #include "systems/deformable_dynamics.h"
@@ -19,6 +21,21 @@ void appendArray(std::ostringstream& x, const char* type, const char* name, int 
     << "\" format=\"ascii\">\n          ";
   for (const T& q : v) x << q << ' ';
   x << "\n        </DataArray>\n";
+}
+
+// A cloth triangle's in-plane stretches: the singular values of F = Ds Dm^-1 (3 x 2), Dm the rest
+// edges in an orthonormal basis of the rest triangle's plane.
+Eigen::Vector2d triangleStretches(const double* x, const double* restX, const int* t) {
+  auto at = [](const double* a, int i) { return Eigen::Vector3d(a[3 * i], a[3 * i + 1], a[3 * i + 2]); };
+  const Eigen::Vector3d e1 = at(restX, t[1]) - at(restX, t[0]), e2 = at(restX, t[2]) - at(restX, t[0]);
+  const Eigen::Vector3d t1 = e1.normalized(), t2 = (e2 - e2.dot(t1) * t1).normalized();
+  Eigen::Matrix2d Dm;
+  Dm << e1.dot(t1), e2.dot(t1), 0, e2.dot(t2);
+  Eigen::Matrix<double, 3, 2> Ds;
+  Ds << at(x, t[1]) - at(x, t[0]), at(x, t[2]) - at(x, t[0]);
+  const Eigen::Matrix<double, 3, 2> F = Ds * Dm.inverse();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(F.transpose() * F);
+  return eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
 }
 
 template <int d>
@@ -67,6 +84,22 @@ void writeDeformableFrame(const World<d>& world, const std::string& path) {
               U * dm::diagonalStress<d>(fm.model, fm.lame, s, fm.clamp).asDiagonal() * V.transpose();
           mises.push_back(vonMises<d>(P * F.transpose() / J));
         } else {
+          mises.push_back(0.0);
+        }
+      }
+    }
+    if constexpr (d == 3) {
+      // Cloth: its triangles, with the area ratio as volume_ratio and the largest in-plane
+      // |stretch - 1| as strain; springs have no constitutive stress (von_mises 0).
+      if (const ClothMesh* cloth = world.template get<ClothMesh>(e)) {
+        for (int c = 0; c < cloth->triangleCount(); ++c) {
+          const int* t = &cloth->triangles[3 * c];
+          for (int k2 = 0; k2 < 3; ++k2) connectivity.push_back(base + t[k2]);
+          offsets.push_back(static_cast<long>(connectivity.size()));
+          types.push_back(5);  // VTK_TRIANGLE
+          const Eigen::Vector2d s = triangleStretches(p.x.data(), cloth->restX.data(), t);
+          volumeRatio.push_back(s(0) * s(1));
+          strain.push_back((s.array() - 1).abs().maxCoeff());
           mises.push_back(0.0);
         }
       }

@@ -67,16 +67,32 @@ std::vector<double> SurfaceCache<d>::positions(World<d>& world) const {
 }
 
 template <int d>
+SurfaceParticles<d>::SurfaceParticles(World<d>& world) {
+  world.template each<Particles<d>, SurfaceCollision>([&](Entity, Particles<d>& p, SurfaceCollision&) {
+    pools.push_back(&p);
+    x.insert(x.end(), p.x.begin(), p.x.end());
+    v.insert(v.end(), p.v.begin(), p.v.end());
+    for (int i = 0; i < p.count(); ++i) inverseMass.push_back(p.fixed[i] ? 0.0 : 1 / p.m[i]);
+  });
+}
+
+template <int d>
+void SurfaceParticles<d>::scatter(const std::vector<double>& joined, std::vector<double> Particles<d>::*field) const {
+  std::size_t offset = 0;
+  for (Particles<d>* p : pools) {
+    std::vector<double>& out = p->*field;
+    std::copy(joined.begin() + offset, joined.begin() + offset + out.size(), out.begin());
+    offset += out.size();
+  }
+}
+
+template <int d>
 void DeformableSelfCollision<d>::run(World<d>& world, StepContext& ctx) {
   const dm::CollisionSurface<d>& surface = surfaces_.get(world);
-  std::vector<Particles<d>*> particles;
-  world.template each<Particles<d>, SurfaceCollision>(
-      [&](Entity, Particles<d>& p, SurfaceCollision&) { particles.push_back(&p); });
-  std::vector<double> x = surfaces_.positions(world), v, inverseMass;
-  for (const Particles<d>* p : particles) {
-    v.insert(v.end(), p->v.begin(), p->v.end());
-    for (int i = 0; i < p->count(); ++i) inverseMass.push_back(p->fixed[i] ? 0.0 : 1 / p->m[i]);
-  }
+  SurfaceParticles<d> particles(world);
+  const std::vector<double>& x = particles.x;
+  std::vector<double>& v = particles.v;
+  const std::vector<double>& inverseMass = particles.inverseMass;
   if (stage_ == Stage::Contact && v == *afterCollisions_) return;  // Step II's result stands
   const dm::ProximitySettings settings;
   auto& out = ctx.diagnostics;
@@ -89,11 +105,7 @@ void DeformableSelfCollision<d>::run(World<d>& world, StepContext& ctx) {
   out.max("self_collision_passes", c.passes);
   out.max("self_collision_remaining", c.remaining);
   if (stage_ == Stage::Collisions) *afterCollisions_ = v;
-  std::size_t offset = 0;
-  for (Particles<d>* p : particles) {
-    std::copy(v.begin() + offset, v.begin() + offset + p->v.size(), p->v.begin());
-    offset += p->v.size();
-  }
+  particles.writeVelocities();
 }
 
 template <int d>
@@ -113,6 +125,8 @@ void SurfaceCrossings<d>::run(World<d>& world, StepContext& ctx) {
 
 template class SurfaceCache<2>;
 template class SurfaceCache<3>;
+template struct SurfaceParticles<2>;
+template struct SurfaceParticles<3>;
 template class DeformableSelfCollision<2>;
 template class DeformableSelfCollision<3>;
 template class SurfaceCrossings<2>;

@@ -42,6 +42,21 @@ class SurfaceCache {
   solvers::deformable::CollisionSurface<d> surface_;
 };
 
+// The colliding bodies' particles joined in pool order (the indices of SurfaceCache's surface):
+// positions, velocities and inverse masses (zero for fixed and bound particles); the changed
+// velocities or positions are written back to the bodies' Particles.
+template <int d>
+struct SurfaceParticles {
+  std::vector<Particles<d>*> pools;
+  std::vector<double> x, v, inverseMass;
+  explicit SurfaceParticles(World<d>& world);
+  void writeVelocities() const { scatter(v, &Particles<d>::v); }
+  void writePositions() const { scatter(x, &Particles<d>::x); }
+
+ private:
+  void scatter(const std::vector<double>& joined, std::vector<double> Particles<d>::*field) const;
+};
+
 template <int d>
 class DeformableSelfCollision final : public System<d> {
  public:

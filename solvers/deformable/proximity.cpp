@@ -10,6 +10,7 @@
 #include <tbb/partitioner.h>
 
 #include "solvers/deformable/elasticity.h"
+#include "solvers/deformable/face_geometry.h"
 
 namespace monolith::solvers::deformable {
 
@@ -40,39 +41,6 @@ VecD<d> at(const std::vector<double>& x, int i) {
   return Eigen::Map<const VecD<d>>(&x[d * i]);
 }
 
-// Ericson, Real-Time Collision Detection, 5.1.5: barycentric coordinates of the closest point.
-Eigen::Vector3d closestOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                  const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return {0, 1, 0};
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-    const double v = d1 / (d1 - d3);
-    return {1 - v, v, 0};
-  }
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return {0, 0, 1};
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-    const double w = d2 / (d2 - d6);
-    return {1 - w, 0, w};
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return {0, 1 - w, w};
-  }
-  const double denom = 1 / (va + vb + vc);
-  const double v = vb * denom, w = vc * denom;
-  return {1 - v - w, v, w};
-}
-
-double clamp01(double s) { return s < 0 ? 0 : s > 1 ? 1 : s; }
 
 // Ericson 5.1.9: parameters s, t of the closest points of segments p1 q1 and p2 q2.
 void closestSegmentSegment(const Eigen::Vector3d& p1, const Eigen::Vector3d& q1, const Eigen::Vector3d& p2,
@@ -130,8 +98,7 @@ Stencil<d> stencilOf(const CollisionSurface<d>& s, const Pair& pair, X pos) {
       fallback = (b - a).cross(c - a);
     } else {
       const VecD<2> a = pos(f[0]), b = pos(f[1]);
-      const double len2 = (b - a).squaredNorm();
-      const double t = len2 > 0 ? clamp01((p - a).dot(b - a) / len2) : 0.0;
+      const double t = closestOnSegment<2>(p, a, b);
       st.idx[1] = f[0];
       st.idx[2] = f[1];
       st.w[1] = -(1 - t);

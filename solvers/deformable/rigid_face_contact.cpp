@@ -1,0 +1,244 @@
+#include "solvers/deformable/rigid_face_contact.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "solvers/collision/collision_impl.h"
+#include "solvers/contact/rigid_math.h"
+#include "solvers/deformable/face_geometry.h"
+
+namespace monolith::solvers::deformable {
+
+namespace col = solvers::collision;
+namespace ct = solvers::contact;
+
+namespace {
+
+template <int d>
+using Vec = Eigen::Matrix<double, d, 1>;
+template <int d>
+using Mat = Eigen::Matrix<double, d, d>;
+
+// Alternating projections from one seed: at most this many face points per seed.
+constexpr int kProjections = 4;
+
+// The face point closest to q, with its weights.
+template <int d>
+Vec<d> closestFacePoint(const Vec<d>* p, const Vec<d>& q, double* weights) {
+  if constexpr (d == 3) {
+    const Eigen::Vector3d b = closestOnTriangle(q, p[0], p[1], p[2]);
+    for (int k = 0; k < 3; ++k) weights[k] = b(k);
+    return b(0) * p[0] + b(1) * p[1] + b(2) * p[2];
+  } else {
+    const double t = closestOnSegment<2>(q, p[0], p[1]);
+    weights[0] = 1 - t;
+    weights[1] = t;
+    return (1 - t) * p[0] + t * p[1];
+  }
+}
+
+template <int d>
+Vec<d> at(const std::vector<double>& x, int i) {
+  return Eigen::Map<const Vec<d>>(&x[d * i]);
+}
+
+template <int d>
+Box<d> faceBox(const std::vector<double>& x, const int* f, double pad) {
+  Box<d> b;
+  b.lo = b.hi = at<d>(x, f[0]);
+  for (int k = 1; k < d; ++k) {
+    b.lo = b.lo.cwiseMin(at<d>(x, f[k]));
+    b.hi = b.hi.cwiseMax(at<d>(x, f[k]));
+  }
+  b.lo.array() -= pad;
+  b.hi.array() += pad;
+  return b;
+}
+
+// The impulse j on the face point (minus on the body) that stops an approach u.n < 0, with
+// Coulomb friction mu (sticking inside the cone, else sliding on its edge); K the relative
+// velocity change per unit impulse.
+template <int d>
+Vec<d> stoppingImpulse(const Mat<d>& K, const Vec<d>& u, const Vec<d>& n, double mu) {
+  const double vn = u.dot(n);
+  const Vec<d> stick = K.lu().solve(-u);
+  const double jn = stick.dot(n);
+  if ((stick - jn * n).norm() <= mu * jn) return stick;
+  const Vec<d> ut = u - vn * n;
+  const Vec<d> t = ut.norm() > 0 ? Vec<d>(ut.normalized()) : Vec<d>::Zero();
+  const Vec<d> dir = n - mu * t;
+  const double denom = n.dot(K * dir);
+  if (denom > 0) return (-vn / denom) * dir;
+  return (-vn / n.dot(K * n)) * n;
+}
+
+}  // namespace
+
+template <int d>
+FaceContact<d> deepestFacePoint(const RigidFaceBody<d>& body, const Vec<d>* p) {
+  FaceContact<d> best;
+  best.distance = std::numeric_limits<double>::infinity();
+  const col::PreparedGeometry<d>& g = *body.geometry;
+  // Distances are needed beyond the contact range while the projections walk: exact out to the
+  // body's size (a polytope's value farther than the limit may be a lower bound only).
+  const double limit = 4 * g.boundingRadius();
+  col::Pose<d> pose;
+  pose.x = body.x;
+  pose.R = body.R;
+  Vec<d> centroid = Vec<d>::Zero();
+  for (int k = 0; k < d; ++k) centroid += p[k] / d;
+  thread_local std::vector<col::FeaturePoint<d>> seeds;
+  seeds.clear();
+  seeds.push_back({body.x, 0.0});
+  col::featurePoints<d>(g, pose, Vec<d>(centroid - body.x), seeds);
+  double w[d];
+  for (const auto& seed : seeds) {
+    Vec<d> target = seed.x;
+    for (int it = 0; it < kProjections; ++it) {
+      const Vec<d> q = closestFacePoint<d>(p, target, w);
+      const col::SurfaceDistance<d> s = col::signedDistance<d>(g, Vec<d>(body.R.transpose() * (q - body.x)), limit);
+      if (s.distance < best.distance) {
+        best.distance = s.distance;
+        best.point = q;
+        best.normal = body.R * s.normal;
+        std::copy(w, w + d, best.weights);
+      }
+      const Vec<d> next = body.R * s.surfacePoint + body.x;
+      if ((next - target).squaredNorm() <= 1e-24 * (1 + next.squaredNorm())) break;
+      target = next;
+    }
+  }
+  return best;
+}
+
+template <int d>
+std::vector<FaceContact<d>> findFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces,
+                                             Bvh<d>& tree) {
+  const int nf = faces.faceCount();
+  const std::vector<int>& f = *faces.faces;
+  std::vector<Box<d>> boxes(nf);
+  for (int k = 0; k < nf; ++k) {
+    double pad = 0;
+    for (int a = 0; a < d; ++a) pad = std::max(pad, (*faces.thickness)[f[d * k + a]]);
+    boxes[k] = faceBox<d>(*faces.x, &f[d * k], pad);
+  }
+  if (static_cast<int>(tree.size()) != nf) tree.build(boxes);
+  else tree.refit(boxes);
+  std::vector<FaceContact<d>> out;
+  std::vector<int> hits;
+  for (int bi = 0; bi < static_cast<int>(bodies.size()); ++bi) {
+    const RigidFaceBody<d>& body = bodies[bi];
+    // Half-spaces are left to the particle contact: a flat face's deepest point in a half-space is
+    // one of its vertices. Meshes have no inside.
+    if (body.geometry->unbounded() || body.geometry->geometry().type == col::GeometryType::Mesh) continue;
+    col::Pose<d> pose;
+    pose.x = body.x;
+    pose.R = body.R;
+    const auto bounds = col::worldBounds<d>(*body.geometry, pose);
+    Box<d> query;
+    query.lo = bounds.min();
+    query.hi = bounds.max();
+    hits.clear();
+    tree.query(query, hits);
+    std::sort(hits.begin(), hits.end());
+    for (int face : hits) {
+      Vec<d> p[d];
+      double thickness = 0, friction = body.friction;
+      for (int a = 0; a < d; ++a) {
+        const int i = f[d * face + a];
+        p[a] = at<d>(*faces.x, i);
+        thickness = std::max(thickness, (*faces.thickness)[i]);
+        friction = std::max(friction, (*faces.friction)[i]);
+      }
+      FaceContact<d> c = deepestFacePoint<d>(body, p);
+      if (!(c.distance < thickness)) continue;
+      c.body = bi;
+      c.face = face;
+      c.thickness = thickness;
+      c.friction = friction;
+      out.push_back(c);
+    }
+  }
+  return out;
+}
+
+template <int d>
+int applyFaceContactImpulses(std::vector<RigidFaceBody<d>>& bodies, FaceSet<d>& faces,
+                             const std::vector<FaceContact<d>>& contacts, int sweeps) {
+  const std::vector<int>& f = *faces.faces;
+  std::vector<double>& v = *faces.v;
+  const std::vector<double>& w = *faces.inverseMass;
+  int impulses = 0;
+  const int n = static_cast<int>(contacts.size());
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    for (int k = 0; k < n; ++k) {
+      const FaceContact<d>& c = contacts[sweep % 2 == 0 ? k : n - 1 - k];
+      RigidFaceBody<d>& b = bodies[c.body];
+      const int* idx = &f[d * c.face];
+      double faceInverseMass = 0;
+      Vec<d> faceV = Vec<d>::Zero();
+      for (int a = 0; a < d; ++a) {
+        faceInverseMass += c.weights[a] * c.weights[a] * w[idx[a]];
+        faceV += c.weights[a] * at<d>(v, idx[a]);
+      }
+      const Vec<d> r = c.point - b.x;
+      const Vec<d> u = faceV - (b.v + ct::angularCross<d>(b.omega, r));
+      if (u.dot(c.normal) >= 0) continue;
+      Mat<d> K = faceInverseMass * Mat<d>::Identity();
+      for (int a = 0; a < d; ++a) {
+        const Vec<d> e = Vec<d>::Unit(a);
+        K.col(a) += b.inverseMass * e + ct::angularCross<d>(AngularD<d>(b.inverseInertia * ct::cross<d>(r, e)), r);
+      }
+      if (!(K.norm() > 0)) continue;  // both sides immovable
+      const Vec<d> j = stoppingImpulse<d>(K, u, c.normal, c.friction);
+      for (int a = 0; a < d; ++a)
+        Eigen::Map<Vec<d>>(&v[d * idx[a]]) += (c.weights[a] * w[idx[a]]) * j;
+      if (b.inverseMass > 0) {
+        b.v -= b.inverseMass * j;
+        b.omega -= b.inverseInertia * ct::cross<d>(r, j);
+        b.impulse -= j;
+        b.angularImpulse -= ct::cross<d>(r, j);
+      }
+      ++impulses;
+    }
+  }
+  return impulses;
+}
+
+template <int d>
+double pushFacesOut(const std::vector<FaceContact<d>>& contacts, const std::vector<int>& faces,
+                    const std::vector<double>& inverseMass, std::vector<double>& x) {
+  double deepest = 0;
+  for (const FaceContact<d>& c : contacts) {
+    const int* idx = &faces[d * c.face];
+    // The point's depth now: faces pushed before this one may have moved its particles already.
+    Vec<d> q = Vec<d>::Zero();
+    double weight = 0;
+    for (int a = 0; a < d; ++a) {
+      q += c.weights[a] * at<d>(x, idx[a]);
+      weight += c.weights[a] * c.weights[a] * inverseMass[idx[a]];
+    }
+    const double depth = -(c.distance + (q - c.point).dot(c.normal));
+    if (depth <= 0 || weight <= 0) continue;
+    deepest = std::max(deepest, depth);
+    for (int a = 0; a < d; ++a)
+      Eigen::Map<Vec<d>>(&x[d * idx[a]]) += (c.weights[a] * inverseMass[idx[a]] / weight * depth) * c.normal;
+  }
+  return deepest;
+}
+
+#define MONOLITH_INSTANTIATE(D)                                                                                   \
+  template FaceContact<D> deepestFacePoint<D>(const RigidFaceBody<D>&, const Vec<D>*);                            \
+  template std::vector<FaceContact<D>> findFaceContacts<D>(const std::vector<RigidFaceBody<D>>&, const FaceSet<D>&, \
+                                                           Bvh<D>&);                                              \
+  template int applyFaceContactImpulses<D>(std::vector<RigidFaceBody<D>>&, FaceSet<D>&,                           \
+                                           const std::vector<FaceContact<D>>&, int);                              \
+  template double pushFacesOut<D>(const std::vector<FaceContact<D>>&, const std::vector<int>&,                    \
+                                  const std::vector<double>&, std::vector<double>&);
+MONOLITH_INSTANTIATE(2)
+MONOLITH_INSTANTIATE(3)
+#undef MONOLITH_INSTANTIATE
+
+}  // namespace monolith::solvers::deformable

@@ -1,0 +1,93 @@
+#include "systems/rigid_surface_contact.h"
+
+#include <Eigen/Geometry>
+
+#include "solvers/rigid_rotation.h"
+
+namespace monolith {
+
+namespace dm = solvers::deformable;
+
+namespace {
+
+constexpr int kContactSweeps = 4;
+
+// The bodies with a collider at their current pose (candidateDt = 0) or their candidate pose
+// x + dt v, R advanced by exp(dt w); dynamic ones movable when `twoWay`.
+template <int d>
+std::vector<dm::RigidFaceBody<d>> rigidFaceBodies(World<d>& world, PreparedShapes<d>& shapes, double candidateDt,
+                                                  bool twoWay, std::vector<RigidBody<d>*>& owners) {
+  std::vector<dm::RigidFaceBody<d>> out;
+  owners.clear();
+  world.template each<RigidBody<d>, Shape<d>, Collider<d>>([&](Entity e, RigidBody<d>& b, Shape<d>& s, Collider<d>& c) {
+    dm::RigidFaceBody<d> v;
+    v.geometry = &shapes.get(e, s);
+    v.friction = c.friction;
+    v.R = b.rotation();
+    v.x = b.x;
+    if (!b.isStatic) {
+      v.v = b.v;
+      v.omega = b.omega();
+      if (candidateDt > 0) {
+        v.x += candidateDt * b.v;
+        if constexpr (d == 3) v.R = (solvers::rotationExponential(candidateDt * v.omega) * b.orientation).toRotationMatrix();
+        else v.R = Eigen::Rotation2Dd(b.orientation + candidateDt * v.omega(0)).toRotationMatrix();
+      }
+      if (twoWay && !world.template has<KinematicMotion<d>>(e)) {
+        v.inverseMass = 1 / b.mass;
+        v.inverseInertia = b.worldInverseInertia();
+      }
+    }
+    out.push_back(v);
+    owners.push_back(&b);
+  });
+  return out;
+}
+
+}  // namespace
+
+template <int d>
+void RigidSurfaceContact<d>::run(World<d>& world, StepContext& ctx) {
+  const bool candidate = stage_ == Stage::Collisions || stage_ == Stage::Contact;
+  const bool twoWay = stage_ == Stage::Collisions || stage_ == Stage::AdvanceVelocity;
+  std::vector<RigidBody<d>*> owners;
+  std::vector<dm::RigidFaceBody<d>> bodies = rigidFaceBodies(world, shapes_, candidate ? ctx.dt : 0.0, twoWay, owners);
+  if (bodies.empty()) return;
+  const dm::CollisionSurface<d>& surface = surfaces_.get(world);
+  SurfaceParticles<d> particles(world);
+  std::vector<double> at = particles.x;
+  if (candidate)
+    for (std::size_t i = 0; i < at.size(); ++i) at[i] += ctx.dt * particles.v[i];
+  dm::FaceSet<d> faces{&surface.faces, &at, &particles.v, &particles.inverseMass, &surface.thickness, &surface.friction};
+  const std::vector<dm::FaceContact<d>> contacts = dm::findFaceContacts<d>(bodies, faces, tree_);
+  if (stage_ == Stage::AdvancePositions) {
+    const double deepest = dm::pushFacesOut<d>(contacts, surface.faces, particles.inverseMass, particles.x);
+    ctx.diagnostics.max("rigid_surface_push_out_depth", deepest);
+    if (deepest > 0) particles.writePositions();
+    return;
+  }
+  const int impulses = dm::applyFaceContactImpulses<d>(bodies, faces, contacts, kContactSweeps);
+  ctx.diagnostics.set(name() + "_impulses", impulses);
+  if (impulses == 0) return;
+  particles.writeVelocities();
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    if (bodies[k].inverseMass == 0) continue;
+    owners[k]->v += bodies[k].impulse / owners[k]->mass;
+    owners[k]->L += bodies[k].angularImpulse;
+  }
+}
+
+template <int d>
+std::vector<std::unique_ptr<System<d>>> makeRigidSurfaceContactSystems(const std::vector<Stage>& stages) {
+  std::vector<std::unique_ptr<System<d>>> out;
+  for (Stage s : stages)
+    out.push_back(std::make_unique<RigidSurfaceContact<d>>(s));
+  return out;
+}
+
+template class RigidSurfaceContact<2>;
+template class RigidSurfaceContact<3>;
+template std::vector<std::unique_ptr<System<2>>> makeRigidSurfaceContactSystems<2>(const std::vector<Stage>&);
+template std::vector<std::unique_ptr<System<3>>> makeRigidSurfaceContactSystems<3>(const std::vector<Stage>&);
+
+}  // namespace monolith
