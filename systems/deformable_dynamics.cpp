@@ -1,5 +1,7 @@
 #include "systems/deformable_dynamics.h"
 
+#include <cmath>
+
 #include "components/cloth.h"
 #include "components/fluid_coupling.h"
 #include "systems/particle_contact.h"
@@ -208,7 +210,12 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
         for (int a = 0; a < d; ++a) p.v[d * i + a] += 0.5 * ctx.dt * g(a);
   });
   ctx.diagnostics.max(half ? "deformable_cg_iterations_half" : "deformable_cg_iterations", iterations);
-  if (half) ctx.diagnostics.set("deformable_stable_dt", unitCflDt(world));
+  // Without a tetrahedral or triangle solid (cloth only) there is no elastic limit: the
+  // stable step is infinite and not reported, since the run's guard refuses non-finite values.
+  if (half) {
+    const double stableDt = unitCflDt(world);
+    if (std::isfinite(stableDt)) ctx.diagnostics.set("deformable_stable_dt", stableDt);
+  }
 }
 
 template <int d>
