@@ -664,7 +664,7 @@ void ResolveInterpenetration<d>::run(World<d>& world, StepContext& ctx) {
   // partner, a dynamic body just outside the rings that could have given way. The joint solve
   // then has no move that separates the jam, and its least-norm answer slides a body sideways
   // by up to metres, which the bound on a pass's move scales down to nothing (2-D random drop
-  // 1227: a 5.8 kg box sunk into the ground under a stack clamped by a 41 kg disk one ring too
+  // 1227: a 5.8 kg box sunk into the ground under a stack clamped by a dynamic body one ring too
   // far, 5.3 % deep after seven passes; 2.0 % with four rings). Steps that end shallower than
   // that never get here.
   int jointSolves = 0, regrowths = 0;

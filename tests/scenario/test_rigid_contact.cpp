@@ -665,11 +665,11 @@ TEST(JointPushOut, ATurnCostsWhatMovingItsFarthestPointWould) {
 TEST(JointPushOut, AJamClampedFromOutsideItsRingsIsSolvedAgainWithMoreRings) {
   // random_drop_2d_1227 on the short schedule, the first 80 steps (dt 1/120; 19 bodies of
   // 0.06-41 kg between two walls). At step 74 a 5.8 kg box lying on the ground is sunk 1.4 cm
-  // into it under a polygon, which lies under a 28 kg disk, which a 41 kg disk outside the jam's
+  // into it under a polygon, which lies under a 28 kg disk, which a dynamic body outside the jam's
   // two rings holds down: no move of the jam lifts the box, the joint solve's least-norm answer
-  // slides bodies sideways by up to 1.6 m, the bound on a pass's move scales that to millimetres,
+  // asks for moves of up to 2.2 m, the bound on a pass's move scales that to millimetres,
   // and the step ends 5.33 % deep (no regrowth: push_out_joint_regrow_overlap 1). Solved again
-  // with four rings the 41 kg disk is in the jam and gives way.
+  // with four rings that body is in the jam and gives way.
   const Registry registry = builtins();
   auto run = [&](const std::string& regrowFrom) {
     Simulation<2> sim(loadScene(kScenes + "random_drop_2d_1227.json",
