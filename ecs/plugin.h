@@ -16,7 +16,8 @@
 namespace monolith {
 
 // Bump whenever a type crossing the plugin boundary changes layout or meaning.
-inline constexpr std::uint32_t kPluginAbiVersion = 5;  // 2: Stage::Advection inserted; 3, 4: ContactSettings grew; 5: PoolBase::fieldLayout
+inline constexpr std::uint32_t kPluginAbiVersion = 6;  // 2: Stage::Advection inserted; 3, 4, 6: ContactSettings grew;
+                                                       // 5: PoolBase::fieldLayout
 
 struct PluginAbi {
   std::uint32_t abiVersion;

@@ -470,6 +470,8 @@ void parseContactSettings(const Config& c, ContactSettings& s) {
   s.pushOutRoundOverlap = c.number("push_out_round_overlap", s.pushOutRoundOverlap, Bound::NonNegative);
   s.pushOutJoint = c.boolean("push_out_joint", s.pushOutJoint);
   s.pushOutJointOverlap = c.number("push_out_joint_overlap", s.pushOutJointOverlap, Bound::NonNegative);
+  s.pushOutJointRegrowOverlap =
+      c.number("push_out_joint_regrow_overlap", s.pushOutJointRegrowOverlap, Bound::NonNegative);
   s.velocityContact = c.boolean("velocity_contact", s.velocityContact);
   s.energyClamp = c.boolean("energy_clamp", s.energyClamp);
   s.stepEnergyClamp = c.boolean("step_energy_clamp", s.stepEnergyClamp);

@@ -148,10 +148,12 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   int growAndMeasure(ContactWorkspace<d>& ws);
   // The jam left after the rounds pushed apart at once (solvers/contact/joint_push_out.h), pass
   // by pass while each leaves its pairs shallower. Returns the passes kept; adds to newPairs.
-  int pushJamsApart(ContactWorkspace<d>& ws, int& newPairs);
+  // The jam is the deep pairs' bodies and `rings` rings of their dynamic neighbours.
+  int pushJamsApart(ContactWorkspace<d>& ws, int rings, int& newPairs);
   static constexpr int kJointPasses = 16;  // linearisations, at most
   static constexpr int kJointHalvings = 3;  // of a pass's step that leaves the jam no shallower
   static constexpr int kJointRings = 2;    // neighbours of neighbours of the deep pairs' bodies
+  static constexpr int kJointRegrowths = 3;  // solves again with 4, 8, 16 rings, at most
   std::vector<char> jamRing_, jamNext_;    // the bodies a ring grows from, and those it adds
   static constexpr int kJointSweeps = 2000;  // Gauss-Seidel sweeps per linearisation, at most
   std::vector<int> jamIndex_;  // per body: its index in the joint solve, or -1 (a fixed partner)

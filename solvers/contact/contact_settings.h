@@ -43,6 +43,10 @@ struct ContactSettings {
   // thesis), pass by pass while each leaves them shallower.
   bool pushOutJoint = true;
   double pushOutJointOverlap = 0.05;
+  // ... and where a jam is still deeper than pushOutJointRegrowOverlap after its passes, it is
+  // solved again with more rings of neighbours (systems/interpenetration.cpp), so that what
+  // clamps it can give way. The thesis schedule's equals its start (5 %), the campaigns' bound.
+  double pushOutJointRegrowOverlap = 0.05;
   bool velocityContact = true;       // second contact step in Step V (Sec. 2.3.2 "Contact Clamping")
   bool energyClamp = true;           // Sec. 2.3.2 for collisions and the second contact step
   // After Step V, an island of bodies moved only by gravity and contact whose energy (kinetic +
@@ -81,6 +85,7 @@ struct ContactSettings {
     stepEnergyClamp = true;
     closeGaps = true;
     pushOutJointOverlap = 0.02;
+    pushOutJointRegrowOverlap = 0.03;
   }
   // The thesis code's schedule (the defaults above): ten epsilon-ramped contact sweeps of two
   // level passes, two shock-propagation passes, manifold solves by sweeps alone, no gap closing,
@@ -93,6 +98,7 @@ struct ContactSettings {
     stepEnergyClamp = false;
     closeGaps = false;
     pushOutJointOverlap = 0.05;
+    pushOutJointRegrowOverlap = 0.05;
   }
 };
 

@@ -662,6 +662,36 @@ TEST(JointPushOut, ATurnCostsWhatMovingItsFarthestPointWould) {
   EXPECT_LT(deepest, 0.05);  // measured 1.3 % (step 27)
 }
 
+TEST(JointPushOut, AJamClampedFromOutsideItsRingsIsSolvedAgainWithMoreRings) {
+  // random_drop_2d_1227 on the short schedule, the first 80 steps (dt 1/120; 19 bodies of
+  // 0.06-41 kg between two walls). At step 74 a 5.8 kg box lying on the ground is sunk 1.4 cm
+  // into it under a polygon, which lies under a 28 kg disk, which a dynamic body outside the jam's
+  // two rings holds down: no move of the jam lifts the box, the joint solve's least-norm answer
+  // asks for moves of up to 2.2 m, the bound on a pass's move scales that to millimetres,
+  // and the step ends 5.33 % deep (no regrowth: push_out_joint_regrow_overlap 1). Solved again
+  // with four rings that body is in the jam and gives way.
+  const Registry registry = builtins();
+  auto run = [&](const std::string& regrowFrom) {
+    Simulation<2> sim(loadScene(kScenes + "random_drop_2d_1227.json",
+                                {{"solvers.contact.schedule", "short"},
+                                 {"solvers.contact.push_out_joint_regrow_overlap", regrowFrom}}),
+                      registry);
+    double deepest = 0, regrowths = 0;
+    for (int step = 0; step < 80; ++step) {
+      const auto diag = sim.step();
+      deepest = std::max(deepest, diag.at("max_penetration_ratio"));
+      regrowths += diag.at("push_out_joint_regrowths");
+    }
+    return std::make_pair(deepest, regrowths);
+  };
+  const auto [without, none] = run("1");
+  const auto [with, regrowths] = run("0.03");  // the short schedule's
+  EXPECT_GT(without, 0.05);  // measured 5.33 % (step 74)
+  EXPECT_EQ(none, 0);
+  EXPECT_LT(with, 0.03);  // measured 1.9 %
+  EXPECT_GT(regrowths, 0);
+}
+
 TEST(PushOutNewOverlaps, APushIntoAnUntouchedNeighbourIsUndoneInTheSameStep) {
   // No gravity, no motion. Sphere C is sunk 5 cm into the static box A; box D sits 1.08 cm above
   // C's shoulder, inside C's bounding box (so the pair is in the broad phase) but not touching,
