@@ -159,7 +159,7 @@ std::vector<FaceError> faceErrors(const TwoPhaseState& state, double epsilon, do
 }  // namespace
 
 OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTime, int points, bool remesh,
-                                             double dtPerDx, bool carryCouplingVelocity) {
+                                             double dtPerDx, bool carryCouplingVelocity, TwoPhaseAdvection advection) {
   const double dx = 1.0 / n, dt = dtPerDx * dx, rhat = 1.0 / 3, omega = 2.0;
   if (points <= 0) points = static_cast<int>(std::lround(2 * M_PI * rhat / dx));
   TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(n, n), dx),
@@ -171,6 +171,7 @@ OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTi
   settings.blowUpSpeed = 10;
   settings.remesh = remesh;
   settings.carryCouplingVelocity = carryCouplingVelocity;
+  settings.advection = advection;
   OscillatingCircleResult r;
   r.points = points;
   const Eigen::Vector2d probe(0.75, 0.5);

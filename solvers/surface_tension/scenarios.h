@@ -67,7 +67,8 @@ struct OscillatingCircleResult {
   bool stable = true;
 };
 OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTime, int points = 0, bool remesh = true,
-                                             double dtPerDx = 0.25, bool carryCouplingVelocity = false);
+                                             double dtPerDx = 0.25, bool carryCouplingVelocity = false,
+                                             TwoPhaseAdvection advection = TwoPhaseAdvection::SemiLagrangian);
 
 // Sec. 6.4.4: [0, 1] x [0, 2] m with n x 2n cells, an air bubble (rho 1e3) of r = 0.2 m at (0.5, 0.5)
 // in water (rho 1e4), mu = 1, sigma = 0.5, g = -8e-4, semi-Lagrangian or ENO/RK3 advection. `steps` steps of dt;

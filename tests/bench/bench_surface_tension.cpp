@@ -77,7 +77,8 @@ int main(int argc, char** argv) {
     // original driver's 2^k at about dx / 4 as in the static circle, with r = 1/3), no_remesh,
     // dt_per_dx=S (dt = S dx; default 1/4), carry (the coupling faces' u* carried on the front),
     // eps=E (repeatable; default 0.05, or the epsilon table's 0.05, 0.025, 0.0125), t_end=T (default
-    // 1.2 pi, past the second zero crossing; with T < 3.3 there is no period, only the errors at t = 0.5).
+    // 1.2 pi, past the second zero crossing; with T < 3.3 there is no period, only the errors at t = 0.5),
+    // advection=none|eno (default semi-Lagrangian).
     // Columns: the relative error as defined (scale eps omega r |sin omega t|), the same max error
     // on the scale eps omega |sin omega t| (without r; see docs/benchmarks_surface_tension.md), and
     // the probe's relative error.
@@ -86,6 +87,7 @@ int main(int argc, char** argv) {
     bool remesh = true;
     double dtPerDx = 0.25, endTime = 1.2 * M_PI;
     bool carry = false;
+    TwoPhaseAdvection advection = TwoPhaseAdvection::SemiLagrangian;
     std::vector<int> ns;
     std::vector<double> epsilons;
     for (int i = 2; i < argc; ++i) {
@@ -97,6 +99,8 @@ int main(int argc, char** argv) {
       else if (a == "carry") carry = true;
       else if (a.rfind("eps=", 0) == 0) epsilons.push_back(std::atof(a.c_str() + 4));
       else if (a.rfind("t_end=", 0) == 0) endTime = std::atof(a.c_str() + 6);
+      else if (a == "advection=none") advection = TwoPhaseAdvection::None;
+      else if (a == "advection=eno") advection = TwoPhaseAdvection::EnoRk3;
       else ns.push_back(std::atoi(a.c_str()));
     }
     if (ns.empty()) ns = eps ? std::vector<int>{50} : std::vector<int>{50, 100};
@@ -113,7 +117,7 @@ int main(int argc, char** argv) {
       for (double epsilon : epsilons) {
         const auto start = std::chrono::steady_clock::now();
         const int p = points >= 0 ? points : 1 << static_cast<int>(std::lround(std::log2(8 * M_PI * n / 3.0)));
-        const OscillatingCircleResult r = runOscillatingCircle(n, epsilon, endTime, p, remesh, dtPerDx, carry);
+        const OscillatingCircleResult r = runOscillatingCircle(n, epsilon, endTime, p, remesh, dtPerDx, carry, advection);
         std::printf("| %d | %g | %.4f | %+.2f %% | %.4e | %.3e | %.3e | %.3e | %d | %d | %.1f |\n", n, epsilon, r.period,
                     100 * (r.period / M_PI - 1), r.probeAtHalf, r.relativeErrorAtHalf, r.relativeErrorAtHalf / 3,
                     r.probeRelativeErrorAtHalf, r.points, r.steps, seconds(start));
