@@ -126,8 +126,8 @@ StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double e
 
 namespace {
 // |u - u_analytic| on every face whose centre lies inside the front, with the face's polar position
-// about the drop's centre and its distance to the front. u_analytic is the linear mode-2 field
-// -eps omega rhat (r / rhat) sin(omega t) (cos(-theta), sin(-theta)) (Sec. 6.4.3).
+// about the drop's centre (angle in radians) and its distance to the front. u_analytic is the
+// linear mode-2 field -eps omega rhat (r / rhat) sin(omega t) (cos(-theta), sin(-theta)) (Sec. 6.4.3).
 struct FaceError {
   double error = 0, radius = 0, angle = 0, distance = 0;
   int axis = 0;
@@ -142,9 +142,9 @@ std::vector<FaceError> faceErrors(const TwoPhaseState& state, double epsilon, do
     FaceError e;
     e.axis = axis;
     e.radius = rel.norm();
-    e.angle = std::atan2(rel.y(), rel.x()) * 180 / M_PI;
+    e.angle = std::atan2(rel.y(), rel.x());
     const double a = -epsilon * omega * rhat * (e.radius / rhat) * std::sin(omega * state.time);
-    const double exact = axis == 0 ? a * std::cos(-e.angle * M_PI / 180) : a * std::sin(-e.angle * M_PI / 180);
+    const double exact = axis == 0 ? a * std::cos(-e.angle) : a * std::sin(-e.angle);
     e.error = std::abs(state.u[f] - exact);
     e.distance = std::numeric_limits<double>::infinity();
     for (const auto& s : state.front.elements) {
@@ -193,14 +193,12 @@ OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTi
       r.probeAtHalf = previousU + w * (u - previousU);
       const double scale = epsilon * omega * rhat * std::abs(std::sin(omega * state.time));
       atHalf = state;
-      double worst = 0;
       for (const FaceError& e : faceErrors(state, epsilon, omega, rhat)) {
-        worst = std::max(worst, e.error);
         if (e.distance >= 2 * dx) r.interiorRelativeErrorAtHalf = std::max(r.interiorRelativeErrorAtHalf, e.error / scale);
         if (e.error / scale > r.relativeErrorAtHalf) {
           r.relativeErrorAtHalf = e.error / scale;
           r.worstRadius = e.radius / rhat;
-          r.worstAngle = e.angle;
+          r.worstAngle = e.angle * 180 / M_PI;
           r.worstDistance = e.distance / dx;
           r.worstAxis = e.axis;
         }
