@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 
 namespace monolith::solvers {
 
@@ -122,8 +124,42 @@ StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double e
   return r;
 }
 
+namespace {
+// |u - u_analytic| on every face whose centre lies inside the front, with the face's polar position
+// about the drop's centre (angle in radians) and its distance to the front. u_analytic is the
+// linear mode-2 field -eps omega rhat (r / rhat) sin(omega t) (cos(-theta), sin(-theta)) (Sec. 6.4.3).
+struct FaceError {
+  double error = 0, radius = 0, angle = 0, distance = 0;
+  int axis = 0;
+};
+std::vector<FaceError> faceErrors(const TwoPhaseState& state, double epsilon, double omega, double rhat) {
+  std::vector<FaceError> out;
+  for (int f = 0; f < state.layout.totalFaces(); ++f) {
+    const auto [axis, idx] = state.layout.faceCoord(f);
+    const Eigen::Vector2d x = state.layout.faceCenter(axis, idx);
+    if (!insideFront(state.front, x)) continue;
+    const Eigen::Vector2d rel = x - Eigen::Vector2d(0.5, 0.5);
+    FaceError e;
+    e.axis = axis;
+    e.radius = rel.norm();
+    e.angle = std::atan2(rel.y(), rel.x());
+    const double a = -epsilon * omega * rhat * (e.radius / rhat) * std::sin(omega * state.time);
+    const double exact = axis == 0 ? a * std::cos(-e.angle) : a * std::sin(-e.angle);
+    e.error = std::abs(state.u[f] - exact);
+    e.distance = std::numeric_limits<double>::infinity();
+    for (const auto& s : state.front.elements) {
+      const Eigen::Vector2d a0 = state.front.points[s[0]], d = state.front.points[s[1]] - a0;
+      const double t = std::clamp((x - a0).dot(d) / d.squaredNorm(), 0.0, 1.0);
+      e.distance = std::min(e.distance, (a0 + t * d - x).norm());
+    }
+    out.push_back(e);
+  }
+  return out;
+}
+}  // namespace
+
 OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTime, int points, bool remesh,
-                                             double dtPerDx, bool carryCouplingVelocity) {
+                                             double dtPerDx, bool carryCouplingVelocity, TwoPhaseAdvection advection) {
   const double dx = 1.0 / n, dt = dtPerDx * dx, rhat = 1.0 / 3, omega = 2.0;
   if (points <= 0) points = static_cast<int>(std::lround(2 * M_PI * rhat / dx));
   TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(n, n), dx),
@@ -135,12 +171,14 @@ OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTi
   settings.blowUpSpeed = 10;
   settings.remesh = remesh;
   settings.carryCouplingVelocity = carryCouplingVelocity;
+  settings.advection = advection;
   OscillatingCircleResult r;
   r.points = points;
   const Eigen::Vector2d probe(0.75, 0.5);
   double previousTime = 0, previousU = 0;
   int crossings = 0;
   bool halfDone = false;
+  std::optional<TwoPhaseState> atHalf;  // the state at t = 0.5, for the error with the run's own frequency
   while (state.time < endTime - 1e-12) {
     const TwoPhaseStepReport report = advanceTwoPhase(state, settings, dt);
     if (report.blewUp) {
@@ -154,18 +192,17 @@ OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTi
       const double w = (0.5 - previousTime) / (state.time - previousTime);
       r.probeAtHalf = previousU + w * (u - previousU);
       const double scale = epsilon * omega * rhat * std::abs(std::sin(omega * state.time));
-      double worst = 0;
-      for (int f = 0; f < state.layout.totalFaces(); ++f) {
-        const auto [axis, idx] = state.layout.faceCoord(f);
-        const Eigen::Vector2d x = state.layout.faceCenter(axis, idx);
-        if (!insideFront(state.front, x)) continue;
-        const Eigen::Vector2d rel = x - Eigen::Vector2d(0.5, 0.5);
-        const double radius = rel.norm(), theta = std::atan2(rel.y(), rel.x());
-        const double a = -epsilon * omega * rhat * (radius / rhat) * std::sin(omega * state.time);
-        const double exact = axis == 0 ? a * std::cos(-theta) : a * std::sin(-theta);
-        worst = std::max(worst, std::abs(state.u[f] - exact));
+      atHalf = state;
+      for (const FaceError& e : faceErrors(state, epsilon, omega, rhat)) {
+        if (e.distance >= 2 * dx) r.interiorRelativeErrorAtHalf = std::max(r.interiorRelativeErrorAtHalf, e.error / scale);
+        if (e.error / scale > r.relativeErrorAtHalf) {
+          r.relativeErrorAtHalf = e.error / scale;
+          r.worstRadius = e.radius / rhat;
+          r.worstAngle = e.angle * 180 / M_PI;
+          r.worstDistance = e.distance / dx;
+          r.worstAxis = e.axis;
+        }
       }
-      r.relativeErrorAtHalf = worst / scale;
       const double probeExact = -epsilon * omega * (probe.x() - 0.5) * std::sin(omega * state.time);
       r.probeRelativeErrorAtHalf = std::abs(u - probeExact) / scale;
     }
@@ -177,6 +214,16 @@ OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTi
     previousU = u;
   }
   r.steps = state.step;
+  if (r.period > 0 && atHalf) {
+    // The analytic field with the run's own frequency 2 pi / T in amplitude and phase.
+    const double own = 2 * M_PI / r.period;
+    const double scale = epsilon * own * rhat * std::abs(std::sin(own * atHalf->time));
+    for (const FaceError& e : faceErrors(*atHalf, epsilon, own, rhat)) {
+      r.ownFrequencyRelativeErrorAtHalf = std::max(r.ownFrequencyRelativeErrorAtHalf, e.error / scale);
+      if (e.distance >= 2 * dx)
+        r.ownFrequencyInteriorRelativeErrorAtHalf = std::max(r.ownFrequencyInteriorRelativeErrorAtHalf, e.error / scale);
+    }
+  }
   return r;
 }
 

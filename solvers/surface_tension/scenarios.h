@@ -53,13 +53,22 @@ TwoPhaseSettings staticCircleSettings(bool onePhase, bool implicit);
 // relative error is its |u_x - u_analytic| on the same scale.
 // The front: `points` points (0: one per dx of arc), remeshed or not. dtPerDx: dt / dx.
 // carryCouplingVelocity: TwoPhaseSettings::carryCouplingVelocity.
+// Where the error is largest: interiorRelativeErrorAtHalf is the same maximum over the faces at least
+// 2 dx from the front; worstRadius (in rhat), worstAngle (degrees about the centre), worstDistance
+// (to the front, in dx) and worstAxis locate the largest error; ownFrequencyRelativeErrorAtHalf
+// takes the analytic field with the run's own frequency 2 pi / T instead of omega = 2 (its scale too),
+// ownFrequencyInteriorRelativeErrorAtHalf that over the faces at least 2 dx inside.
 struct OscillatingCircleResult {
   double period = 0, probeAtHalf = 0, relativeErrorAtHalf = 0, probeRelativeErrorAtHalf = 0;
+  double interiorRelativeErrorAtHalf = 0, ownFrequencyRelativeErrorAtHalf = 0, ownFrequencyInteriorRelativeErrorAtHalf = 0;
+  double worstRadius = 0, worstAngle = 0, worstDistance = 0;
+  int worstAxis = 0;
   int steps = 0, points = 0;
   bool stable = true;
 };
 OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTime, int points = 0, bool remesh = true,
-                                             double dtPerDx = 0.25, bool carryCouplingVelocity = false);
+                                             double dtPerDx = 0.25, bool carryCouplingVelocity = false,
+                                             TwoPhaseAdvection advection = TwoPhaseAdvection::SemiLagrangian);
 
 // Sec. 6.4.4: [0, 1] x [0, 2] m with n x 2n cells, an air bubble (rho 1e3) of r = 0.2 m at (0.5, 0.5)
 // in water (rho 1e4), mu = 1, sigma = 0.5, g = -8e-4, semi-Lagrangian or ENO/RK3 advection. `steps` steps of dt;

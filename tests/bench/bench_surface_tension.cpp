@@ -1,9 +1,9 @@
 // Surface tension on a Lagrangian front (thesis Ch. 6): the experiments of Sec. 6.4 with the
 // solvers of solvers/surface_tension, printed with wall time and error beside the thesis's tables.
 //   bench_surface_tension sine [N...]                 Table 6.1
-//   bench_surface_tension static one|two|one_ls|two_ls [N...]   Tables 6.2 / 6.3 (t = 5, dt = 0.2 dx)
+//   bench_surface_tension static one|two|one_ls|two_ls [N...] [t_end=T]   Tables 6.2 / 6.3 (t = 5, dt = 0.2 dx)
 //   bench_surface_tension oscillating [N...]          Table 6.4 refinement test (period, u at t = 0.5)
-//   bench_surface_tension epsilon N                   Table 6.4 epsilon test
+//   bench_surface_tension epsilon N [eps=E...]        Table 6.4 epsilon test
 //   bench_surface_tension rising_stability [N]        Sec. 6.4.4 (implicit and explicit, dt = 3 and 7 s)
 //   bench_surface_tension stability_map               Fig. 6.6-style sweep
 #include <chrono>
@@ -43,12 +43,12 @@ int main(int argc, char** argv) {
     }
   } else if (mode == "static") {
     // Options among the sizes: points=P (front points; default the original driver's 2^k at about
-    // dx / 4; one_per_dx: one point per dx of arc), remesh, rho_out=R.
+    // dx / 4; one_per_dx: one point per dx of arc), remesh, rho_out=R, t_end=T (default the thesis's 5).
     const bool one = argc > 2 && (std::string(argv[2]) == "one" || std::string(argv[2]) == "one_ls");
     const bool ls = argc > 2 && std::string(argv[2]).find("_ls") != std::string::npos;
     int points = 0;
     bool remesh = false;
-    double rhoOut = 1e4;
+    double rhoOut = 1e4, endTime = 5.0;
     std::vector<int> ns;
     for (int i = 3; i < argc; ++i) {
       const std::string a = argv[i];
@@ -56,17 +56,18 @@ int main(int argc, char** argv) {
       else if (a == "one_per_dx") points = -1;
       else if (a == "remesh") remesh = true;
       else if (a.rfind("rho_out=", 0) == 0) rhoOut = std::atof(a.c_str() + 8);
+      else if (a.rfind("t_end=", 0) == 0) endTime = std::atof(a.c_str() + 6);
       else ns.push_back(std::atoi(a.c_str()));
     }
     if (ns.empty()) ns = {20, 40, 80};
-    std::printf("static circle, %s phase, %s, implicit, t = 5, dt = 0.2 dx, front points %s%s, rho_out %g\n"
+    std::printf("static circle, %s phase, %s, implicit, t = %g, dt = 0.2 dx, front points %s%s, rho_out %g\n"
                 "| 1/dx | L1(u) | Linf(u) | pressure jump | jump error | steps | CG its (last) | wall s |\n|---|---|---|---|---|---|---|---|\n",
-                one ? "one" : "two", ls ? "level-set front" : "front tracking",
+                one ? "one" : "two", ls ? "level-set front" : "front tracking", endTime,
                 points == 0 ? "2^k at about dx/4" : points < 0 ? "one per dx" : std::to_string(points).c_str(), remesh ? ", remeshed" : "", rhoOut);
     for (int n : ns) {
       const auto start = std::chrono::steady_clock::now();
       const int p = points >= 0 ? points : static_cast<int>(std::lround(2 * M_PI * 0.25 * n));
-      const StaticCircleResult r = runStaticCircle(n, one, true, 5.0, ls, p, remesh, rhoOut);
+      const StaticCircleResult r = runStaticCircle(n, one, true, endTime, ls, p, remesh, rhoOut);
       std::printf("| %d | %.3e | %.3e | %.5f | %.2e | %d | %d | %.1f |\n", n, r.l1, r.linf, r.pressureJump,
                   std::abs(r.pressureJump - 4.0) / 4.0, r.steps, r.lastIterations, seconds(start));
       std::fflush(stdout);
@@ -74,16 +75,21 @@ int main(int argc, char** argv) {
   } else if (mode == "oscillating" || mode == "epsilon") {
     // Options among the sizes: points=P (front points; default one per dx of arc; driver: the
     // original driver's 2^k at about dx / 4 as in the static circle, with r = 1/3), no_remesh,
-    // dt_per_dx=S (dt = S dx; default 1/4), carry (the coupling faces' u* carried on the front).
+    // dt_per_dx=S (dt = S dx; default 1/4), carry (the coupling faces' u* carried on the front),
+    // eps=E (repeatable; default 0.05, or the epsilon table's 0.05, 0.025, 0.0125), t_end=T (default
+    // 1.2 pi, past the second zero crossing; with T < 3.3 there is no period, only the errors at t = 0.5),
+    // advection=none|eno (default semi-Lagrangian).
     // Columns: the relative error as defined (scale eps omega r |sin omega t|), the same max error
     // on the scale eps omega |sin omega t| (without r; see docs/benchmarks_surface_tension.md), and
     // the probe's relative error.
     const bool eps = mode == "epsilon";
     int points = 0;
     bool remesh = true;
-    double dtPerDx = 0.25;
+    double dtPerDx = 0.25, endTime = 1.2 * M_PI;
     bool carry = false;
+    TwoPhaseAdvection advection = TwoPhaseAdvection::SemiLagrangian;
     std::vector<int> ns;
+    std::vector<double> epsilons;
     for (int i = 2; i < argc; ++i) {
       const std::string a = argv[i];
       if (a.rfind("dt_per_dx=", 0) == 0) dtPerDx = std::atof(a.c_str() + 10);
@@ -91,22 +97,33 @@ int main(int argc, char** argv) {
       else if (a.rfind("points=", 0) == 0) points = std::atoi(a.c_str() + 7);
       else if (a == "no_remesh") remesh = false;
       else if (a == "carry") carry = true;
+      else if (a.rfind("eps=", 0) == 0) epsilons.push_back(std::atof(a.c_str() + 4));
+      else if (a.rfind("t_end=", 0) == 0) endTime = std::atof(a.c_str() + 6);
+      else if (a == "advection=none") advection = TwoPhaseAdvection::None;
+      else if (a == "advection=eno") advection = TwoPhaseAdvection::EnoRk3;
       else ns.push_back(std::atoi(a.c_str()));
     }
     if (ns.empty()) ns = eps ? std::vector<int>{50} : std::vector<int>{50, 100};
+    if (epsilons.empty()) epsilons = eps ? std::vector<double>{0.05, 0.025, 0.0125} : std::vector<double>{0.05};
     std::printf("oscillating circle, front tracking, implicit, dt = %g dx, coupling u* %s, front %s%s\n"
                 "| N | epsilon | period T | T/pi - 1 | u(0.75,0.5) at t=0.5 | rel. Linf err at t=0.5 | same, scale without r | probe rel. err | points | steps | wall s |\n"
-                "|---|---|---|---|---|---|---|---|---|---|---|\n",
+                "|---|---|---|---|---|---|---|---|---|---|---|\n"
+                "  (then: the max error's face: r / rhat, angle, distance to the front in dx, axis; the max over faces >= 2 dx\n"
+                "   inside; the max with the analytic field at the run's own frequency 2 pi / T, over all faces and >= 2 dx\n"
+                "   inside; all scaled as the rel. Linf, with r; divide by 3 for the thesis's scale)\n",
                 dtPerDx, carry ? "carried on the front" : "sampled from the grid", points == 0 ? "one point per dx" : points < 0 ? "2^k points at about dx/4" : std::to_string(points).c_str(),
                 remesh ? ", remeshed" : ", not remeshed");
     for (int n : ns)
-      for (double epsilon : eps ? std::vector<double>{0.05, 0.025, 0.0125} : std::vector<double>{0.05}) {
+      for (double epsilon : epsilons) {
         const auto start = std::chrono::steady_clock::now();
         const int p = points >= 0 ? points : 1 << static_cast<int>(std::lround(std::log2(8 * M_PI * n / 3.0)));
-        const OscillatingCircleResult r = runOscillatingCircle(n, epsilon, 1.2 * M_PI, p, remesh, dtPerDx, carry);
+        const OscillatingCircleResult r = runOscillatingCircle(n, epsilon, endTime, p, remesh, dtPerDx, carry, advection);
         std::printf("| %d | %g | %.4f | %+.2f %% | %.4e | %.3e | %.3e | %.3e | %d | %d | %.1f |\n", n, epsilon, r.period,
                     100 * (r.period / M_PI - 1), r.probeAtHalf, r.relativeErrorAtHalf, r.relativeErrorAtHalf / 3,
                     r.probeRelativeErrorAtHalf, r.points, r.steps, seconds(start));
+        std::printf("  worst at r/rhat %.3f, angle %.1f deg, %.2f dx from the front, axis %d; >= 2 dx inside %.3e; own frequency %.3e, >= 2 dx inside %.3e\n",
+                    r.worstRadius, r.worstAngle, r.worstDistance, r.worstAxis, r.interiorRelativeErrorAtHalf,
+                    r.ownFrequencyRelativeErrorAtHalf, r.ownFrequencyInteriorRelativeErrorAtHalf);
         std::fflush(stdout);
       }
   } else if (mode == "rising_stability") {
