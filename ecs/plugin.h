@@ -16,8 +16,9 @@
 namespace monolith {
 
 // Bump whenever a type crossing the plugin boundary changes layout or meaning.
-inline constexpr std::uint32_t kPluginAbiVersion = 6;  // 2: Stage::Advection inserted; 3, 4, 6: ContactSettings grew;
-                                                       // 5: PoolBase::fieldLayout
+inline constexpr std::uint32_t kPluginAbiVersion = 6;  // 2: Stage::Advection inserted; 3, 4: ContactSettings grew;
+                                                       // 5: PoolBase::fieldLayout; 6: ContactSettings grew
+                                                       // and its defaults are the short schedule
 
 struct PluginAbi {
   std::uint32_t abiVersion;

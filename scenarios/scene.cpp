@@ -452,7 +452,8 @@ void parseContactSettings(const Config& c, ContactSettings& s) {
     value = static_cast<int>(c.integer(key, value, min, 100000));
   };
   // The schedule first: the keys below adjust it.
-  if (c.oneOf("schedule", {"thesis", "short"}, "thesis") == "short") s.useShortSchedule();
+  if (c.oneOf("schedule", {"thesis", "short"}, "short") == "short") s.useShortSchedule();
+  else s.useThesisSchedule();
   count("collision_iterations", s.collisionIterations, 0);
   count("collision_pair_iterations", s.collisionPairIterations, 1);
   count("contact_iterations", s.contactIterations, 0);

@@ -5,26 +5,26 @@
 namespace monolith {
 
 // Collisions, contact and interpenetration resolution (scene "solvers": {"contact": {...}}).
-// The defaults are the thesis code's schedule (notes 1.4, 1.6, 1.7). `"schedule": "short"`
-// (useShortSchedule, docs/rigid_contact.md) is one contact sweep of one level pass, one
-// shock-propagation pass, exact manifold solves, contact that lets a gap close in the step and
-// the step energy clamp: 12-15x cheaper per awake step, not the default because 2-D random
-// drops still sink deeper than 5 % for a step on it (2 of 838; docs/rigid_contact.md).
+// The defaults are the short schedule (useShortSchedule, docs/rigid_contact.md): one contact
+// sweep of one level pass, one shock-propagation pass, exact manifold solves, contact that lets a
+// gap close in the step, the step energy clamp and the joint push-out of jams from 2 %: 12-15x
+// cheaper per awake step than the thesis code's schedule (notes 1.4, 1.6, 1.7), which
+// `"schedule": "thesis"` (useThesisSchedule) selects.
 struct ContactSettings {
   int collisionIterations = 5;       // Gauss-Seidel sweeps over the pairs (Step II)
   int collisionPairIterations = 20;  // impulses per pair per sweep
-  int contactIterations = 10;        // outer contact sweeps (Step III), epsilon-scaled
-  int contactLevelIterations = 2;    // per level and sweep
+  int contactIterations = 1;         // outer contact sweeps (Step III), epsilon-scaled; thesis: 10
+  int contactLevelIterations = 1;    // per level and sweep; thesis: 2
   int contactPairIterations = 10;    // Gauss-Seidel sweeps of one pair's manifold solve (measured)
   bool shockPropagation = true;      // GBF 2003 shock propagation after contact
-  int shockLevelIterations = 2;      // the thesis code's
+  int shockLevelIterations = 1;      // thesis: 2
   int shockPairIterations = 40;      // measured: a 2-D pyramid's joint solves need them (docs/benchmarks.md)
   // Manifold and joint solves end with an exact active-set step once it applies
   // (solvers/contact/manifold_polish.h; not in the thesis, whose sweeps stop at their count).
-  // Off by default: at the thesis's schedule it costs 3-30 % more than it saves on three of five
+  // Off in the thesis schedule: there it costs 3-30 % more than it saves on three of five
   // scenes; on the short schedule it makes the step 3x faster and leaves a standing pyramid
   // exactly at rest.
-  bool exactManifoldFinish = false;
+  bool exactManifoldFinish = true;
   bool pushOut = true;               // interpenetration resolution, Sec. 4.6.1 / App. B
   int pushOutLevelIterations = 6;    // thesis code: 2; measured on piles (the git history of docs/benchmarks.md ("Six push-out passes"))
   int pushOutBodyIterations = 5;
@@ -41,25 +41,27 @@ struct ContactSettings {
   // its smaller body's size (a jam), the bodies of those pairs and their overlapping dynamic
   // neighbours (two rings) pushed apart all at once (solvers/contact/joint_push_out.h; not in the
   // thesis), pass by pass while each leaves them shallower.
+  // From 2 %: started at 5 %, the random-drop campaigns' own bound, the short schedule's 2-D
+  // drops kept single steps 5-10 % deep (docs/benchmarks_rigid_contact.md); thesis: 5 %.
   bool pushOutJoint = true;
-  double pushOutJointOverlap = 0.05;
+  double pushOutJointOverlap = 0.02;
   // ... and where a jam is still deeper than pushOutJointRegrowOverlap after its passes, it is
   // solved again with more rings of neighbours (systems/interpenetration.cpp), so that what
-  // clamps it can give way. The thesis schedule's equals its start (5 %), the campaigns' bound.
-  double pushOutJointRegrowOverlap = 0.05;
+  // clamps it can give way; thesis: 5 %, its start and the campaigns' bound.
+  double pushOutJointRegrowOverlap = 0.03;
   bool velocityContact = true;       // second contact step in Step V (Sec. 2.3.2 "Contact Clamping")
   bool energyClamp = true;           // Sec. 2.3.2 for collisions and the second contact step
   // After Step V, an island of bodies moved only by gravity and contact whose energy (kinetic +
   // gravity's potential) rose in the step has its velocities scaled down to take the rise back
   // (not in the thesis, which leaves the first contact step unclamped, Sec. 2.3.2; systems/
   // step_energy_clamp.cpp). The short schedule needs it: its one inelastic contact pass can lift
-  // a spinning body for the position update without paying for the rise.
-  bool stepEnergyClamp = false;
+  // a spinning body for the position update without paying for the rise. Thesis: off.
+  bool stepEnergyClamp = true;
   // Contact (Steps III and V) lets each point close the gap its bodies have at the base poses
   // within the step: v_n >= -gap/dt instead of v_n >= 0 (not in the thesis, whose ramped sweeps
   // close such gaps approximately). Without it one fully inelastic pass stops a body falling
-  // onto a support closer than its step's fall in the air above it.
-  bool closeGaps = false;
+  // onto a support closer than its step's fall in the air above it. Thesis: off.
+  bool closeGaps = true;
   // Step II: a pair moving more than half its thinner body's size in the step is tested at its
   // first contact along the motion instead of at the candidate poses (not in the thesis;
   // solvers/collision/swept_contact.h).
@@ -75,8 +77,9 @@ struct ContactSettings {
   double sleepSpeed = 0.01;          // m/s, at the body's farthest point from its centre of mass
   double sleepTime = 0.5;            // s
 
-  // The short schedule: one contact sweep of one level pass, one shock-propagation pass, manifold
-  // solves finished exactly, gaps closed, and the step energy clamp.
+  // The short schedule (the defaults above): one contact sweep of one level pass, one
+  // shock-propagation pass, manifold solves finished exactly, gaps closed, the step energy clamp,
+  // the joint push-out from 2 % and its regrowth from 3 %.
   void useShortSchedule() {
     contactIterations = 1;
     contactLevelIterations = 1;
@@ -87,9 +90,9 @@ struct ContactSettings {
     pushOutJointOverlap = 0.02;
     pushOutJointRegrowOverlap = 0.03;
   }
-  // The thesis code's schedule (the defaults above): ten epsilon-ramped contact sweeps of two
-  // level passes, two shock-propagation passes, manifold solves by sweeps alone, no gap closing,
-  // no step clamp.
+  // The thesis code's schedule: ten epsilon-ramped contact sweeps of two level passes, two
+  // shock-propagation passes, manifold solves by sweeps alone, no gap closing, no step clamp, and
+  // the joint push-out from 5 % (regrown from 5 %).
   void useThesisSchedule() {
     contactIterations = 10;
     contactLevelIterations = 2;

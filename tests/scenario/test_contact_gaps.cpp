@@ -87,9 +87,10 @@ TEST(ContactGaps, ABoxDroppedAFewMillimetresOntoAShelfLandsOnTheShortSchedule) {
   }
 }
 
-TEST(ContactGaps, TheThesisScheduleTheDefaultClosesSuchGapsByItsSweeps) {
+TEST(ContactGaps, TheThesisScheduleClosesSuchGapsByItsSweepsAndTheDefaultByClosingThem) {
   // The thesis's ten epsilon-ramped sweeps close such a gap approximately (to 0.1 mm), without
   // closeGaps: each removes only part of the approach, the next sees what is left of the gap.
+  // The default (the short schedule) closes it by v_n >= -gap/dt.
   const std::string scene = boxOnShelf(3e-3, false);
   EXPECT_NEAR(finalY<3>(scene, {}, "box") - 2.22, 0.0, 2e-4);
   EXPECT_NEAR(finalY<3>(scene, {{"solvers.contact.schedule", "thesis"}}, "box") - 2.22, 0.0, 2e-4);

@@ -571,7 +571,8 @@ TEST(StepEnergyClamp, TakesBackWhatTheShortSchedulesFirstContactStepLifts) {
 
 TEST(StepEnergyClamp, LeavesAFallingBodyAloneAndTheThesisScheduleDoesNotUseIt) {
   // A free fall keeps E = KE - m g.x exactly under the Newmark step, so nothing is clamped
-  // before the first contact; the thesis schedule (the default) has no clamp (no diagnostic).
+  // before the first contact; the thesis schedule has no clamp (no diagnostic). The default is
+  // the short schedule.
   const Registry registry = builtins();
   Simulation<2> shortRun(loadScene(kScenes + "random_drop_2d_261.json", {{"solvers.contact.schedule", "short"}}),
                          registry);
@@ -582,7 +583,7 @@ TEST(StepEnergyClamp, LeavesAFallingBodyAloneAndTheThesisScheduleDoesNotUseIt) {
                           registry);
   EXPECT_FALSE(thesisRun.step().count("step_energy_clamped_islands"));
   Simulation<2> defaultRun(loadScene(kScenes + "random_drop_2d_261.json"), registry);
-  EXPECT_FALSE(defaultRun.step().count("step_energy_clamped_islands"));
+  EXPECT_EQ(defaultRun.step().at("step_energy_clamped_islands"), 0);
   const ContactSettings& thesis = thesisRun.world().settings().contact;
   EXPECT_EQ(thesis.contactIterations, 10);
   EXPECT_EQ(thesis.contactLevelIterations, 2);
@@ -591,8 +592,12 @@ TEST(StepEnergyClamp, LeavesAFallingBodyAloneAndTheThesisScheduleDoesNotUseIt) {
   EXPECT_FALSE(thesis.stepEnergyClamp);
   EXPECT_FALSE(thesis.closeGaps);
   const ContactSettings& byDefault = defaultRun.world().settings().contact;
-  EXPECT_EQ(byDefault.contactIterations, 10);
-  EXPECT_FALSE(byDefault.closeGaps);
+  EXPECT_EQ(byDefault.contactIterations, 1);
+  EXPECT_TRUE(byDefault.closeGaps);
+  EXPECT_EQ(byDefault.pushOutJointOverlap, 0.02);
+  EXPECT_EQ(ContactSettings{}.contactIterations, 1);  // the struct's own defaults agree
+  EXPECT_TRUE(ContactSettings{}.stepEnergyClamp);
+  EXPECT_EQ(thesis.pushOutJointOverlap, 0.05);
   const ContactSettings& shortSettings = shortRun.world().settings().contact;
   EXPECT_EQ(shortSettings.contactIterations, 1);
   EXPECT_EQ(shortSettings.contactLevelIterations, 1);
@@ -764,7 +769,8 @@ TEST(CollisionSkip, APairThatCannotApproachIsProcessedWithoutImpulseAndABarelyAp
 }
 
 TEST(PushOutRounds, APushPastTheBroadPhaseBoxIsUndoneInTheSameStep) {
-  // As above, but D sits 2 cm above C's bounding box (a 1 m cube 1.97 m up), so the pair
+  // On the thesis schedule (the short one's joint push-out from 2 % would take the 3 % overlap
+  // the single round leaves). As above, but D sits 2 cm above C's bounding box (a 1 m cube 1.97 m up), so the pair
   // (C, D) is not in the broad phase when push-out starts. Lifting C 5 cm out of A drives it 3 cm
   // into D; only the broad phase grown after that push finds the pair. One round leaves the
   // overlap (the figure is reported but not pushed apart); a second round, on the bodies of the
@@ -780,7 +786,8 @@ TEST(PushOutRounds, APushPastTheBroadPhaseBoxIsUndoneInTheSameStep) {
       {"name": "D", "shape": {"type": "box", "half_extents": [0.5, 0.5, 0.5]},
        "rigid_body": {"mass": 1, "position": [0, 1.97, 0]}, "collider": {"restitution": 0, "friction": 0.5}}]})";
     const SceneSpec scene =
-        parseScene(text, "past_the_box.json", {{"solvers.contact.push_out_rounds", std::to_string(rounds)}});
+        parseScene(text, "past_the_box.json",
+                   {{"solvers.contact.schedule", "thesis"}, {"solvers.contact.push_out_rounds", std::to_string(rounds)}});
     Simulation<3> sim(scene, registry);
     const auto diag = sim.step();
     struct Result {
@@ -908,7 +915,8 @@ TEST(PushOutRounds, APushPastTheBroadPhaseBoxIsUndoneInTheSameStepIn2D) {
        "rigid_body": {"mass": 1, "position": [0, 0.95]}, "collider": {"restitution": 0, "friction": 0.5}},
       {"name": "D", "shape": {"type": "box", "half_extents": [0.5, 0.5]},
        "rigid_body": {"mass": 1, "position": [0, 1.97]}, "collider": {"restitution": 0, "friction": 0.5}}]})";
-    Simulation<2> sim(parseScene(text, "past_the_box_2d.json", {{"solvers.contact.push_out_rounds", std::to_string(rounds)}}),
+    Simulation<2> sim(parseScene(text, "past_the_box_2d.json",
+                                 {{"solvers.contact.schedule", "thesis"}, {"solvers.contact.push_out_rounds", std::to_string(rounds)}}),
                       registry);
     const auto diag = sim.step();
     return std::make_pair(diag.at("max_penetration"), bodyOf(sim, "D").x.y());
