@@ -28,6 +28,7 @@
 #include "scenarios/simulation.h"
 
 using namespace monolith;
+using test::bodyNamed;
 using test::builtins;
 using test::kScenes;
 
@@ -36,9 +37,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
 
-const RigidBody<3>& body(Simulation<3>& sim, const std::string& name) {
-  return *sim.world().get<RigidBody<3>>(*sim.world().find(name));
-}
 
 double totalEnergy(Simulation<3>& sim) {
   double e = 0;
@@ -68,7 +66,7 @@ std::vector<double> stateOf(Simulation<3>& sim) {
 
 // Angle of the rod from hanging straight down (about +z).
 double pendulumAngle(Simulation<3>& sim) {
-  const Eigen::Vector3d x = body(sim, "rod").x;
+  const Eigen::Vector3d x = bodyNamed(sim, "rod").x;
   return std::atan2(x.x(), -x.y());
 }
 
@@ -131,7 +129,7 @@ TEST(Articulation, HangingChainStaysJoinedWithoutGainingEnergyOnAnyThreadCount) 
   EXPECT_LT(worstRise, 1e-3 * scale);
   EXPECT_EQ(stateHash(one.world()), stateHash(two.world()));
   // It fell: the last link is well below the pivot.
-  EXPECT_LT(body(one, "link19").x.y(), -1.0);
+  EXPECT_LT(bodyNamed(one, "link19").x.y(), -1.0);
 }
 
 TEST(Articulation, LoopDroppedOnTheGroundStaysClosed) {
@@ -142,7 +140,7 @@ TEST(Articulation, LoopDroppedOnTheGroundStaysClosed) {
   std::cout << "[measured] loop_six joint_error_max " << worst << " m\n";
   EXPECT_LT(worst, 1e-3);
   for (int k = 0; k < 6; ++k) {  // at rest on the ground
-    const auto& b = body(sim, "bar" + std::to_string(k));
+    const auto& b = bodyNamed(sim, "bar" + std::to_string(k));
     EXPECT_NEAR(b.x.y(), 0.02, 2e-3);
     EXPECT_LT(b.v.norm(), 1e-2);
   }
@@ -186,7 +184,7 @@ TEST(Articulation, PdArmSettlesWithTheOvershootItsGainsPredict) {
   double peak = 0, settledAt = 0;
   while (!sim.finished()) {
     sim.step();
-    const Eigen::Vector3d tip = body(sim, "fore").x;
+    const Eigen::Vector3d tip = bodyNamed(sim, "fore").x;
     const double angle = std::atan2(tip.y(), tip.x());  // the straight arm's angle
     peak = std::max(peak, angle);
     if (std::abs(angle - target) > 0.02 * target) settledAt = sim.time();
@@ -222,7 +220,7 @@ TEST(Articulation, ContactStartsFromTheJointStagesVelocities) {
   while (!plain.finished()) {
     plain.step();
     colliding.step();
-    worst = std::max(worst, (body(plain, "fore").x - body(colliding, "fore").x).norm());
+    worst = std::max(worst, (bodyNamed(plain, "fore").x - bodyNamed(colliding, "fore").x).norm());
   }
   std::cout << "[measured] pd_arm with idle colliders: largest tip position difference " << worst << " m\n";
   // Only the joint closing after push-out (run with colliders) differs, at the joints' 1e-10 m.
@@ -422,9 +420,9 @@ TEST(Articulation, PrismaticAndUniversalJointsKeepTheirConstraints) {
   const auto [worst, worstAngle] = runToEndWithWorstJointErrors(sim);
   EXPECT_LT(worst, 1e-6);
   EXPECT_LT(worstAngle, 1e-6);
-  const Eigen::Vector3d x = body(sim, "slider").x;
+  const Eigen::Vector3d x = bodyNamed(sim, "slider").x;
   EXPECT_NEAR(x.x(), -x.y(), 1e-6);  // on the rail
-  EXPECT_NEAR(body(sim, "slider").orientation.angularDistance(Eigen::Quaterniond::Identity()), 0, 1e-6);
+  EXPECT_NEAR(bodyNamed(sim, "slider").orientation.angularDistance(Eigen::Quaterniond::Identity()), 0, 1e-6);
   EXPECT_GT(x.x(), 0.5);  // it slid down the rail (free slide alone would give 1.73 m)
 }
 
@@ -443,7 +441,7 @@ TEST(Articulation, TwistJointSlidesAndSpinsFreelyAboutItsAxis) {
                                 "twist.json"),
                      registry);
   const auto [worst, worstAngle] = runToEndWithWorstJointErrors(sim);
-  const RigidBody<3>& cube = body(sim, "cube");
+  const RigidBody<3>& cube = bodyNamed(sim, "cube");
   const Eigen::Vector3d axis(std::sqrt(0.5), -std::sqrt(0.5), 0);
   const double slide = kG * 1.0 / (2 * std::sqrt(2.0));
   std::cout << "[measured] twist joint: slide " << cube.x.dot(axis) << " m (free fall along the rail " << slide

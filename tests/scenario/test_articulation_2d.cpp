@@ -27,6 +27,7 @@
 #include "scenarios/simulation.h"
 
 using namespace monolith;
+using test::bodyNamed;
 using test::builtins;
 using test::kScenes;
 
@@ -35,13 +36,10 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
 
-const RigidBody<2>& body(Simulation<2>& sim, const std::string& name) {
-  return *sim.world().get<RigidBody<2>>(*sim.world().find(name));
-}
 
 // Angle of the rod of pendulum_2d from hanging straight down.
 double pendulumAngle(Simulation<2>& sim) {
-  const Eigen::Vector2d x = body(sim, "rod").x;
+  const Eigen::Vector2d x = bodyNamed(sim, "rod").x;
   return std::atan2(x.x(), -x.y());
 }
 
@@ -111,7 +109,7 @@ TEST(Articulation2d, ChainStaysJoinedWithoutGainingEnergyOnAnyThreadCount) {
   EXPECT_LT(worstError, 1e-4 * 0.1);
   EXPECT_LT(worstRise, 1e-3 * scale);
   EXPECT_EQ(stateHash(one.world()), stateHash(two.world()));
-  EXPECT_LT(body(one, "link19").x.y(), -1.0);  // it fell
+  EXPECT_LT(bodyNamed(one, "link19").x.y(), -1.0);  // it fell
 }
 
 TEST(Articulation2d, GlobalAndPairwisePostStabilizationAgreeAtConvergence) {
@@ -160,7 +158,7 @@ TEST(Articulation2d, PrismaticJointSlidesAsInFreeFallAlongItsRail) {
     worst = std::max(worst, d.at("joint_error_max"));
     worstAngle = std::max(worstAngle, d.at("joint_angle_error_max"));
   }
-  const RigidBody<2>& b = body(sim, "link");
+  const RigidBody<2>& b = bodyNamed(sim, "link");
   const Eigen::Vector2d axis(c, -s);
   const double slide = 0.5 * kG * s * 1.0;
   std::cout << "[measured] 2-D prismatic: slide " << b.x.dot(axis) << " m (free fall along the rail " << slide
@@ -189,7 +187,7 @@ TEST(Articulation2d, PdDriveOvershootsAsItsGainsPredict) {
   double peak = 0, settledAt = 0, worst = 0;
   while (!sim.finished()) {
     worst = std::max(worst, sim.step().at("joint_error_max"));
-    const Eigen::Vector2d x = body(sim, "link").x;
+    const Eigen::Vector2d x = bodyNamed(sim, "link").x;
     const double angle = std::atan2(x.y(), x.x());
     peak = std::max(peak, angle);
     if (std::abs(angle - 0.5) > 0.02 * 0.5) settledAt = sim.time();
@@ -215,7 +213,7 @@ TEST(Articulation2d, PinLimitsStopTheSwing) {
   double largest = 0, smallest = 0, worst = 0;
   while (!sim.finished()) {
     worst = std::max(worst, sim.step().at("joint_error_max"));
-    const Eigen::Vector2d x = body(sim, "rod").x;
+    const Eigen::Vector2d x = bodyNamed(sim, "rod").x;
     const double a = std::atan2(x.x(), -x.y());
     largest = std::max(largest, a), smallest = std::min(smallest, a);
   }
@@ -288,7 +286,7 @@ TEST(Articulation2d, FourBarLinkageIsAcceptedAndStaysClosed) {
                       registry);
     double worst = 0;
     while (!sim.finished()) worst = std::max(worst, sim.step().at("joint_error_max"));
-    EXPECT_GT(std::abs(body(sim, "crank").orientation), 0.1);  // it moved
+    EXPECT_GT(std::abs(bodyNamed(sim, "crank").orientation), 0.1);  // it moved
     return worst;
   };
   const double pairwise = worstError("pairwise"), global = worstError("global");
@@ -327,7 +325,7 @@ TEST(Articulation2d, ChainDroppedOnTheGroundKeepsItsJointsClosedOnAnyThreadCount
     if (one.time() > 1.0) deepest = std::max(deepest, diag.at("max_penetration"));
   }
   double lowest = 1e300;
-  for (int k = 0; k < 20; ++k) lowest = std::min(lowest, body(one, "link" + std::to_string(k)).x.y());
+  for (int k = 0; k < 20; ++k) lowest = std::min(lowest, bodyNamed(one, "link" + std::to_string(k)).x.y());
   std::cout << "[measured] chain_2d on the ground: joint_error_max " << worst << " m, max_penetration after 1 s "
             << deepest << " m, lowest link centre " << lowest << " m\n";
   EXPECT_LT(worst, 1e-6);

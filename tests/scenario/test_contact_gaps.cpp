@@ -26,15 +26,12 @@
 using namespace monolith;
 
 namespace {
+using test::bodyNamed;
 using test::builtins;
 
 using Overrides = std::vector<std::pair<std::string, std::string>>;
 constexpr double kLanded = 1e-5;  // ContactSettings::pushOutTolerance
 
-template <int d>
-const RigidBody<d>& body(Simulation<d>& sim, const std::string& name) {
-  return *sim.world().template get<RigidBody<d>>(*sim.world().find(name));
-}
 
 // Runs the scene to its end and returns the y of `name` (the largest total-energy rise over the
 // start, relative to the start's |E|, in `rise`).
@@ -51,7 +48,7 @@ double finalY(const std::string& text, const Overrides& overrides, const std::st
     worst = std::max(worst, e - first);
   }
   if (rise) *rise = worst / std::max(std::abs(first), 1e-12);
-  return body<d>(sim, name).x.y();
+  return bodyNamed<d>(sim, name).x.y();
 }
 
 std::string boxOnShelf(double gap, bool kinematicShelf) {
@@ -130,8 +127,8 @@ TEST(ContactGaps, ABoxDroppedAFewMillimetresOntoADynamicMeshCubeLandsOnTheShortS
   const Registry registry = builtins();
   Simulation<3> sim(parseScene(scene, "mesh_gap.json", {{"solvers.contact.schedule", "short"}}), registry);
   while (!sim.finished()) sim.step();
-  const double gap = (body<3>(sim, "box").x.y() - 0.2) - (body<3>(sim, "mesh_cube").x.y() + 0.5);
-  std::printf("box on the mesh cube: gap %.2e m, cube at %.6f\n", gap, body<3>(sim, "mesh_cube").x.y());
+  const double gap = (bodyNamed<3>(sim, "box").x.y() - 0.2) - (bodyNamed<3>(sim, "mesh_cube").x.y() + 0.5);
+  std::printf("box on the mesh cube: gap %.2e m, cube at %.6f\n", gap, bodyNamed<3>(sim, "mesh_cube").x.y());
   EXPECT_NEAR(gap, 0.0, kLanded);
-  EXPECT_NEAR(body<3>(sim, "mesh_cube").x.y(), 0.5, kLanded);
+  EXPECT_NEAR(bodyNamed<3>(sim, "mesh_cube").x.y(), 0.5, kLanded);
 }

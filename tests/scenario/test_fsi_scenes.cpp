@@ -45,9 +45,6 @@ PlateRun runPlate(const Registry& registry, int n, std::vector<Override> overrid
   return r;
 }
 
-const RigidBody<2>& bodyNamed(Simulation<2>& sim, const std::string& name) {
-  return *sim.world().get<RigidBody<2>>(*sim.world().find(name));
-}
 
 }  // namespace
 

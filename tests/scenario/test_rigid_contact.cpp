@@ -28,6 +28,7 @@
 using namespace monolith;
 
 namespace {
+using test::bodyNamed;
 using test::builtins;
 using test::kScenes;
 
@@ -88,10 +89,6 @@ template <int d>
 Eigen::Matrix<double, d, 1> positionOf(Simulation<d>& sim, const std::string& name) {
   return sim.world().template get<RigidBody<d>>(*sim.world().find(name))->x;
 }
-template <int d>
-const RigidBody<d>& bodyOf(Simulation<d>& sim, const std::string& name) {
-  return *sim.world().template get<RigidBody<d>>(*sim.world().find(name));
-}
 
 double slideDistance(double dt, double mu, double T, EnergyWatch* watch = nullptr) {
   const Registry registry = builtins();
@@ -144,7 +141,7 @@ TEST(InclineRoll2D, DiskRollsWithoutSlipping) {
   const double s = (positionOf(sim, "disk") - x0).dot(down);
   EXPECT_NEAR(s / (0.5 * a * T * T), 1.0, 0.02);
   // Rolling: the contact point does not slip, v = -w r (clockwise spin when moving down-slope).
-  const RigidBody<2>& disk = bodyOf(sim, "disk");
+  const RigidBody<2>& disk = bodyNamed(sim, "disk");
   EXPECT_NEAR(disk.v.dot(down), -disk.omega()(0) * 0.5, 0.02 * disk.v.norm());
   watch.expectNoGain(std::abs(watch.initialTotal) + 1);
 }
@@ -160,7 +157,7 @@ std::vector<double> apexes(double e, double T, EnergyWatch& watch, std::vector<d
   double previousVy = 0;
   while (!sim.finished()) {
     watch.observe(sim.step());
-    const RigidBody<3>& ball = bodyOf(sim, "ball");
+    const RigidBody<3>& ball = bodyNamed(sim, "ball");
     if (heights) heights->push_back(ball.x.y() - 0.5);
     if (previousVy > 0 && ball.v.y() <= 0) out.push_back(ball.x.y() - 0.5);
     previousVy = ball.v.y();
@@ -200,8 +197,8 @@ TEST(NewtonsCradle, FarSphereLeavesWithTheIncomingSpeed) {
   Simulation<3> sim(loadScene(kScenes + "newtons_cradle.json"), registry);
   EnergyWatch watch;
   for (int n = 0; n < 20; ++n) watch.observe(sim.step());
-  EXPECT_GE(bodyOf(sim, "far").v.x(), 0.95);
-  for (const char* name : {"striker", "b1", "b2", "b3"}) EXPECT_LE(bodyOf(sim, name).v.norm(), 0.05) << name;
+  EXPECT_GE(bodyNamed(sim, "far").v.x(), 0.95);
+  for (const char* name : {"striker", "b1", "b2", "b3"}) EXPECT_LE(bodyNamed(sim, name).v.norm(), 0.05) << name;
   watch.expectNoGain(1.0);
 }
 
@@ -219,7 +216,7 @@ TEST(Elevator, BoxRidesTheKinematicPlatform) {
       worstCollisionGain = std::max(worstCollisionGain, diag.at("collision_energy_change_kinematic_frame"));
       worstContactGain = std::max(worstContactGain, diag.at("velocity_contact_energy_change_kinematic_frame"));
     }
-    if (sim.time() > 1.0) worst = std::max(worst, (bodyOf(sim, "box").v - bodyOf(sim, "platform").v).norm());
+    if (sim.time() > 1.0) worst = std::max(worst, (bodyNamed(sim, "box").v - bodyNamed(sim, "platform").v).norm());
   }
   EXPECT_EQ(frameSteps, sim.stepsDone());
   EXPECT_LE(worstCollisionGain, 1e-12) << "collision impulses added kinetic energy in the platform's frame";
@@ -720,7 +717,7 @@ TEST(PushOutNewOverlaps, APushIntoAnUntouchedNeighbourIsUndoneInTheSameStep) {
     EXPECT_TRUE(sim.finished());
     struct Result {
       double depth, cY, dY, ke;
-    } r{diag.at("max_penetration"), bodyOf(sim, "C").x.y(), bodyOf(sim, "D").x.y(), diag.at("kinetic_energy")};
+    } r{diag.at("max_penetration"), bodyNamed(sim, "C").x.y(), bodyNamed(sim, "D").x.y(), diag.at("kinetic_energy")};
     return r;
   };
   for (bool reversed : {false, true}) {
@@ -793,7 +790,7 @@ TEST(PushOutRounds, APushPastTheBroadPhaseBoxIsUndoneInTheSameStep) {
     struct Result {
       double depth, rounds, left, cY, dY, ke;
     } r{diag.at("max_penetration"),         diag.at("push_out_rounds"), diag.at("push_out_overlaps_found_after"),
-        bodyOf(sim, "C").x.y(),             bodyOf(sim, "D").x.y(),     diag.at("kinetic_energy")};
+        bodyNamed(sim, "C").x.y(),             bodyNamed(sim, "D").x.y(),     diag.at("kinetic_energy")};
     return r;
   };
   const auto one = run(1), four = run(4);
@@ -919,7 +916,7 @@ TEST(PushOutRounds, APushPastTheBroadPhaseBoxIsUndoneInTheSameStepIn2D) {
                                  {{"solvers.contact.schedule", "thesis"}, {"solvers.contact.push_out_rounds", std::to_string(rounds)}}),
                       registry);
     const auto diag = sim.step();
-    return std::make_pair(diag.at("max_penetration"), bodyOf(sim, "D").x.y());
+    return std::make_pair(diag.at("max_penetration"), bodyNamed(sim, "D").x.y());
   };
   const auto [oneDepth, oneD] = run(1);
   const auto [fourDepth, fourD] = run(4);
@@ -1049,7 +1046,7 @@ TEST(BroadPhaseGrowth, ABallThatBouncesIntoABallItWasNeverPairedWithDoesNotSinkI
   ASSERT_TRUE(sim.finished());
   EXPECT_EQ(diag.at("contact_pairs_broad_phase"), 3);  // ground-A, ground-B, and A-B found again
   EXPECT_EQ(diag.at("broad_phase_pairs_added_after_collisions"), 1);
-  const RigidBody<3>&a = bodyOf(sim, "A"), &b = bodyOf(sim, "B");
+  const RigidBody<3>&a = bodyNamed(sim, "A"), &b = bodyNamed(sim, "B");
   // A bounced: moving up, and not into B (distance of the centres at least the sum of radii,
   // up to push-out's 1e-5 m tolerance).
   EXPECT_GT(a.v.y(), 0);
@@ -1130,7 +1127,7 @@ TEST(SweptCollisions, PlatesThrownAtAThinShelfStopOnItAtFrameRate) {
     }
     EXPECT_LE(worst, 0.01);
     watch.expectNoGain(std::abs(watch.initialTotal));
-    EXPECT_LT(bodyOf(sim, "plate").v.norm(), 1e-3);
+    EXPECT_LT(bodyNamed(sim, "plate").v.norm(), 1e-3);
     // The metric counts the fast pairs met where they first touch: the landing (stopped at its
     // start-of-step pose, the plate falls the rest of the gap and lands again, as in the thesis's
     // Step II), and nothing once it rests (it would keep counting if a resting pair were taken
@@ -1212,8 +1209,8 @@ TEST(MeshGround, SphereAndBoxComeToRestOnAnObjMesh) {
   while (!sim.finished()) watch.observe(sim.step());
   EXPECT_NEAR(positionOf(sim, "ball").y(), 0.5, 2e-3);
   EXPECT_NEAR(positionOf(sim, "box").y(), 0.2, 2e-3);
-  EXPECT_LT(bodyOf(sim, "ball").v.norm(), 1e-3);
-  EXPECT_LT(bodyOf(sim, "box").v.norm(), 1e-3);
+  EXPECT_LT(bodyNamed(sim, "ball").v.norm(), 1e-3);
+  EXPECT_LT(bodyNamed(sim, "box").v.norm(), 1e-3);
   watch.expectNoGain(std::abs(watch.initialTotal));
 }
 
@@ -1263,7 +1260,7 @@ TEST(MeshGround, ADynamicMeshCubeRestsAsTheBoxItBounds) {
     EXPECT_NEAR(positionOf(sim, "mesh_cube").y(), 0.5, 1e-3);
     EXPECT_LT(slid.norm(), 1e-3);
     EXPECT_LT(apart, 1e-4);
-    for (const char* name : {"mesh_cube", "on_mesh", "box_cube", "on_box"}) EXPECT_LT(bodyOf(sim, name).v.norm(), 1e-3) << name;
+    for (const char* name : {"mesh_cube", "on_mesh", "box_cube", "on_box"}) EXPECT_LT(bodyNamed(sim, name).v.norm(), 1e-3) << name;
     watch.expectNoGain(std::abs(watch.initialTotal));
   }
 }
@@ -1294,7 +1291,7 @@ std::pair<double, double> offCentreStack(int dimension, double seconds, bool sho
       moved = std::max({moved, (positionOf(sim, "cube") - cube0).norm(), (positionOf(sim, "top") - top0).norm()});
     }
     watch.expectNoGain(std::abs(watch.initialTotal));
-    speed = std::max(bodyOf(sim, "cube").v.norm(), bodyOf(sim, "top").v.norm());
+    speed = std::max(bodyNamed(sim, "cube").v.norm(), bodyNamed(sim, "top").v.norm());
   };
   std::vector<Override> overrides;
   if (shortSchedule)
@@ -1357,8 +1354,8 @@ TEST(ShockPropagation, APlankOnAStaticAndAKinematicBlockKeepsUpWithTheLift) {
   double worstApproach = 0;
   while (!sim.finished()) {
     sim.step();
-    const RigidBody<3>& plank = bodyOf(sim, "plank");
-    const RigidBody<3>& lift = bodyOf(sim, "lift");
+    const RigidBody<3>& plank = bodyNamed(sim, "plank");
+    const RigidBody<3>& lift = bodyNamed(sim, "lift");
     // The plank's lowest point above the lift's far edge (its underside at x = +1.5 in the
     // plank's frame), and its velocity relative to the lift along the lift's top normal.
     const Eigen::Vector3d corner = plank.x + plank.orientation * Eigen::Vector3d(1.5, -0.1, 0);

@@ -19,6 +19,7 @@
 #include "scenarios/simulation.h"
 
 using namespace monolith;
+using test::bodyNamed;
 using test::builtins;
 using test::kScenes;
 
@@ -41,12 +42,6 @@ double diagnostic(const std::map<std::string, double>& diag, const std::string& 
   return it == diag.end() ? 0.0 : it->second;
 }
 
-template <int d>
-const RigidBody<d>& bodyNamed(Simulation<d>& sim, const std::string& name) {
-  const RigidBody<d>* b = sim.world().template get<RigidBody<d>>(*sim.world().find(name));
-  if (!b) throw std::runtime_error("no body named " + name);
-  return *b;
-}
 
 // A 3-D scene at dt = 1/60 with gravity, sleeping on and a ground plane (friction 0.5), then
 // `entities` (each after a comma).
