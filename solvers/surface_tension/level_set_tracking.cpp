@@ -7,8 +7,7 @@
 
 namespace monolith::solvers {
 
-namespace {
-double sampleCells(const MacLayout<2>& layout, const std::vector<double>& phi, const Eigen::Vector2d& x) {
+double sampleCellField(const MacLayout<2>& layout, const std::vector<double>& phi, const Eigen::Vector2d& x) {
   const Eigen::Vector2d g = (x - layout.origin) / layout.dx - Eigen::Vector2d::Constant(0.5);
   const int nx = layout.cells.x(), ny = layout.cells.y();
   const double cx = std::clamp(g.x(), 0.0, nx - 1.0), cy = std::clamp(g.y(), 0.0, ny - 1.0);
@@ -17,6 +16,8 @@ double sampleCells(const MacLayout<2>& layout, const std::vector<double>& phi, c
   auto at = [&](int a, int b) { return phi[static_cast<std::size_t>(b) * nx + a]; };
   return (1 - wy) * ((1 - wx) * at(i, j) + wx * at(i + 1, j)) + wy * ((1 - wx) * at(i, j + 1) + wx * at(i + 1, j + 1));
 }
+
+namespace {
 Eigen::Vector2d velocityAt(const MacLayout<2>& layout, const Eigen::VectorXd& u, const Eigen::Vector2d& x) {
   return {sampleFaceVelocity(layout, u, 0, x), sampleFaceVelocity(layout, u, 1, x)};
 }
@@ -61,7 +62,7 @@ std::vector<double> advectCellField(const MacLayout<2>& layout, const std::vecto
     const Eigen::Vector2d x = layout.cellCenter(layout.cellCoord(c));
     const Eigen::Vector2d mid = x - 0.5 * dt * velocityAt(layout, u, x);
     const Eigen::Vector2d departure = x - dt * velocityAt(layout, u, mid);
-    out[c] = sampleCells(layout, phi, departure);
+    out[c] = sampleCellField(layout, phi, departure);
   }
   return out;
 }

@@ -15,6 +15,9 @@
 
 namespace monolith::solvers {
 
+// Bilinear sample of a cell-centred field at x (clamped to the cell centres' box).
+double sampleCellField(const MacLayout<2>& layout, const std::vector<double>& phi, const Eigen::Vector2d& x);
+
 // Semi-Lagrangian (midpoint rule) advection of a cell-centred field through the face velocities u.
 std::vector<double> advectCellField(const MacLayout<2>& layout, const std::vector<double>& phi, const Eigen::VectorXd& u,
                                     double dt);

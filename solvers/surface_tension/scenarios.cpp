@@ -1,6 +1,7 @@
 #include "solvers/surface_tension/scenarios.h"
 
 #include "solvers/surface_tension/front_metrics.h"
+#include "solvers/surface_tension/fast_marching.h"
 #include "solvers/surface_tension/pressure_jump.h"
 
 #include <algorithm>
@@ -90,7 +91,7 @@ int staticCircleFrontPoints(int n) {
 }
 
 StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double endTime, bool levelSet, int points,
-                                   bool remesh, double densityOutside) {
+                                   bool remesh, double densityOutside, const LevelSetFrontOptions& levelSetOptions) {
   const double dx = 1.0 / n, dt = 0.2 * dx;
   if (points <= 0) points = staticCircleFrontPoints(n);
   TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(n, n), dx),
@@ -104,12 +105,17 @@ StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double e
     for (int c = 0; c < state.layout.cellCount(); ++c)
       state.phi[c] = (state.layout.cellCenter(state.layout.cellCoord(c)) - Eigen::Vector2d(0.5, 0.5)).norm() - 0.25;
     state.front = frontFromLevelSet(state.layout, state.phi, CrossingOrder::Fourth);
+    settings.levelSetRedistancing = levelSetOptions.redistancing;
+    settings.levelSetKeep = levelSetOptions.keep;
+    settings.particleLevelSet = levelSetOptions.particles;
   }
+  const std::vector<double> exactPhi = state.phi;
   StaticCircleResult r;
   const int steps = static_cast<int>(std::lround(endTime / dt));
   TwoPhaseStepReport last;
   for (int i = 0; i < steps; ++i) {
     last = advanceTwoPhase(state, settings, dt);
+    if (levelSet && levelSetOptions.frozen) state.phi = exactPhi;
     if (last.blewUp) {
       r.stable = false;
       break;
@@ -386,6 +392,53 @@ StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, in
   }
   return stepStabilityCase(n, steps, state, enclosedArea(state.front),
                            [&](TwoPhaseState& s) { return advanceTwoPhase(s, settings, dt); });
+}
+
+VortexDeformationResult runVortexDeformation(int n, double period, bool particles) {
+  const double dx = 1.0 / n;
+  const MacLayout<2> layout(Eigen::Vector2i(n, n), dx);
+  const Eigen::Vector2d centre(0.5, 0.75);
+  const double radius = 0.15;
+  std::vector<double> phi(layout.cellCount());
+  for (int c = 0; c < layout.cellCount(); ++c) phi[c] = (layout.cellCenter(layout.cellCoord(c)) - centre).norm() - radius;
+  ParticleLevelSetSettings settings;
+  std::vector<LevelSetParticle> markers;
+  if (particles) markers = seedParticles(layout, phi, settings);
+  VortexDeformationResult result;
+  result.particles = static_cast<int>(markers.size());
+  auto front = [&] { return frontFromLevelSet(layout, phi, CrossingOrder::Fourth); };
+  result.fronts.push_back(front());
+  result.initialArea = enclosedArea(result.fronts.back());
+  const int steps = static_cast<int>(std::ceil(period / dx - 1e-9));
+  const double dt = period / steps;
+  Eigen::VectorXd u(layout.totalFaces());
+  for (int step = 0; step < steps; ++step) {
+    const double time = (step + 0.5) * dt, scale = std::cos(M_PI * time / period);
+    for (int f = 0; f < layout.totalFaces(); ++f) {
+      const auto [axis, coord] = layout.faceCoord(f);
+      const Eigen::Vector2d x = layout.faceCenter(axis, coord);
+      const double sx = std::sin(M_PI * x.x()), sy = std::sin(M_PI * x.y());
+      u[f] = scale * (axis == 0 ? -sx * sx * std::sin(2 * M_PI * x.y()) : sy * sy * std::sin(2 * M_PI * x.x()));
+    }
+    if (particles) {
+      result.escapedTotal += particleLevelSetStep(layout, u, dt, phi, markers, settings);
+    } else {
+      phi = advectCellField(layout, phi, u, dt);
+      fastMarchingRedistance(layout, phi, settings.redistanceBand);
+    }
+    if (step + 1 == steps / 2) {
+      result.fronts.push_back(front());
+      result.halfArea = enclosedArea(result.fronts.back());
+    }
+  }
+  result.fronts.push_back(front());
+  result.finalArea = enclosedArea(result.fronts.back());
+  result.areaError = (result.finalArea - result.initialArea) / result.initialArea;
+  result.halfAreaError = (result.halfArea - result.initialArea) / result.initialArea;
+  for (const auto& x : result.fronts.back().points)
+    result.maxShapeError = std::max(result.maxShapeError, std::abs((x - centre).norm() - radius));
+  result.steps = steps;
+  return result;
 }
 
 }  // namespace monolith::solvers

@@ -7,6 +7,7 @@
 
 #include "solvers/surface_tension/level_set_front.h"
 #include "solvers/surface_tension/level_set_tracking.h"
+#include "solvers/surface_tension/particle_level_set.h"
 #include "solvers/surface_tension/two_phase_flow.h"
 
 namespace monolith::solvers {
@@ -38,9 +39,18 @@ struct StaticCircleResult {
   int steps = 0, lastIterations = 0;
   bool stable = true;
 };
+// How a level-set-tracked front is kept (TwoPhaseSettings); frozen: phi is reset to the circle's exact
+// distance after every step, so the mesh never moves (the discretization's own floor).
+struct LevelSetFrontOptions {
+  LevelSetRedistancing redistancing = LevelSetRedistancing::ToMesh;
+  double keep = 2;
+  bool particles = false;
+  bool frozen = false;
+};
 // levelSet: the level-set-tracked front (level_set_tracking.h) from the circle's exact signed distance.
 StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double endTime, bool levelSet = false,
-                                   int points = 0, bool remesh = false, double densityOutside = 1e4);
+                                   int points = 0, bool remesh = false, double densityOutside = 1e4,
+                                   const LevelSetFrontOptions& levelSetOptions = {});
 // The point count of the original driver's front at 1/dx = n: the power of two nearest 8 pi r n.
 int staticCircleFrontPoints(int n);
 TwoPhaseSettings staticCircleSettings(bool onePhase, bool implicit);
@@ -122,5 +132,20 @@ StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, in
 double stabilityCapillaryDt(int n);
 // The same case with the pressure jump scheme (pressure_jump.h), phi the distance to the shape.
 StabilityCase runPressureJumpStabilityCase(int n, double dt, bool ellipse, int steps);
+
+// The single-vortex deformation test of the particle level set [47] (Sec. 5.3; after LeVeque): [0, 1]^2
+// with n x n cells, a circle r = 0.15 about (0.5, 0.75) in u = -sin^2(pi x) sin(2 pi y) cos(pi t / T),
+// v = sin^2(pi y) sin(2 pi x) cos(pi t / T), which stretches it into a spiral until T/2 and brings it
+// back to the circle at T. dt = dx (CFL <= 1), the velocity at the step's middle time.
+// Plain: semi-Lagrangian phi with fast-marching redistancing every step; particles: the particle level
+// set (particle_level_set.h). The area is that of the front built from phi (fourth-order crossings);
+// areaError = (A(T) - A(0)) / A(0). fronts: the fronts at t = 0, T/2 and T (for the figure).
+struct VortexDeformationResult {
+  double initialArea = 0, halfArea = 0, finalArea = 0, areaError = 0, halfAreaError = 0;
+  double maxShapeError = 0;  // max over the final front's points of | |x - c| - r |
+  int steps = 0, particles = 0, escapedTotal = 0;
+  std::vector<Front2> fronts;
+};
+VortexDeformationResult runVortexDeformation(int n, double period, bool particles);
 
 }  // namespace monolith::solvers

@@ -12,6 +12,7 @@
 #include "solvers/advection/semi_lagrangian.h"
 #include "solvers/surface_tension/face_extrapolation.h"
 #include "solvers/surface_tension/level_set_front.h"
+#include "solvers/surface_tension/fast_marching.h"
 #include "solvers/surface_tension/level_set_tracking.h"
 
 namespace monolith::solvers {
@@ -520,8 +521,10 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
     moveLevelSetWithFront(layout, state.front, velocity, dt, state.phi);
     if (rebuildFront(state, layout, settings, report)) redistanceToFront(layout, state.front, state.phi);
   } else if (settings.levelSetFront) {
-    // The level set moves with the grid velocity; the mesh is rebuilt from it and it is
-    // redistanced to that mesh.
+    // The level set moves with the grid velocity (its particles too, with the particle level set,
+    // and they correct it); it is redistanced and the mesh rebuilt from it.
+    const std::vector<double> previousPhi = settings.particleLevelSet && state.levelSetParticles.empty() ? state.phi
+                                                                                                        : std::vector<double>();
     if (settings.advection == TwoPhaseAdvection::EnoRk3) {
       const Eigen::VectorXd phi = Eigen::Map<const Eigen::VectorXd>(state.phi.data(), static_cast<Eigen::Index>(state.phi.size()));
       Eigen::VectorXd next = phi;
@@ -531,7 +534,20 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
     } else {
       state.phi = advectCellField(layout, state.phi, state.u, dt);
     }
-    if (rebuildFront(state, layout, settings, report)) redistanceToFront(layout, state.front, state.phi);
+    if (settings.particleLevelSet) {
+      if (state.levelSetParticles.empty()) state.levelSetParticles = seedParticles(layout, previousPhi, settings.particleSettings);
+      advectParticles(layout, state.u, dt, state.levelSetParticles);
+      correctWithParticles(layout, state.levelSetParticles, state.phi);
+    }
+    if (settings.levelSetRedistancing == LevelSetRedistancing::FastMarching)
+      fastMarchingRedistance(layout, state.phi, 5, settings.levelSetKeep);
+    if (settings.particleLevelSet) {
+      if (settings.levelSetRedistancing == LevelSetRedistancing::FastMarching)
+        correctWithParticles(layout, state.levelSetParticles, state.phi);
+      adjustParticleRadii(layout, state.phi, state.levelSetParticles, settings.particleSettings);
+    }
+    if (rebuildFront(state, layout, settings, report) && settings.levelSetRedistancing == LevelSetRedistancing::ToMesh)
+      redistanceToFront(layout, state.front, state.phi, 5, settings.levelSetKeep);
   } else {
     const Eigen::VectorXd v = D.Ht.transpose() * unew;  // H u^{n+1}
     for (int k = 0; k < state.front.pointCount(); ++k) state.front.points[k] += dt * v.segment<2>(2 * k);

@@ -40,6 +40,7 @@
 #include "solvers/fluid/krylov.h"
 #include "solvers/mac_layout.h"
 #include "solvers/surface_tension/front.h"
+#include "solvers/surface_tension/particle_level_set.h"
 
 namespace monolith::solvers {
 
@@ -48,6 +49,11 @@ namespace monolith::solvers {
 // third-order Hamilton-Jacobi ENO with TVD RK3 (Sec. 6.3; solvers/advection/eno.h; stable for
 // CFL numbers up to about 1).
 enum class TwoPhaseAdvection { None, SemiLagrangian, EnoRk3 };
+
+// How a level-set-tracked front's phi is made a distance again after it moved (the cells within
+// TwoPhaseSettings::levelSetKeep dx keep their values): the exact distance to the rebuilt mesh
+// (level_set_tracking.h), fast marching from the kept cells (fast_marching.h), or not at all.
+enum class LevelSetRedistancing { ToMesh, FastMarching, None };
 
 struct TwoPhaseSettings {
   double densityInside = 1;   // rho: the phase the front's loops enclose
@@ -75,6 +81,12 @@ struct TwoPhaseSettings {
   // like), and set phi to the signed distance to the moved mesh. The next step's mesh is rebuilt
   // from that phi as usual.
   bool levelSetImplicitUpdate = false;
+  LevelSetRedistancing levelSetRedistancing = LevelSetRedistancing::ToMesh;
+  double levelSetKeep = 2;  // in dx; 0 re-initialises every cell (the fast marching of [47])
+  // The particle level set [47] (particle_level_set.h) corrects the advected phi before and after
+  // redistancing; its particles live in TwoPhaseState::levelSetParticles (seeded on the first step).
+  bool particleLevelSet = false;
+  ParticleLevelSetSettings particleSettings;
   // Front tracking, beyond the thesis (which does not say where a coupling face's u* comes from):
   // false samples it from the grid velocity each step, which discards the last solve's coupling
   // velocities and damps the interface's motion by a fixed amount per step (more steps, more
@@ -91,6 +103,7 @@ struct TwoPhaseState {
   std::vector<double> pInside, pOutside;  // per cell: the phase's pressure (0 where it has none)
   std::vector<double> phi;                // level-set-tracked fronts: signed distance per cell
   std::vector<Eigen::Vector2d> pointVelocity;  // carryCouplingVelocity: H u^n per front point, else empty
+  std::vector<LevelSetParticle> levelSetParticles;  // particleLevelSet: the marker particles
   double time = 0;
   int step = 0;
 };

@@ -6,6 +6,7 @@
 //   bench_surface_tension epsilon N [eps=E...]        Table 6.4 epsilon test
 //   bench_surface_tension rising_stability [N]        Sec. 6.4.4 (implicit and explicit, dt = 3 and 7 s)
 //   bench_surface_tension stability_map               Fig. 6.6-style sweep
+//   bench_surface_tension vortex [T] [N...]            particle level set against the plain one
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -49,6 +50,7 @@ int main(int argc, char** argv) {
     int points = 0;
     bool remesh = false;
     double rhoOut = 1e4, endTime = 5.0;
+    LevelSetFrontOptions lsOptions;
     std::vector<int> ns;
     for (int i = 3; i < argc; ++i) {
       const std::string a = argv[i];
@@ -57,9 +59,20 @@ int main(int argc, char** argv) {
       else if (a == "remesh") remesh = true;
       else if (a.rfind("rho_out=", 0) == 0) rhoOut = std::atof(a.c_str() + 8);
       else if (a.rfind("t_end=", 0) == 0) endTime = std::atof(a.c_str() + 6);
+      else if (a == "redistance=fmm") lsOptions.redistancing = LevelSetRedistancing::FastMarching;
+      else if (a == "redistance=none") lsOptions.redistancing = LevelSetRedistancing::None;
+      else if (a.rfind("keep=", 0) == 0) lsOptions.keep = std::atof(a.c_str() + 5);
+      else if (a == "particles") lsOptions.particles = true;
+      else if (a == "frozen") lsOptions.frozen = true;
       else ns.push_back(std::atoi(a.c_str()));
     }
     if (ns.empty()) ns = {20, 40, 80};
+    if (ls)
+      std::printf("level set: redistancing %s, keep %g dx%s%s\n",
+                  lsOptions.redistancing == LevelSetRedistancing::ToMesh       ? "to the mesh"
+                  : lsOptions.redistancing == LevelSetRedistancing::FastMarching ? "fast marching"
+                                                                                 : "none",
+                  lsOptions.keep, lsOptions.particles ? ", particle level set" : "", lsOptions.frozen ? ", frozen" : "");
     std::printf("static circle, %s phase, %s, implicit, t = %g, dt = 0.2 dx, front points %s%s, rho_out %g\n"
                 "| 1/dx | L1(u) | Linf(u) | pressure jump | jump error | steps | CG its (last) | wall s |\n|---|---|---|---|---|---|---|---|\n",
                 one ? "one" : "two", ls ? "level-set front" : "front tracking", endTime,
@@ -67,7 +80,7 @@ int main(int argc, char** argv) {
     for (int n : ns) {
       const auto start = std::chrono::steady_clock::now();
       const int p = points >= 0 ? points : static_cast<int>(std::lround(2 * M_PI * 0.25 * n));
-      const StaticCircleResult r = runStaticCircle(n, one, true, endTime, ls, p, remesh, rhoOut);
+      const StaticCircleResult r = runStaticCircle(n, one, true, endTime, ls, p, remesh, rhoOut, lsOptions);
       std::printf("| %d | %.3e | %.3e | %.5f | %.2e | %d | %d | %.1f |\n", n, r.l1, r.linf, r.pressureJump,
                   std::abs(r.pressureJump - 4.0) / 4.0, r.steps, r.lastIterations, seconds(start));
       std::fflush(stdout);
@@ -250,6 +263,40 @@ int main(int argc, char** argv) {
         }
         std::printf("(wall %.1f s)\n", seconds(start));
       }
+  } else if (mode == "vortex") {
+    // vortex [T] [N...] [fronts=PREFIX]: the single-vortex test of the particle level set [47], plain
+    // level set (semi-Lagrangian + fast marching) against the particle level set. fronts=PREFIX writes
+    // PREFIX_N.csv: scheme, time label (0, half, end), x, y per point of each segment's start.
+    const double period = argc > 2 ? std::atof(argv[2]) : 2.0;
+    std::string frontsPrefix;
+    std::vector<int> ns;
+    for (int i = 3; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (a.rfind("fronts=", 0) == 0) frontsPrefix = a.substr(7);
+      else ns.push_back(std::atoi(a.c_str()));
+    }
+    if (ns.empty()) ns = {32, 64, 128};
+    std::printf("single vortex, circle r = 0.15 at (0.5, 0.75), T = %g, dt = dx\n"
+                "| N | scheme | area error at T/2 | area error at T | max radius error at T | particles | escaped (sum over steps) | steps | wall s |\n"
+                "|---|---|---|---|---|---|---|---|\n",
+                period);
+    for (int n : ns) {
+      FILE* out = frontsPrefix.empty() ? nullptr : std::fopen((frontsPrefix + "_" + std::to_string(n) + ".csv").c_str(), "w");
+      for (bool particles : {false, true}) {
+        const auto start = std::chrono::steady_clock::now();
+        const VortexDeformationResult r = runVortexDeformation(n, period, particles);
+        std::printf("| %d | %s | %+.3e | %+.3e | %.3e | %d | %d | %d | %.1f |\n", n, particles ? "particle level set" : "level set",
+                    r.halfAreaError, r.areaError, r.maxShapeError, r.particles, r.escapedTotal, r.steps, seconds(start));
+        std::fflush(stdout);
+        const char* labels[] = {"0", "half", "end"};
+        if (out)
+          for (std::size_t k = 0; k < r.fronts.size(); ++k)
+            for (const auto& e : r.fronts[k].elements)
+              std::fprintf(out, "%s,%s,%.9g,%.9g,%.9g,%.9g\n", particles ? "particles" : "plain", labels[k], r.fronts[k].points[e[0]].x(),
+                           r.fronts[k].points[e[0]].y(), r.fronts[k].points[e[1]].x(), r.fronts[k].points[e[1]].y());
+      }
+      if (out) std::fclose(out);
+    }
   } else {
     std::fprintf(stderr, "unknown mode %s\n", mode.c_str());
     return 2;
