@@ -406,7 +406,9 @@ VortexDeformationResult runVortexDeformation(int n, double period, bool particle
   if (particles) markers = seedParticles(layout, phi, settings);
   VortexDeformationResult result;
   result.particles = static_cast<int>(markers.size());
-  auto front = [&] { return frontFromLevelSet(layout, phi, CrossingOrder::Fourth); };
+  // No sliver merging: the stretched spiral's under-resolved tail can leave marching-squares segments
+  // that do not chain, and the area (a sum over segments) does not need them to.
+  auto front = [&] { return frontFromLevelSet(layout, phi, CrossingOrder::Fourth, 0.0); };
   result.fronts.push_back(front());
   result.initialArea = enclosedArea(result.fronts.back());
   const int steps = static_cast<int>(std::ceil(period / dx - 1e-9));

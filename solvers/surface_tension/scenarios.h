@@ -138,7 +138,8 @@ StabilityCase runPressureJumpStabilityCase(int n, double dt, bool ellipse, int s
 // v = sin^2(pi y) sin(2 pi x) cos(pi t / T), which stretches it into a spiral until T/2 and brings it
 // back to the circle at T. dt = dx (CFL <= 1), the velocity at the step's middle time.
 // Plain: semi-Lagrangian phi with fast-marching redistancing every step; particles: the particle level
-// set (particle_level_set.h). The area is that of the front built from phi (fourth-order crossings);
+// set (particle_level_set.h). The area is that of the front built from phi (fourth-order crossings, no
+// sliver merging);
 // areaError = (A(T) - A(0)) / A(0). fronts: the fronts at t = 0, T/2 and T (for the figure).
 struct VortexDeformationResult {
   double initialArea = 0, halfArea = 0, finalArea = 0, areaError = 0, halfAreaError = 0;
