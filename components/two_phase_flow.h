@@ -38,6 +38,9 @@ struct TwoPhaseFlow {
   std::uint8_t levelSetFront = 0;                // 1: the front is rebuilt each step from `phi`;
                                                  // 2: and phi follows the mesh moved by H u (implicit update)
   std::uint8_t carryCouplingVelocity = 0;        // 1: coupling faces' u* from the points' carried H u^n
+  std::uint8_t levelSetRedistancing = 0;         // level-set fronts: 0 to the mesh, 1 fast marching, 2 none
+  double levelSetKeep = 3;                       // cells within this many dx keep their advected phi
+  std::uint8_t particleLevelSet = 0;             // 1: the particle level set corrects phi
 
   // --- state ---
   std::vector<double> u;               // face velocities, MAC layout order
@@ -47,6 +50,7 @@ struct TwoPhaseFlow {
   std::vector<double> phi;             // level-set-tracked fronts: signed distance per cell
   double initialArea = 0;              // enclosed by the front at the start (area drift)
   std::vector<double> frontPointVelocity;  // carryCouplingVelocity: H u^n, d per point (empty: sample the grid)
+  std::vector<double> levelSetParticles;   // particleLevelSet: d coordinates, radius, sign per particle
 
   // --- probes: velocity sampled at points, reported as <name>_u, <name>_v in metrics.csv ---
   std::vector<double> probePoints;     // d per probe
@@ -84,6 +88,10 @@ struct TwoPhaseFlow {
     // Appended after the original fields, so the layout of the fields before them is unchanged.
     visit("carry_coupling_velocity", carryCouplingVelocity);
     visit("front_point_velocity", frontPointVelocity);
+    visit("level_set_redistancing", levelSetRedistancing);
+    visit("level_set_keep", levelSetKeep);
+    visit("particle_level_set", particleLevelSet);
+    visit("level_set_particles", levelSetParticles);
   }
 };
 

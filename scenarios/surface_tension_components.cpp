@@ -120,6 +120,18 @@ void parseTwoPhaseFlow(World<d>& world, Entity e, const Config& c) {
                "\"sampled\" with a level-set-tracked front (\"carried\" needs \"tracking\": \"front\": a level set's mesh "
                "is rebuilt every step, so no point keeps its velocity)",
                "\"carried\" with \"tracking\": \"" + tracking + "\"");
+    // How a level-set-tracked front's phi is kept a distance (docs/surface_tension.md, step 5).
+    for (const char* key : {"redistancing", "keep", "particles"})
+      if (!flow.levelSetFront && f.has(key))
+        f.failAt(key, "no \"" + std::string(key) + "\" with \"tracking\": \"front\" (it sets how a level set is kept)",
+                 "\"" + std::string(key) + "\" with front tracking");
+    const std::string redistancing = f.oneOf("redistancing", {"to_mesh", "fast_marching", "none"}, "to_mesh");
+    flow.levelSetRedistancing = redistancing == "to_mesh" ? 0 : redistancing == "fast_marching" ? 1 : 2;
+    flow.levelSetKeep = f.number("keep", flow.levelSetKeep, Bound::NonNegative);
+    flow.particleLevelSet = f.boolean("particles", false) ? 1 : 0;
+    if (flow.particleLevelSet && flow.levelSetFront == 2)
+      f.failAt("particles", "false with \"tracking\": \"level_set_implicit\" (its phi is not advected, so no particle corrects it)",
+               "true");
     solvers::Front2 front = parseFront(f, flow.dx);
     const Eigen::Vector2d upper = flow.origin + flow.dx * flow.cells.cast<double>();
     for (const auto& x : front.points)
@@ -172,7 +184,7 @@ void registerSurfaceTensionComponents(Registry& r) {
       "one- or two-phase flow with surface tension on a Lagrangian front (2-D): cells, domain_min/max, phases "
       "(one|two), density_inside/outside, viscosity, surface_tension, treatment (implicit|explicit), gravity, "
       "advection, coupling_velocity (sampled|carried), front {shape: circle|polygon, tracking: "
-      "front|level_set|level_set_implicit}, probes [{name, position}]",
+      "front|level_set|level_set_implicit, redistancing: to_mesh|fast_marching|none, keep, particles}, probes [{name, position}]",
       parseTwoPhaseFlow<d>);
 }
 

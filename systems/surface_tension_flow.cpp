@@ -41,6 +41,10 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
       state.phi = flow.phi;
       for (std::size_t k = 0; k + 1 < flow.frontPointVelocity.size(); k += 2)
         state.pointVelocity.emplace_back(flow.frontPointVelocity[k], flow.frontPointVelocity[k + 1]);
+      for (std::size_t k = 0; k + 3 < flow.levelSetParticles.size(); k += 4) {
+        const double* q = flow.levelSetParticles.data() + k;
+        state.levelSetParticles.push_back({Eigen::Vector2d(q[0], q[1]), q[2], q[3] < 0 ? -1 : 1});
+      }
       state.time = ctx.time;
       state.step = static_cast<int>(ctx.step);
 
@@ -64,6 +68,11 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
       s.levelSetFront = flow.levelSetFront != 0;
       s.levelSetImplicitUpdate = flow.levelSetFront == 2;
       s.carryCouplingVelocity = flow.carryCouplingVelocity != 0;
+      s.levelSetRedistancing = flow.levelSetRedistancing == 1   ? solvers::LevelSetRedistancing::FastMarching
+                               : flow.levelSetRedistancing == 2 ? solvers::LevelSetRedistancing::None
+                                                                : solvers::LevelSetRedistancing::ToMesh;
+      s.levelSetKeep = flow.levelSetKeep;
+      s.particleLevelSet = flow.particleLevelSet != 0;
 
       const Eigen::Vector2d centroidBefore = solvers::measureFront(state.front).centroid;
       const solvers::TwoPhaseStepReport r = solvers::advanceTwoPhase(state, s, ctx.dt);
@@ -78,6 +87,9 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
       flow.phi = state.phi;
       flow.frontPointVelocity.clear();
       for (const auto& v : state.pointVelocity) flow.frontPointVelocity.insert(flow.frontPointVelocity.end(), {v.x(), v.y()});
+      flow.levelSetParticles.clear();
+      for (const auto& p : state.levelSetParticles)
+        flow.levelSetParticles.insert(flow.levelSetParticles.end(), {p.x.x(), p.x.y(), p.radius, static_cast<double>(p.sign)});
 
       auto& out = ctx.diagnostics;
       out.max("fluid_max_speed", r.maxSpeed);

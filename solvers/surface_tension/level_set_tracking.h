@@ -1,13 +1,14 @@
 #pragma once
-// Level-set-tracked fronts (thesis Sec. 6.3.1, "Level Set Tracked"), in a reduced form: the
-// cell-centred level set is advected semi-Lagrangianly with the grid velocity (no particle
-// correction), the surface mesh is rebuilt from it every step (level_set_front.h, fourth-order
-// crossings, slivers < 0.1 dx merged), and the level set is redistanced to the exact distance to
-// that mesh between `keep` and `band` cells from it (values beyond the band are clamped to
-// +-band dx; only the signs are read there). The values within `keep` cells, which the crossing
-// stencils read, stay the advected ones: the distance to the mesh's chords would move the
-// interface inward by O(dx^2 / r) each step (measured: 8 % of a 20-cell drop's area in 20 steps).
-// The particle level set [47] and fast marching are not implemented.
+// Level-set-tracked fronts (thesis Sec. 6.3.1, "Level Set Tracked"): the cell-centred level set is
+// advected with the grid velocity, the surface mesh is rebuilt from it every step (level_set_front.h,
+// fourth-order crossings, slivers < 0.1 dx merged), and the level set is made a distance again
+// beyond `keep` cells: here the exact distance to that mesh between `keep` and `band` cells from it
+// (values beyond the band are clamped to +-band dx; only the signs are read there); fast marching
+// (fast_marching.h) is the other choice, and the particle level set [47] (particle_level_set.h)
+// corrects phi around it. The values within `keep` cells, which the crossing stencils read, stay the
+// advected ones: the distance to the mesh's chords moves the interface inward by O(dx^2 / r) each
+// step (measured: 8 % of a 20-cell drop's area in 20 steps with keep = 0), and with keep = 2 it still
+// changed values the stencils read, enough to stop the parasitic currents converging.
 #include <vector>
 
 #include "solvers/mac_layout.h"
@@ -34,7 +35,7 @@ void moveLevelSetWithFront(const MacLayout<2>& layout, const Front2& front, cons
 // Signed distance to `front` (negative inside, sign taken from `phi`) for the cells between `keep`
 // and `band` cells from it.
 void redistanceToFront(const MacLayout<2>& layout, const Front2& front, std::vector<double>& phi, double band = 5,
-                       double keep = 2);
+                       double keep = 3);
 
 // Exact signed distance to a closed front (negative inside), clamped to +-band dx.
 std::vector<double> signedDistanceToFront(const MacLayout<2>& layout, const Front2& front, double band = 4);

@@ -43,7 +43,7 @@ struct StaticCircleResult {
 // distance after every step, so the mesh never moves (the discretization's own floor).
 struct LevelSetFrontOptions {
   LevelSetRedistancing redistancing = LevelSetRedistancing::ToMesh;
-  double keep = 2;
+  double keep = 3;
   bool particles = false;
   bool frozen = false;
 };

@@ -409,6 +409,19 @@ bool rebuildFront(TwoPhaseState& state, const MacLayout<2>& layout, const TwoPha
     return false;
   }
 }
+
+// A moved level set made a distance again beyond levelSetKeep cells (the particles correct it once
+// more after fast marching and take their new radii), and the mesh rebuilt from it.
+void redistanceLevelSet(TwoPhaseState& state, const MacLayout<2>& layout, const TwoPhaseSettings& settings,
+                        TwoPhaseStepReport& report) {
+  if (settings.levelSetRedistancing == LevelSetRedistancing::FastMarching) {
+    fastMarchingRedistance(layout, state.phi, 5, settings.levelSetKeep);
+    if (settings.particleLevelSet) correctWithParticles(layout, state.levelSetParticles, state.phi);
+  }
+  if (settings.particleLevelSet) adjustParticleRadii(layout, state.phi, state.levelSetParticles, settings.particleSettings);
+  if (rebuildFront(state, layout, settings, report) && settings.levelSetRedistancing == LevelSetRedistancing::ToMesh)
+    redistanceToFront(layout, state.front, state.phi, 5, settings.levelSetKeep);
+}
 }  // namespace
 
 TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings& settings, double dt) {
@@ -514,12 +527,12 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
   }
   if (settings.levelSetFront && settings.levelSetImplicitUpdate) {
     // phi moves with the Lagrangian velocity H u^{n+1}; the mesh is rebuilt from it and phi is
-    // redistanced to that mesh beyond 2 cells, as below.
+    // redistanced beyond levelSetKeep cells, as below.
     const Eigen::VectorXd v = D.Ht.transpose() * unew;
     std::vector<Eigen::Vector2d> velocity(state.front.pointCount());
     for (int k = 0; k < state.front.pointCount(); ++k) velocity[k] = v.segment<2>(2 * k);
     moveLevelSetWithFront(layout, state.front, velocity, dt, state.phi);
-    if (rebuildFront(state, layout, settings, report)) redistanceToFront(layout, state.front, state.phi);
+    redistanceLevelSet(state, layout, settings, report);
   } else if (settings.levelSetFront) {
     // The level set moves with the grid velocity (its particles too, with the particle level set,
     // and they correct it); it is redistanced and the mesh rebuilt from it.
@@ -539,15 +552,7 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
       advectParticles(layout, state.u, dt, state.levelSetParticles);
       correctWithParticles(layout, state.levelSetParticles, state.phi);
     }
-    if (settings.levelSetRedistancing == LevelSetRedistancing::FastMarching)
-      fastMarchingRedistance(layout, state.phi, 5, settings.levelSetKeep);
-    if (settings.particleLevelSet) {
-      if (settings.levelSetRedistancing == LevelSetRedistancing::FastMarching)
-        correctWithParticles(layout, state.levelSetParticles, state.phi);
-      adjustParticleRadii(layout, state.phi, state.levelSetParticles, settings.particleSettings);
-    }
-    if (rebuildFront(state, layout, settings, report) && settings.levelSetRedistancing == LevelSetRedistancing::ToMesh)
-      redistanceToFront(layout, state.front, state.phi, 5, settings.levelSetKeep);
+    redistanceLevelSet(state, layout, settings, report);
   } else {
     const Eigen::VectorXd v = D.Ht.transpose() * unew;  // H u^{n+1}
     for (int k = 0; k < state.front.pointCount(); ++k) state.front.points[k] += dt * v.segment<2>(2 * k);

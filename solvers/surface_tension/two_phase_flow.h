@@ -82,7 +82,11 @@ struct TwoPhaseSettings {
   // from that phi as usual.
   bool levelSetImplicitUpdate = false;
   LevelSetRedistancing levelSetRedistancing = LevelSetRedistancing::ToMesh;
-  double levelSetKeep = 2;  // in dx; 0 re-initialises every cell (the fast marching of [47])
+  // In dx; 0 re-initialises every cell (the fast marching of [47]). The crossing stencils read phi up
+  // to about 3 cells from the front, and any redistancing there moves the mesh points by an O(dx^2)
+  // that varies from point to point: O(1) curvature noise, parasitic currents that do not converge
+  // (docs/benchmarks_surface_tension.md). 3 keeps every value the stencils read.
+  double levelSetKeep = 3;
   // The particle level set [47] (particle_level_set.h) corrects the advected phi before and after
   // redistancing; its particles live in TwoPhaseState::levelSetParticles (seeded on the first step).
   bool particleLevelSet = false;

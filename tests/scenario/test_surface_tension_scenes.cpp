@@ -121,6 +121,33 @@ TEST(SurfaceTensionScenes, CarriedCouplingVelocitiesRestartBitwise) {
   EXPECT_NE(lastValue(tmp.path() / "carried" / "metrics.csv", "p1_u"), lastValue(tmp.path() / "sampled" / "metrics.csv", "p1_u"));
 }
 
+TEST(SurfaceTensionScenes, ParticleLevelSetRestartsBitwiseAndThreadsAgree) {
+  // The level-set-tracked drop with the particle level set and fast marching: its particles are
+  // state (level_set_particles), so a run resumed at step 20 ends bitwise equal to the straight one,
+  // and 1 and 2 threads agree. Without particles the run differs, so the option reaches the solver.
+  TempDir tmp;
+  const std::vector<std::string> levelSet = {"--set", "entities.0.two_phase_flow.coupling_velocity=sampled", "--set",
+                                             "entities.0.two_phase_flow.front.tracking=level_set", "--set",
+                                             "entities.0.two_phase_flow.front.redistancing=fast_marching"};
+  std::vector<std::string> particles = levelSet;
+  particles.insert(particles.end(), {"--set", "entities.0.two_phase_flow.front.particles=true"});
+  std::vector<std::string> a = particles, c = particles;
+  a.insert(a.end(), {"--checkpoint-every", "20", "--threads", "2"});
+  c.insert(c.end(), {"--threads", "1"});
+  ASSERT_EQ(runSmallOscillatingDrop(tmp, "A", a).exitCode, 0);
+  ASSERT_EQ(runSmallOscillatingDrop(tmp, "C", c).exitCode, 0);
+  ASSERT_EQ(runSmallOscillatingDrop(tmp, "plain", levelSet).exitCode, 0);
+  const CommandResult b = resumeAtStep20(tmp, "A", "B");
+  ASSERT_EQ(b.exitCode, 0) << b.err;
+  const Json ra = Json::parse(slurp(tmp.path() / "A" / "summary.json"));
+  EXPECT_EQ(ra["steps_completed"], 40);
+  EXPECT_EQ(ra["state_hash"], Json::parse(slurp(tmp.path() / "B" / "summary.json"))["state_hash"]);
+  EXPECT_EQ(ra["state_hash"], Json::parse(slurp(tmp.path() / "C" / "summary.json"))["state_hash"]);
+  EXPECT_NE(ra["state_hash"], Json::parse(slurp(tmp.path() / "plain" / "summary.json"))["state_hash"]);
+  EXPECT_LT(lastValue(tmp.path() / "A" / "metrics.csv", "p1_u"), 0.0);  // the drop's first half-period
+  EXPECT_LT(std::abs(lastValue(tmp.path() / "A" / "metrics.csv", "front_area_drift")), 0.01);
+}
+
 TEST(SurfaceTensionScenes, FrontFramesReadBackWithVtk) {
   // The static circle to t = 1 (frames at t = 0 and 1): front_N.vtp read by vtkXMLPolyDataReader.
   // One closed polyline of the 128 points at r = 0.25 about (0.5, 0.5), curvature 1/r, outward
@@ -220,6 +247,19 @@ TEST(SurfaceTensionScenes, ValidationNamesFilePathAndExpectation) {
   const CommandResult coupling = validate("coupling.json", "{" + base + R"("density_outside": 1, "coupling_velocity": "kept",
       "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2 } })");
   expectRefused(coupling, {"two_phase_flow.coupling_velocity", "carried"});
+  const CommandResult keep = validate("keep.json", "{" + base + R"("density_outside": 1,
+      "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, "keep": 3 } })");
+  expectRefused(keep, {"keep.json", "two_phase_flow.front.keep", "\"tracking\": \"front\""});
+  const CommandResult redistancing = validate("fmm.json", "{" + base + R"("density_outside": 1,
+      "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, "tracking": "level_set", "redistancing": "sweeping" } })");
+  expectRefused(redistancing, {"two_phase_flow.front.redistancing", "fast_marching"});
+  const CommandResult implicitParticles = validate("pls.json", "{" + base + R"("density_outside": 1,
+      "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, "tracking": "level_set_implicit", "particles": true } })");
+  expectRefused(implicitParticles, {"two_phase_flow.front.particles", "level_set_implicit"});
+  const CommandResult particleLevelSet = validate("pls_ok.json", "{" + base + R"("density_outside": 1,
+      "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, "tracking": "level_set", "particles": true,
+                 "redistancing": "fast_marching", "keep": 0 } })");
+  EXPECT_EQ(particleLevelSet.exitCode, 0) << particleLevelSet.err;
   // The options of this page are accepted.
   const CommandResult options = validate("ok.json", "{" + base + R"("density_outside": 1, "advection": "eno_rk3",
       "remesh": false, "coupling_velocity": "sampled", "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, "tracking": "level_set_implicit" } })");
