@@ -90,6 +90,14 @@ int staticCircleFrontPoints(int n) {
   return 1 << static_cast<int>(std::lround(std::log2(8 * M_PI * 0.25 * n)));
 }
 
+namespace {
+void applyLevelSetOptions(TwoPhaseSettings& settings, const LevelSetFrontOptions& options) {
+  settings.levelSetRedistancing = options.redistancing;
+  settings.levelSetKeep = options.keep;
+  settings.particleLevelSet = options.particles;
+}
+}  // namespace
+
 StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double endTime, bool levelSet, int points,
                                    bool remesh, double densityOutside, const LevelSetFrontOptions& levelSetOptions) {
   const double dx = 1.0 / n, dt = 0.2 * dx;
@@ -105,9 +113,7 @@ StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double e
     for (int c = 0; c < state.layout.cellCount(); ++c)
       state.phi[c] = (state.layout.cellCenter(state.layout.cellCoord(c)) - Eigen::Vector2d(0.5, 0.5)).norm() - 0.25;
     state.front = frontFromLevelSet(state.layout, state.phi, CrossingOrder::Fourth);
-    settings.levelSetRedistancing = levelSetOptions.redistancing;
-    settings.levelSetKeep = levelSetOptions.keep;
-    settings.particleLevelSet = levelSetOptions.particles;
+    applyLevelSetOptions(settings, levelSetOptions);
   }
   const std::vector<double> exactPhi = state.phi;
   StaticCircleResult r;
@@ -234,7 +240,7 @@ OscillatingCircleResult runOscillatingCircle(int n, double epsilon, double endTi
 }
 
 RisingBubbleStability runRisingBubbleStability(int n, double dt, bool implicit, int steps, TwoPhaseAdvection advection,
-                                               bool levelSet, double advectionCfl) {
+                                               bool levelSet, double advectionCfl, const LevelSetFrontOptions& levelSetOptions) {
   const double dx = 1.0 / n;
   const int points = static_cast<int>(std::lround(2 * M_PI * 0.2 / dx));
   TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(n, 2 * n), dx),
@@ -250,7 +256,10 @@ RisingBubbleStability runRisingBubbleStability(int n, double dt, bool implicit, 
   settings.solve.relativeTolerance = 1e-10;
   settings.advection = advection;
   settings.advectionCfl = advectionCfl;
-  if (levelSet) trackWithLevelSet(state, settings, perturbedCircle(Eigen::Vector2d(0.5, 0.5), 0.2, 0, 0, 16 * points));
+  if (levelSet) {
+    trackWithLevelSet(state, settings, perturbedCircle(Eigen::Vector2d(0.5, 0.5), 0.2, 0, 0, 16 * points));
+    applyLevelSetOptions(settings, levelSetOptions);
+  }
   const double area0 = enclosedArea(state.front);
   RisingBubbleStability r;
   for (int i = 0; i < steps; ++i) {

@@ -94,7 +94,8 @@ struct RisingBubbleStability {
 // levelSet: the level-set-tracked front (phi the exact distance to the circle).
 RisingBubbleStability runRisingBubbleStability(int n, double dt, bool implicit, int steps,
                                                TwoPhaseAdvection advection = TwoPhaseAdvection::SemiLagrangian,
-                                               bool levelSet = false, double advectionCfl = 0);
+                                               bool levelSet = false, double advectionCfl = 0,
+                                               const LevelSetFrontOptions& levelSetOptions = {});
 
 // Sec. 6.4.5: an air bubble (rho 1.226) of r = 1/300 m about the origin in water (rho 1000),
 // mu = 1.78e-5 in both phases, sigma = 0.0728, g = -9.8, two phases, n x 3n/2 cells on

@@ -140,12 +140,17 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
       }
   } else if (mode == "rising_stability") {
-    // rising_stability [N] [sl|eno|eno_sub] [front|ls] [dt...]: both variants at each dt, to t = 90 s.
+    // rising_stability [N] [sl|eno|eno_sub] [front|ls|ls_fmm|pls] [dt...]: both variants at each dt, to t = 90 s.
     // eno_sub: ENO/RK3 in substeps of CFL <= 0.9.
     const int n = argc > 2 ? std::atoi(argv[2]) : 80;
     const bool eno = argc > 3 && std::string(argv[3]).rfind("eno", 0) == 0;
     const double advectionCfl = argc > 3 && std::string(argv[3]) == "eno_sub" ? 0.9 : 0.0;
-    const bool ls = argc > 4 && std::string(argv[4]) == "ls";
+    // ls_fmm: fast marching instead of the distance to the mesh; pls: the particle level set with it.
+    const std::string tracking = argc > 4 ? argv[4] : "front";
+    const bool ls = tracking == "ls" || tracking == "ls_fmm" || tracking == "pls";
+    LevelSetFrontOptions lsOptions;
+    if (tracking != "ls") lsOptions.redistancing = LevelSetRedistancing::FastMarching;
+    lsOptions.particles = tracking == "pls";
     std::vector<double> dts;
     for (int i = 5; i < argc; ++i) dts.push_back(std::atof(argv[i]));
     if (dts.empty()) dts = {3.0, 7.0};
@@ -153,13 +158,14 @@ int main(int argc, char** argv) {
                 "| dt | variant | stable | steps | max speed | max CFL | capillary dt | dt / capillary | area drift | blow-up | wall s |\n"
                 "|---|---|---|---|---|---|---|---|---|---|---|\n",
                 n, 2 * n, eno ? (advectionCfl > 0 ? "ENO/RK3 in substeps of CFL <= 0.9" : "ENO/RK3") : "semi-Lagrangian",
-                ls ? "level-set front" : "front tracking");
+                ls ? (tracking == "pls" ? "particle level set (fast marching)" : tracking == "ls_fmm" ? "level set (fast marching)" : "level-set front")
+                   : "front tracking");
     for (double dt : dts) {
       for (bool implicit : {true, false}) {
         const auto start = std::chrono::steady_clock::now();
         const RisingBubbleStability r =
             runRisingBubbleStability(n, dt, implicit, static_cast<int>(std::lround(90 / dt)),
-                                     eno ? TwoPhaseAdvection::EnoRk3 : TwoPhaseAdvection::SemiLagrangian, ls, advectionCfl);
+                                     eno ? TwoPhaseAdvection::EnoRk3 : TwoPhaseAdvection::SemiLagrangian, ls, advectionCfl, lsOptions);
         std::printf("| %g | %s | %s | %d | %.3e | %.2f | %.4f | %.1f | %.3f | %s | %.1f |\n", dt, implicit ? "implicit" : "explicit",
                     r.stable ? "yes" : "no", r.steps, r.maxSpeed, r.maxSpeed * dt * n, r.capillaryDt, dt / r.capillaryDt, r.areaChange,
                     r.reason.c_str(), seconds(start));
