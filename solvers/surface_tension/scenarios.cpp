@@ -384,6 +384,31 @@ StabilityCase runPressureJumpStabilityCase(int n, double dt, bool ellipse, int s
   return stepStabilityCase(n, steps, state, area0, [&](PressureJumpState& s) { return advancePressureJump(s, settings, dt); });
 }
 
+StaticCircleResult runPressureJumpStaticCircle(int n, double endTime) {
+  const double dx = 1.0 / n, dt = 0.2 * dx;
+  PressureJumpState state;
+  state.layout = MacLayout<2>(Eigen::Vector2i(n, n), dx);
+  state.u = Eigen::VectorXd::Zero(state.layout.totalFaces());
+  state.phi.resize(state.layout.cellCount());
+  for (int c = 0; c < state.layout.cellCount(); ++c)
+    state.phi[c] = (state.layout.cellCenter(state.layout.cellCoord(c)) - Eigen::Vector2d(0.5, 0.5)).norm() - 0.25;
+  PressureJumpSettings settings;
+  settings.density = 1e4;
+  settings.sigma = 1;
+  StaticCircleResult r;
+  const int steps = static_cast<int>(std::lround(endTime / dt));
+  for (int i = 0; i < steps; ++i)
+    if (advancePressureJump(state, settings, dt).blewUp) {
+      r.stable = false;
+      break;
+    }
+  const auto [l1, linf] = velocityNorms(state.u);
+  r.l1 = l1;
+  r.linf = linf;
+  r.steps = state.step;
+  return r;
+}
+
 StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps, bool levelSet,
                                bool levelSetImplicitUpdate) {
   const double dx = 0.04 / n;

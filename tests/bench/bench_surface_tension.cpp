@@ -1,7 +1,7 @@
 // Surface tension on a Lagrangian front (thesis Ch. 6): the experiments of Sec. 6.4 with the
 // solvers of solvers/surface_tension, printed with wall time and error beside the thesis's tables.
 //   bench_surface_tension sine [N...]                 Table 6.1
-//   bench_surface_tension static one|two|one_ls|two_ls [N...] [t_end=T]   Tables 6.2 / 6.3 (t = 5, dt = 0.2 dx)
+//   bench_surface_tension static one|two|one_ls|two_ls|pj [N...] [t_end=T]   Tables 6.2 / 6.3 (t = 5, dt = 0.2 dx)
 //   bench_surface_tension oscillating [N...]          Table 6.4 refinement test (period, u at t = 0.5)
 //   bench_surface_tension epsilon N [eps=E...]        Table 6.4 epsilon test
 //   bench_surface_tension rising_stability [N]        Sec. 6.4.4 (implicit and explicit, dt = 3 and 7 s)
@@ -79,6 +79,13 @@ int main(int argc, char** argv) {
                 points == 0 ? "2^k at about dx/4" : points < 0 ? "one per dx" : std::to_string(points).c_str(), remesh ? ", remeshed" : "", rhoOut);
     for (int n : ns) {
       const auto start = std::chrono::steady_clock::now();
+      if (std::string(argv[2]) == "pj") {  // the pressure jump scheme (one phase, inviscid, explicit)
+        const StaticCircleResult r = runPressureJumpStaticCircle(n, endTime);
+        std::printf("| %d | %.3e | %.3e | pressure jump scheme | %s | %d | | %.1f |\n", n, r.l1, r.linf, r.stable ? "stable" : "blew up",
+                    r.steps, seconds(start));
+        std::fflush(stdout);
+        continue;
+      }
       const int p = points >= 0 ? points : static_cast<int>(std::lround(2 * M_PI * 0.25 * n));
       const StaticCircleResult r = runStaticCircle(n, one, true, endTime, ls, p, remesh, rhoOut, lsOptions);
       std::printf("| %d | %.3e | %.3e | %.5f | %.2e | %d | %d | %.1f |\n", n, r.l1, r.linf, r.pressureJump,
