@@ -96,6 +96,18 @@ void applyLevelSetOptions(TwoPhaseSettings& settings, const LevelSetFrontOptions
   settings.levelSetKeep = options.keep;
   settings.particleLevelSet = options.particles;
 }
+// Steps a static circle until the end or a blow-up (advance returns true), then takes the
+// parasitic-current norms over all faces.
+template <class State, class Advance>
+StaticCircleResult stepStaticCircle(State& state, int steps, Advance advance) {
+  StaticCircleResult r;
+  for (int i = 0; i < steps && r.stable; ++i) r.stable = !advance(state);
+  const auto [l1, linf] = velocityNorms(state.u);
+  r.l1 = l1;
+  r.linf = linf;
+  r.steps = state.step;
+  return r;
+}
 }  // namespace
 
 StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double endTime, bool levelSet, int points,
@@ -116,22 +128,13 @@ StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double e
     applyLevelSetOptions(settings, levelSetOptions);
   }
   const std::vector<double> exactPhi = state.phi;
-  StaticCircleResult r;
-  const int steps = static_cast<int>(std::lround(endTime / dt));
   TwoPhaseStepReport last;
-  for (int i = 0; i < steps; ++i) {
-    last = advanceTwoPhase(state, settings, dt);
-    if (levelSet && levelSetOptions.frozen) state.phi = exactPhi;
-    if (last.blewUp) {
-      r.stable = false;
-      break;
-    }
-  }
-  const auto [l1, linf] = velocityNorms(state.u);
-  r.l1 = l1;
-  r.linf = linf;
+  StaticCircleResult r = stepStaticCircle(state, static_cast<int>(std::lround(endTime / dt)), [&](TwoPhaseState& s) {
+    last = advanceTwoPhase(s, settings, dt);
+    if (levelSet && levelSetOptions.frozen) s.phi = exactPhi;
+    return last.blewUp;
+  });
   r.pressureJump = last.pressureJump;
-  r.steps = state.step;
   r.lastIterations = last.solve.iterations;
   return r;
 }
@@ -395,18 +398,8 @@ StaticCircleResult runPressureJumpStaticCircle(int n, double endTime) {
   PressureJumpSettings settings;
   settings.density = 1e4;
   settings.sigma = 1;
-  StaticCircleResult r;
-  const int steps = static_cast<int>(std::lround(endTime / dt));
-  for (int i = 0; i < steps; ++i)
-    if (advancePressureJump(state, settings, dt).blewUp) {
-      r.stable = false;
-      break;
-    }
-  const auto [l1, linf] = velocityNorms(state.u);
-  r.l1 = l1;
-  r.linf = linf;
-  r.steps = state.step;
-  return r;
+  return stepStaticCircle(state, static_cast<int>(std::lround(endTime / dt)),
+                          [&](PressureJumpState& s) { return advancePressureJump(s, settings, dt).blewUp; });
 }
 
 StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, int steps, bool levelSet,
