@@ -153,7 +153,7 @@ PressureJumpReport advancePressureJump(PressureJumpState& state, const PressureJ
   try {
     const Front2 mesh = frontFromLevelSet(layout, state.phi, CrossingOrder::Fourth);
     report.area = enclosedArea(mesh);
-    redistanceToFront(layout, mesh, state.phi, 5, 2);
+    redistanceToFront(layout, mesh, state.phi, 5, settings.keep);
   } catch (const std::invalid_argument&) {
     report.blewUp = true;
     why << "the level set's mesh no longer forms closed curves";

@@ -13,7 +13,7 @@
 //    are Neumann;
 //  * velocities: the air faces get values extrapolated from the fluid faces (layer averages), then
 //    semi-Lagrangian advection, the projection, and phi is advected semi-Lagrangianly with the new
-//    velocity, its mesh rebuilt and phi redistanced beyond 2 cells (level_set_tracking.h).
+//    velocity, its mesh rebuilt and phi redistanced beyond `keep` cells (level_set_tracking.h).
 // Used only for the stability maps; no surface mesh enters the dynamics.
 #include <Eigen/Core>
 #include <string>
@@ -26,6 +26,7 @@ namespace monolith::solvers {
 struct PressureJumpSettings {
   double density = 1, sigma = 0;
   double blowUpSpeed = 1e3;
+  double keep = 2;  // phi is redistanced beyond this many cells (level_set_tracking.h)
 };
 
 struct PressureJumpState {

@@ -387,7 +387,7 @@ StabilityCase runPressureJumpStabilityCase(int n, double dt, bool ellipse, int s
   return stepStabilityCase(n, steps, state, area0, [&](PressureJumpState& s) { return advancePressureJump(s, settings, dt); });
 }
 
-StaticCircleResult runPressureJumpStaticCircle(int n, double endTime) {
+StaticCircleResult runPressureJumpStaticCircle(int n, double endTime, double keep) {
   const double dx = 1.0 / n, dt = 0.2 * dx;
   PressureJumpState state;
   state.layout = MacLayout<2>(Eigen::Vector2i(n, n), dx);
@@ -398,6 +398,7 @@ StaticCircleResult runPressureJumpStaticCircle(int n, double endTime) {
   PressureJumpSettings settings;
   settings.density = 1e4;
   settings.sigma = 1;
+  settings.keep = keep;
   return stepStaticCircle(state, static_cast<int>(std::lround(endTime / dt)),
                           [&](PressureJumpState& s) { return advancePressureJump(s, settings, dt).blewUp; });
 }

@@ -56,7 +56,7 @@ int staticCircleFrontPoints(int n);
 // The same circle with the pressure jump scheme (pressure_jump.h: one phase, explicit, phi the exact
 // distance). That scheme has no viscosity, so this is the inviscid circle (mu = 1 barely matters
 // here: the viscous time rho r^2 / mu is 625 s against t = 5). pressureJump is not measured (0).
-StaticCircleResult runPressureJumpStaticCircle(int n, double endTime);
+StaticCircleResult runPressureJumpStaticCircle(int n, double endTime, double keep = 2);
 TwoPhaseSettings staticCircleSettings(bool onePhase, bool implicit);
 
 // Sec. 6.4.3 / Table 6.4: [0, 1]^2, r = (1/3)(1 + eps cos 2 theta) about (0.5, 0.5), rho = 27,

@@ -51,6 +51,7 @@ int main(int argc, char** argv) {
     bool remesh = false;
     double rhoOut = 1e4, endTime = 5.0;
     LevelSetFrontOptions lsOptions;
+    bool keepGiven = false;  // the pressure jump scheme keeps 2 cells unless told
     std::vector<int> ns;
     for (int i = 3; i < argc; ++i) {
       const std::string a = argv[i];
@@ -61,7 +62,7 @@ int main(int argc, char** argv) {
       else if (a.rfind("t_end=", 0) == 0) endTime = std::atof(a.c_str() + 6);
       else if (a == "redistance=fmm") lsOptions.redistancing = LevelSetRedistancing::FastMarching;
       else if (a == "redistance=none") lsOptions.redistancing = LevelSetRedistancing::None;
-      else if (a.rfind("keep=", 0) == 0) lsOptions.keep = std::atof(a.c_str() + 5);
+      else if (a.rfind("keep=", 0) == 0) lsOptions.keep = std::atof(a.c_str() + 5), keepGiven = true;
       else if (a == "particles") lsOptions.particles = true;
       else if (a == "frozen") lsOptions.frozen = true;
       else ns.push_back(std::atoi(a.c_str()));
@@ -80,7 +81,7 @@ int main(int argc, char** argv) {
     for (int n : ns) {
       const auto start = std::chrono::steady_clock::now();
       if (std::string(argv[2]) == "pj") {  // the pressure jump scheme (one phase, inviscid, explicit)
-        const StaticCircleResult r = runPressureJumpStaticCircle(n, endTime);
+        const StaticCircleResult r = runPressureJumpStaticCircle(n, endTime, keepGiven ? lsOptions.keep : 2.0);
         std::printf("| %d | %.3e | %.3e | pressure jump scheme | %s | %d | | %.1f |\n", n, r.l1, r.linf, r.stable ? "stable" : "blew up",
                     r.steps, seconds(start));
         std::fflush(stdout);
