@@ -45,7 +45,7 @@ struct FsiSolver {
   // "buoyancy": "structure_cells" (false, default): a coupled rigid body feels the buoyancy of its
   // staircase, rho_f g V_cells, through the pressure; "body_volume" (true): its weight is corrected
   // by rho_f g (V_cells - V) so that weight and buoyancy together are (m - rho_f V) g for the
-  // body's own volume V (disk/sphere and box shapes; docs/fsi.md).
+  // body's own volume V (systems/shape_volume.h; docs/fsi.md).
   bool bodyVolumeBuoyancy = false;
   template <class V>
   void visitFields(V& visit) {

@@ -11,6 +11,7 @@
 #include "systems/fluid_domain.h"
 #include "systems/fluid_preconditioner_kind.h"
 #include "systems/obstacle_geometry.h"
+#include "systems/shape_volume.h"
 
 namespace monolith {
 
@@ -88,12 +89,10 @@ double fluidShare(const solvers::FluidDomain<d>& domain, int f) {
   return fluid == 0 ? 0.0 : fluid == 1 ? 0.5 : 1.0;
 }
 
-// A body's own volume (area in 2-D) where its shape gives it simply (disk/sphere, box), else 0.
+// A body's own volume (area in 2-D), 0 without a shape or where its shape has none here.
 template <int d>
-double shapeVolume(const Shape<d>* shape) {
-  if (shape && shape->type == ShapeType::Sphere) return d == 2 ? M_PI * std::pow(shape->radius, 2) : 4.0 / 3.0 * M_PI * std::pow(shape->radius, 3);
-  if (shape && shape->type == ShapeType::Box) return std::pow(2.0, d) * shape->halfExtents.prod();
-  return 0.0;
+double bodyVolume(const Shape<d>* shape) {
+  return shape ? monolith::shapeVolume(*shape) : 0.0;
 }
 
 template <int d>
@@ -107,7 +106,41 @@ double fluidViscosity(const World<d>& world, Entity grid) {
   return m ? m->viscosity : 0.0;
 }
 
-// "obstacle_wall": "surface" or "cell_boundary" for the coupled rigid bodies too: the viscous row
+// A deformable's wall seen from a fluid face at x along e (axis b), in cells, weighted by how much
+// of the face's dual cell the structure covers across the pair: rays from kSamples points spread
+// over the dual cell's section normal to e (kSamples along the one other axis in 2-D, a square of
+// them in 3-D), each as far as 1.5 cells. The row's weight squared is w^2 phi / theta for a wall
+// covering the fraction phi of the section at the mean distance theta of the rays that hit it, so
+// the shear the fluid feels follows the structure's end as it moves inside its cell (a flag's tip
+// that covers a quarter of the end cell's top face pulls a quarter of that face's shear) instead of
+// jumping by a whole cell's shear when the staircase gains or loses a cell. theta / phi can exceed
+// 1 (a weaker row, still of G_mu^T G_mu form: SPD). No ray hits: a weight of 1e-3 w^2.
+template <int d>
+double deformableWallDistance(const solvers::SimplexLocator<d>& locator, const solvers::MacLayout<d>& layout,
+                              const Eigen::Matrix<double, d, 1>& x, int b, const Eigen::Matrix<double, d, 1>& e) {
+  constexpr int kPerAxis = d == 2 ? 16 : 4, kSamples = 16;
+  constexpr double kReach = 1.5, kNoWall = 1e3;
+  double sum = 0;
+  int hits = 0;
+  for (int k = 0; k < kSamples; ++k) {
+    Eigen::Matrix<double, d, 1> p = x;
+    int rest = k;
+    for (int axis = 0; axis < d; ++axis) {
+      if (axis == b) continue;
+      p[axis] += ((rest % kPerAxis) + 0.5) / kPerAxis * layout.dx - 0.5 * layout.dx;
+      rest /= kPerAxis;
+    }
+    const double t = locator.rayEntry(p, e, kReach * layout.dx);
+    if (!std::isfinite(t)) continue;
+    sum += std::max(t / layout.dx, solvers::FluidDomain<d>::kMinWallDistance);
+    ++hits;
+  }
+  if (hits == 0) return kNoWall;
+  const double theta = sum / hits, phi = static_cast<double>(hits) / kSamples;
+  return std::clamp(theta / phi, solvers::FluidDomain<d>::kMinWallDistance, kNoWall);
+}
+
+// "obstacle_wall": "surface" or "cell_boundary" for the coupled structures too: the viscous row
 // between a fluid face and a structure face (the tangential coupling of Sec. 5.7 sits on faces half
 // a cell inside the staircase, Fig. 5.2) measures the shear against a wall theta cells from the
 // fluid face, at the body's true surface along the pair (or at the structure cells' boundary),
@@ -115,11 +148,11 @@ double fluidViscosity(const World<d>& world, Entity grid) {
 // symmetric Dirichlet treatment (solvers/fluid/operators.h). The wall moves with the structure
 // face's velocity (exact for translation; a rotating body's wall speed is taken at the face,
 // theta' dx deeper). With "face" (default) nothing is stored and the rows stay the thesis's.
-// Deformable structures keep theta = 1 (no surface to measure against here).
 template <int d>
 void placeStructureWalls(FluidSolverSettings::ObstacleWall where, const std::vector<ObstacleGeometry<d>>& geometry,
                          StructureCouplingSetup<d>& setup) {
-  if (where == FluidSolverSettings::ObstacleWall::Face || geometry.empty()) return;
+  using Vec = Eigen::Matrix<double, d, 1>;
+  if (where == FluidSolverSettings::ObstacleWall::Face || (geometry.empty() && setup.locators.empty())) return;
   auto& domain = setup.domain;
   const auto& layout = domain.layout;
   const int nf = layout.totalFaces(), nb = static_cast<int>(geometry.size());
@@ -138,19 +171,23 @@ void placeStructureWalls(FluidSolverSettings::ObstacleWall where, const std::vec
         }
         const int other = layout.faceIndex(a, g);
         if (!domain.structureFace[other]) continue;
-        double t = std::numeric_limits<double>::infinity();
-        Eigen::Matrix<double, d, 1> e = Eigen::Matrix<double, d, 1>::Zero();
+        double theta = std::numeric_limits<double>::infinity();
+        Vec e = Vec::Zero();
         e[b] = s ? 1.0 : -1.0;
         for (int which = 0; which < 2; ++which) {
           int cell = -1;
-          if (!domain.faceCell(other, which, cell) || setup.cellBody[cell] < 0 || setup.cellBody[cell] >= nb) continue;
-          t = where == FluidSolverSettings::ObstacleWall::CellBoundary
-                  ? (b == a ? layout.dx : 0.5 * layout.dx)
-                  : std::min(t, geometry[setup.cellBody[cell]].rayEntry(layout.faceCenter(a, fc), e, layout.dx));
+          if (!domain.faceCell(other, which, cell) || setup.cellBody[cell] < 0) continue;
+          const int body = setup.cellBody[cell];
+          if (where == FluidSolverSettings::ObstacleWall::CellBoundary)
+            theta = b == a ? 1.0 : 0.5;
+          else if (body < nb)
+            theta = std::min(theta, std::clamp(geometry[body].rayEntry(layout.faceCenter(a, fc), e, layout.dx) / layout.dx,
+                                               solvers::FluidDomain<d>::kMinWallDistance, 1.0));
+          else
+            theta = std::min(theta, deformableWallDistance(setup.locators[body - nb], layout, layout.faceCenter(a, fc), b, e));
         }
-        if (!std::isfinite(t)) continue;
-        domain.wallDistance[solvers::FluidDomain<d>::wallDistanceIndex(f, b, s)] =
-            std::clamp(t / layout.dx, solvers::FluidDomain<d>::kMinWallDistance, 1.0);
+        if (!std::isfinite(theta)) continue;
+        domain.wallDistance[solvers::FluidDomain<d>::wallDistanceIndex(f, b, s)] = theta;
       }
   }
 }
@@ -233,7 +270,7 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
   for (int b = 0; b < nb; ++b)
     if (std::find(setup.cellBody.begin(), setup.cellBody.end(), b) == setup.cellBody.end()) {
       claim(geometry[b].body().x, b);
-      extraMass[b] = std::max(0.0, rhoFluid * (claimed[b] * layout.cellVolume() - shapeVolume(world.template get<Shape<d>>(setup.bodies[b]))));
+      extraMass[b] = std::max(0.0, rhoFluid * (claimed[b] * layout.cellVolume() - bodyVolume(world.template get<Shape<d>>(setup.bodies[b]))));
     }
   for (int k = 0; k < nd; ++k) {
     const std::vector<int> inside = setup.locators[k].cellsInside();
@@ -348,7 +385,7 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
     // weighs on the walls through the pressure, the same amount taken off the body). Not for a body
     // that claims its cell (its composite mass already balances the claimed fluid) or a shape of
     // unknown volume.
-    const double volume = shapeVolume(world.template get<Shape<d>>(setup.bodies[b]));
+    const double volume = bodyVolume(world.template get<Shape<d>>(setup.bodies[b]));
     if (fsiSolverOf(world).bodyVolumeBuoyancy && !body.isStatic && claimed[b] == 0 && volume > 0) {
       const double cells = static_cast<double>(std::count(setup.cellBody.begin(), setup.cellBody.end(), b));
       coupling.velocity.segment(off, d) += dt * rhoFluid * (cells * layout.cellVolume() - volume) / mass * world.settings().gravity;

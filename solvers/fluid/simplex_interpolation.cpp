@@ -112,6 +112,39 @@ SimplexWeights<d> SimplexLocator<d>::weightsAt(const Vec& p) const {
   return w;
 }
 
+template <int d>
+double SimplexLocator<d>::rayEntry(const Vec& p, const Vec& e, double tMax) const {
+  const Vec q = p + tMax * e;
+  Index<d> lo, hi;
+  cellRange<d>(layout_, p.cwiseMin(q), p.cwiseMax(q), 0, lo, hi);
+  std::vector<int> candidates;
+  forEachIndexIn<d>(lo, hi, [&](const Index<d>& c) {
+    const int cell = layout_.cellIndex(c);
+    candidates.insert(candidates.end(), bucketElements_.begin() + bucketStart_[cell],
+                      bucketElements_.begin() + bucketStart_[cell + 1]);
+  });
+  std::sort(candidates.begin(), candidates.end());
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  double entry = std::numeric_limits<double>::infinity();
+  for (int el : candidates) {
+    // lambda(t) = l0 + t (l1 - l0) / tMax >= 0 for every coordinate: an interval of t.
+    const auto l0 = barycentric(el, p), l1 = barycentric(el, q);
+    double t0 = 0, t1 = tMax;
+    for (int v = 0; v < d + 1 && t0 <= t1; ++v) {
+      const double slope = (l1[v] - l0[v]) / tMax;
+      if (slope == 0) {
+        if (l0[v] < 0) t1 = -1;
+      } else if (slope > 0) {
+        t0 = std::max(t0, -l0[v] / slope);
+      } else {
+        t1 = std::min(t1, -l0[v] / slope);
+      }
+    }
+    if (t0 <= t1) entry = std::min(entry, t0);
+  }
+  return entry;
+}
+
 template class SimplexLocator<2>;
 template class SimplexLocator<3>;
 

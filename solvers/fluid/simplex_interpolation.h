@@ -9,7 +9,9 @@
 //  * weightsAt: the d+1 particles and weights of the element containing a point, or, for a
 //    point just outside the mesh (a coupling face centre half a cell outside its cell), of the
 //    element with the largest smallest barycentric coordinate, its negative coordinates clamped
-//    to zero and the rest renormalised: the weights are nonnegative and sum to 1.
+//    to zero and the rest renormalised: the weights are nonnegative and sum to 1;
+//  * rayEntry: where a segment enters the mesh (the walls of the tangential coupling at the
+//    structure's true surface, systems/fluid_structure_coupling.cpp).
 // Elements are bucketed by the cells their bounding box (grown by one cell) overlaps, so a
 // lookup tests only the elements near the point. Periodic wrap-around is not followed: the mesh
 // must not cross a periodic side.
@@ -40,6 +42,9 @@ class SimplexLocator {
   // Barycentric coordinates of p in element e (sum 1; all >= 0 inside).
   Eigen::Matrix<double, d + 1, 1> barycentric(int e, const Vec& p) const;
   SimplexWeights<d> weightsAt(const Vec& p) const;
+  // Distance t in [0, tMax] at which p + t e (|e| = 1) enters the mesh: 0 if p is inside, +inf on
+  // a miss. Exact: the barycentric coordinates are affine along the segment.
+  double rayEntry(const Vec& p, const Vec& e, double tMax) const;
 
  private:
   int bucketOf(const Vec& p) const;

@@ -224,3 +224,25 @@ TEST(FsiDeformable, SolveNeverAddsKineticEnergy) {
     EXPECT_LE(r.kineticEnergyAfter - r.kineticEnergyBefore, -r.dampingWork * (1 - 1e-6));
   }
 }
+
+// SimplexLocator::rayEntry (walls at a deformable's surface): exact entry distances into a
+// triangulated square and a tetrahedron, 0 from inside, +inf on a miss or beyond tMax.
+TEST(FsiDeformable, RayEntryIntoTheMeshIsExact) {
+  {
+    const solvers::MacLayout<2> layout(Eigen::Vector2i(8, 8), 0.25);
+    // The square [0.5, 1.5]^2 as two triangles.
+    const solvers::SimplexLocator<2> square({0.5, 0.5, 1.5, 0.5, 1.5, 1.5, 0.5, 1.5}, {0, 1, 2, 0, 2, 3}, layout);
+    EXPECT_NEAR(square.rayEntry(Eigen::Vector2d(1.0, 1.6), Eigen::Vector2d(0, -1), 0.25), 0.1, 1e-14);
+    EXPECT_NEAR(square.rayEntry(Eigen::Vector2d(0.3, 0.7), Eigen::Vector2d(1, 0), 0.25), 0.2, 1e-14);
+    EXPECT_EQ(square.rayEntry(Eigen::Vector2d(1.0, 1.0), Eigen::Vector2d(1, 0), 0.25), 0.0);
+    EXPECT_TRUE(std::isinf(square.rayEntry(Eigen::Vector2d(1.0, 1.6), Eigen::Vector2d(0, -1), 0.05)));
+    EXPECT_TRUE(std::isinf(square.rayEntry(Eigen::Vector2d(1.6, 1.0), Eigen::Vector2d(0, 1), 0.25)));
+    const Eigen::Vector2d diagonal = Eigen::Vector2d(1, 1).normalized();  // into the corner (0.5, 0.5)
+    EXPECT_NEAR(square.rayEntry(Eigen::Vector2d(0.4, 0.4), diagonal, 0.25), 0.1 * std::sqrt(2.0), 1e-14);
+  }
+  const solvers::MacLayout<3> layout(Eigen::Vector3i(4, 4, 4), 0.5);
+  const solvers::SimplexLocator<3> tet({0.5, 0.5, 0.5, 1.5, 0.5, 0.5, 0.5, 1.5, 0.5, 0.5, 0.5, 1.5}, {0, 1, 2, 3}, layout);
+  // Down onto the face x + y + z = 2.5 from above (0.6, 0.6, 1.6): it enters at z = 1.3.
+  EXPECT_NEAR(tet.rayEntry(Eigen::Vector3d(0.6, 0.6, 1.6), Eigen::Vector3d(0, 0, -1), 1.0), 0.3, 1e-14);
+  EXPECT_NEAR(tet.rayEntry(Eigen::Vector3d(0.6, 0.6, 0.2), Eigen::Vector3d(0, 0, 1), 1.0), 0.3, 1e-14);
+}
