@@ -126,6 +126,11 @@ struct ArticulationSolver {
   // With colliders: passes of that solve, each with the contact points found again where the
   // last one left the bodies, while an overlap beyond push-out's tolerance is left.
   int pushOutContactPasses = 1;
+  // With colliders: the most sweeps of Step V's joint-and-contact projection (systems/
+  // articulation.h, postStabilizeWithContacts); it stops earlier once its rows are within
+  // post_tolerance. Projected Gauss-Seidel converges linearly, and what 50 sweeps left of a
+  // resting pile's gravity kick stayed in its velocities (docs/benchmarks_articulation.md).
+  int contactSolveSweeps = 500;
 
   template <class V>
   void visitFields(V& visit) {
@@ -139,6 +144,7 @@ struct ArticulationSolver {
     visit("contact_rounds", contactRounds);
     visit("push_out_contact_sweeps", pushOutContactSweeps);
     visit("push_out_contact_passes", pushOutContactPasses);
+    visit("contact_solve_sweeps", contactSolveSweeps);
   }
 };
 
