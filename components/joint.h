@@ -57,10 +57,14 @@ struct ArticulationJoint {
   Orientation<d> parentFrame = RigidBody<d>::identityOrientation();  // joint frame orientation on the parent
   Orientation<d> childFrame = RigidBody<d>::identityOrientation();   // ... on the child
 
-  // Angle limits of a revolute joint (rad, lower < upper): a one-sided row about the hinge,
-  // active while the joint is at or past a limit and moving (or predicted) further out.
+  // Angle limits of a revolute or twist joint (rad, lower < upper): a one-sided row about the
+  // hinge, active while the joint is at or past a limit and moving (or predicted) further out.
   bool limited = false;
   double lower = 0, upper = 0;
+  // Slide limits of a prismatic or twist joint (m, lower < upper; the child's anchor along the
+  // parent frame's axis from the parent's anchor): a linear row along the axis, active likewise.
+  bool slideLimited = false;
+  double slideLower = 0, slideUpper = 0;
 
   // PD drive of a revolute joint's angle (impulse per step dt (kp (a* - a) + kd (a*' - a'))).
   PdTarget pd = PdTarget::None;
@@ -87,6 +91,9 @@ struct ArticulationJoint {
     visit("limited", limited);
     visit("lower", lower);
     visit("upper", upper);
+    visit("slide_limited", slideLimited);
+    visit("slide_lower", slideLower);
+    visit("slide_upper", slideUpper);
     visit("pd", pd);
     visit("kp", kp);
     visit("kd", kd);
