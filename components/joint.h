@@ -57,10 +57,14 @@ struct ArticulationJoint {
   Orientation<d> parentFrame = RigidBody<d>::identityOrientation();  // joint frame orientation on the parent
   Orientation<d> childFrame = RigidBody<d>::identityOrientation();   // ... on the child
 
-  // Angle limits of a revolute joint (rad, lower < upper): a one-sided row about the hinge,
-  // active while the joint is at or past a limit and moving (or predicted) further out.
+  // Angle limits of a revolute or twist joint (rad, lower < upper): a one-sided row about the
+  // hinge, active while the joint is at or past a limit and moving (or predicted) further out.
   bool limited = false;
   double lower = 0, upper = 0;
+  // Slide limits of a prismatic or twist joint (m, lower < upper; the child's anchor along the
+  // parent frame's axis from the parent's anchor): a linear row along the axis, active likewise.
+  bool slideLimited = false;
+  double slideLower = 0, slideUpper = 0;
 
   // PD drive of a revolute joint's angle (impulse per step dt (kp (a* - a) + kd (a*' - a'))).
   PdTarget pd = PdTarget::None;
@@ -87,6 +91,9 @@ struct ArticulationJoint {
     visit("limited", limited);
     visit("lower", lower);
     visit("upper", upper);
+    visit("slide_limited", slideLimited);
+    visit("slide_lower", slideLower);
+    visit("slide_upper", slideUpper);
     visit("pd", pd);
     visit("kp", kp);
     visit("kd", kd);
@@ -126,6 +133,11 @@ struct ArticulationSolver {
   // With colliders: passes of that solve, each with the contact points found again where the
   // last one left the bodies, while an overlap beyond push-out's tolerance is left.
   int pushOutContactPasses = 1;
+  // With colliders: the most sweeps of Step V's joint-and-contact projection (systems/
+  // articulation.h, postStabilizeWithContacts); it stops earlier once its rows are within
+  // post_tolerance. Projected Gauss-Seidel converges linearly, and what 50 sweeps left of a
+  // resting pile's gravity kick stayed in its velocities (docs/benchmarks_articulation.md).
+  int contactSolveSweeps = 500;
 
   template <class V>
   void visitFields(V& visit) {
@@ -139,6 +151,7 @@ struct ArticulationSolver {
     visit("contact_rounds", contactRounds);
     visit("push_out_contact_sweeps", pushOutContactSweeps);
     visit("push_out_contact_passes", pushOutContactPasses);
+    visit("contact_solve_sweeps", contactSolveSweeps);
   }
 };
 

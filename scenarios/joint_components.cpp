@@ -148,7 +148,8 @@ void parseJoint(World<d>& world, Entity e, const Config& c) {
     }
   }
   if (c.has("limits")) {
-    if (j.type != JointType::Revolute) c.failAt("limits", "angle limits on a revolute joint only", "a " + type + " joint");
+    if (j.type != JointType::Revolute && j.type != JointType::Twist)
+      c.failAt("limits", "angle limits on a revolute or twist joint only", "a " + type + " joint");
     const Eigen::VectorXd l = c.vector("limits", 2);
     if (!(l(0) < l(1)) || l(0) < -3.14159265358979323846 || l(1) > 3.14159265358979323846)
       c.failAt("limits", "[lower, upper] in radians with -pi <= lower < upper <= pi",
@@ -156,6 +157,17 @@ void parseJoint(World<d>& world, Entity e, const Config& c) {
     j.limited = true;
     j.lower = l(0);
     j.upper = l(1);
+  }
+  if (c.has("slide_limits")) {
+    if (j.type != JointType::Prismatic && j.type != JointType::Twist)
+      c.failAt("slide_limits", "slide limits on a prismatic or twist joint only", "a " + type + " joint");
+    const Eigen::VectorXd l = c.vector("slide_limits", 2);
+    if (!(l(0) < l(1)))
+      c.failAt("slide_limits", "[lower, upper] in length units with lower < upper",
+               "[" + formatNumber(l(0)) + ", " + formatNumber(l(1)) + "]");
+    j.slideLimited = true;
+    j.slideLower = l(0);
+    j.slideUpper = l(1);
   }
   if (c.has("pd")) {
     if (j.type != JointType::Revolute) c.failAt("pd", "PD control on a revolute joint only", "a " + type + " joint");
@@ -194,6 +206,7 @@ void parseArticulation(World<d>& world, Entity e, const Config& c) {
       static_cast<int>(c.integer("push_out_contact_sweeps", s.pushOutContactSweeps, 0, 1000000));
   s.pushOutContactPasses =
       static_cast<int>(c.integer("push_out_contact_passes", s.pushOutContactPasses, 1, 1000));
+  s.contactSolveSweeps = static_cast<int>(c.integer("contact_solve_sweeps", s.contactSolveSweeps, 1, 1000000));
   world.add(e, s);
 }
 
@@ -249,17 +262,18 @@ void registerJointComponents(Registry& r) {
   r.addComponentOf<d, ArticulationJoint<d>>(
       d == 3 ? "articulation joint: type (fixed, revolute, spherical, prismatic, universal, twist), parent (entity or "
                "\"world\"), child (default: this entity), anchor + axis (world, at the initial poses) or "
-               "parent_frame/child_frame {position, orientation}; limits [lower, upper] and pd {kp, kd, target} on "
-               "revolute joints"
+               "parent_frame/child_frame {position, orientation}; limits [lower, upper] (rad) on revolute and twist "
+               "joints, slide_limits [lower, upper] on prismatic and twist joints, pd {kp, kd, target} on revolute "
+               "joints"
              : "articulation joint of the plane: type (fixed, revolute (a pin), prismatic (slides along axis)), parent "
                "(entity or \"world\"), child (default: this entity), anchor + axis (world, at the initial poses) or "
                "parent_frame/child_frame {position, angle}; limits [lower, upper] and pd {kp, kd, target} on revolute "
-               "joints",
+               "joints, slide_limits [lower, upper] on prismatic joints",
       parseJoint<d>);
   r.addComponentOf<d, ArticulationSolver>(
       "how the scene's joints are solved (one per scene): post_stabilization/pre_stabilization \"pairwise\" or "
       "\"global\", pre_stabilize, post_iterations, post_tolerance, pre_iterations, pre_tolerance, contact_rounds, "
-      "push_out_contact_sweeps, push_out_contact_passes",
+      "push_out_contact_sweeps, push_out_contact_passes, contact_solve_sweeps",
       parseArticulation<d>);
 }
 

@@ -61,6 +61,9 @@ solvers::JointDefinition jointDefinition(const ArticulationJoint<d>& j) {
   def.limited = j.limited;
   def.lower = j.lower;
   def.upper = j.upper;
+  def.slideLimited = j.slideLimited;
+  def.slideLower = j.slideLower;
+  def.slideUpper = j.slideUpper;
   if constexpr (d == 2) {
     def.planar = true;
     if (j.type == JointType::Prismatic) {

@@ -62,6 +62,31 @@ Vector6d solveRows(const Ldlt6& K, const Vector6d& rhs, int k) {
   return out;
 }
 
+// Whether a limit row is on: the coordinate past a limit, or at it (within limitSlack) and moving
+// further out.
+bool pastLimit(double value, double rate, double lower, double upper) {
+  const bool pastUpper = value > upper || (value >= upper - limitSlack && rate > 0);
+  const bool pastLower = value < lower || (value <= lower + limitSlack && rate < 0);
+  return pastUpper || pastLower;
+}
+
+// The hinge's angle limit (revolute, twist) about the parent frame's axis.
+bool angleLimitActive(const JointDefinition& joint, const ConstraintBody& P, const ConstraintBody& C,
+                      const Eigen::Vector3d& axis) {
+  if (!joint.limited) return false;
+  return pastLimit(revoluteAngle(joint, P.q, C.q), axis.dot(C.w - P.w), joint.lower, joint.upper);
+}
+
+// The slide limit (prismatic, twist): the child's anchor along the axis from the parent's, and its
+// rate, the relative velocity at the child's anchor along the axis (the row's own velocity).
+bool slideLimitActive(const JointDefinition& joint, const JointRows& rows, const ConstraintBody& P,
+                      const ConstraintBody& C, const Eigen::Vector3d& axis) {
+  if (!joint.slideLimited) return false;
+  const double slide = axis.dot((C.x + C.q * joint.childAnchor) - (P.x + P.q * joint.parentAnchor));
+  const double rate = axis.dot(C.v + C.w.cross(rows.armChild) - P.v - P.w.cross(rows.armParent));
+  return pastLimit(slide, rate, joint.slideLower, joint.slideUpper);
+}
+
 // A planar joint's frames turn about z only, so each of its row directions lies in the plane or
 // along z (to rounding): keep the linear rows in the plane and the angular rows about z.
 void keepInPlane(JointRows& rows) {
@@ -109,13 +134,7 @@ JointRows jointRows(const JointDefinition& joint, const std::vector<ConstraintBo
     case JointKind::Revolute: {
       rows.linear = 3, rows.linearDirs = Fp;
       rows.angular = 2, rows.angularDirs.leftCols<2>() = Fp.leftCols<2>();
-      if (joint.limited) {
-        const double angle = revoluteAngle(joint, P.q, C.q);
-        const double rate = Fp.col(2).dot(C.w - P.w);
-        const bool pastUpper = angle > joint.upper || (angle >= joint.upper - limitSlack && rate > 0);
-        const bool pastLower = angle < joint.lower || (angle <= joint.lower + limitSlack && rate < 0);
-        if (pastUpper || pastLower) rows.angular = 3, rows.angularDirs.col(2) = Fp.col(2);
-      }
+      if (angleLimitActive(joint, P, C, Fp.col(2))) rows.angular = 3, rows.angularDirs.col(2) = Fp.col(2);
       break;
     }
     case JointKind::Spherical:
@@ -124,10 +143,13 @@ JointRows jointRows(const JointDefinition& joint, const std::vector<ConstraintBo
     case JointKind::Prismatic:
       rows.linear = 2, rows.linearDirs.leftCols<2>() = Fp.leftCols<2>();
       rows.angular = 3, rows.angularDirs = Fp;
+      if (slideLimitActive(joint, rows, P, C, Fp.col(2))) rows.linear = 3, rows.linearDirs.col(2) = Fp.col(2);
       break;
     case JointKind::Twist:
       rows.linear = 2, rows.linearDirs.leftCols<2>() = Fp.leftCols<2>();
       rows.angular = 2, rows.angularDirs.leftCols<2>() = Fp.leftCols<2>();
+      if (slideLimitActive(joint, rows, P, C, Fp.col(2))) rows.linear = 3, rows.linearDirs.col(2) = Fp.col(2);
+      if (angleLimitActive(joint, P, C, Fp.col(2))) rows.angular = 3, rows.angularDirs.col(2) = Fp.col(2);
       break;
     case JointKind::Universal: {
       rows.linear = 3, rows.linearDirs = Fp;
@@ -148,7 +170,13 @@ JointError jointError(const JointDefinition& joint, const Eigen::Vector3d& xPare
   const Eigen::Quaterniond qP = qParent * joint.parentFrame, qC = qChild * joint.childFrame;
   const Eigen::Vector3d axis = qP * Eigen::Vector3d::UnitZ();
   e.linear = (xChild + qChild * joint.childAnchor) - (xParent + qParent * joint.parentAnchor);
-  if (joint.type == JointKind::Prismatic || joint.type == JointKind::Twist) e.linear -= axis * axis.dot(e.linear);
+  if (joint.type == JointKind::Prismatic || joint.type == JointKind::Twist) {
+    const double slide = axis.dot(e.linear);
+    e.linear -= axis * slide;
+    // Past a slide limit, the overshoot along the axis is an error too.
+    if (joint.slideLimited && slide > joint.slideUpper) e.linear += (slide - joint.slideUpper) * axis;
+    if (joint.slideLimited && slide < joint.slideLower) e.linear += (slide - joint.slideLower) * axis;
+  }
   switch (joint.type) {
     case JointKind::Fixed:
     case JointKind::Prismatic:
@@ -402,7 +430,7 @@ RedundantJoint firstRedundantJoint(const std::vector<JointDefinition>& joints, c
   std::function<int(int)> find = [&](int i) { return up[i] == i ? i : up[i] = find(up[i]); };
   for (std::size_t k = 0; k < joints.size(); ++k) {
     JointDefinition joint = joints[k];
-    joint.limited = false;
+    joint.limited = joint.slideLimited = false;
     const int a = find(nodeOf(joint.parent)), b = find(nodeOf(joint.child));
     if (a != b) {
       up[std::max(a, b)] = std::min(a, b);
@@ -420,7 +448,7 @@ RedundantJoint firstRedundantJoint(const std::vector<JointDefinition>& joints, c
     }
     auto rowsOfJoint = [&](std::size_t i) {
       JointDefinition d = joints[i];
-      d.limited = false;
+      d.limited = d.slideLimited = false;
       const JointRows r = jointRows(d, bodies);
       Eigen::MatrixXd out = Eigen::MatrixXd::Zero(r.rows(), 6 * columns);
       for (int q = 0; q < r.rows(); ++q) {

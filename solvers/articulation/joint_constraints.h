@@ -40,8 +40,10 @@ struct JointDefinition {
   int parent = 0, child = 0;  // indices into the body list
   Eigen::Vector3d parentAnchor = Eigen::Vector3d::Zero(), childAnchor = Eigen::Vector3d::Zero();
   Eigen::Quaterniond parentFrame = Eigen::Quaterniond::Identity(), childFrame = Eigen::Quaterniond::Identity();
-  bool limited = false;  // revolute: angle limits [lower, upper]
+  bool limited = false;  // revolute, twist: angle limits [lower, upper]
   double lower = 0, upper = 0;
+  bool slideLimited = false;  // prismatic, twist: slide limits [slideLower, slideUpper] along the axis
+  double slideLower = 0, slideUpper = 0;
   // A joint of the plane z = 0 between bodies that move in it (2-D scenes): its frames turn about
   // z only, and the rows that leave the plane (linear along z, angular about x and y) are dropped;
   // a pin is then a revolute joint about z, a 2-D slider a prismatic joint along an in-plane z.

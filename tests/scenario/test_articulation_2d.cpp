@@ -170,6 +170,33 @@ TEST(Articulation2d, PrismaticJointSlidesAsInFreeFallAlongItsRail) {
   EXPECT_LT(worstAngle, 1e-9);
 }
 
+// The slider of PrismaticJointSlidesAsInFreeFallAlongItsRail with slide limits [-0.1, 0.4] m:
+// it slides down to 0.4 m and stops there, the total energy never above the start.
+TEST(Articulation2d, SlideLimitsStopTheSlider) {
+  const Registry registry = builtins();
+  const Eigen::Vector2d axis(std::cos(kPi / 6), -std::sin(kPi / 6));
+  Simulation<2> sim(parseScene(singleBody(R"({ "mass": 2 })",
+                                          R"({ "type": "prismatic", "parent": "world", "anchor": [0, 0], "axis": [0.8660254037844386, -0.5], "slide_limits": [-0.1, 0.4] })",
+                                          1.0, "[0, -9.81]"),
+                               "slider.json"),
+                    registry);
+  double worst = 0, largest = -1e300, start = 0, rise = -1e300;
+  while (!sim.finished()) {
+    const auto& d = sim.step();
+    worst = std::max(worst, d.at("joint_error_max"));
+    if (start == 0) start = d.at("total_energy");
+    rise = std::max(rise, d.at("total_energy") - start);
+    largest = std::max(largest, bodyNamed(sim, "link").x.dot(axis));
+  }
+  const double slide = bodyNamed(sim, "link").x.dot(axis);
+  std::cout << "[measured] 2-D slide limit 0.4 m: slide at 1 s " << slide << " m, largest " << largest
+            << " m, energy rise " << rise << " J, joint_error_max " << worst << " m\n";
+  EXPECT_NEAR(slide, 0.4, 1e-6);
+  EXPECT_LT(largest, 0.4 + 1e-6);
+  EXPECT_LT(rise, 1e-9);
+  EXPECT_LT(worst, 1e-6);
+}
+
 // A link pinned at one end, no gravity, driven to 0.5 rad by PD: I a'' = kp (a* - a) - kd a',
 // gains for zeta = 0.3 and w_n = 2 pi: overshoot exp(-pi zeta / sqrt(1 - zeta^2)) = 0.372.
 TEST(Articulation2d, PdDriveOvershootsAsItsGainsPredict) {
