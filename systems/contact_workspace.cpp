@@ -492,15 +492,11 @@ void ContactWorkspace<d>::findPairs() {
     boxes_[i] = box;
     infinite_[i] = b.immovable() ? 1 : 0;
   }
-  // On one thread sweep and prune is the faster of the two below about 500 boxes, FCL's dynamic
-  // AABB tree above (bench_narrow_phase); on several, sweep and prune runs its sweep in parallel,
-  // where the tree's pass is serial (a tenth of a 1000-sphere pour's step). Both return the
-  // same sorted pairs, so the choice does not change results.
-  if (!broadPhase_) {
-    const bool serial = tbb::this_task_arena::max_concurrency() < 2;
-    broadPhase_ = std::make_unique<col::BroadPhase<d>>(n > 500 && serial ? col::BroadPhaseMethod::FclDynamicTree
-                                                                         : col::BroadPhaseMethod::SweepAndPrune);
-  }
+  // Sweep and prune is the faster of the two below about 500 boxes, FCL's dynamic AABB tree
+  // above (bench_narrow_phase); both return the same sorted pairs.
+  if (!broadPhase_)
+    broadPhase_ = std::make_unique<col::BroadPhase<d>>(n > 500 ? col::BroadPhaseMethod::FclDynamicTree
+                                                               : col::BroadPhaseMethod::SweepAndPrune);
   broadPhase_->excludePairs(jointedPairs_);
   const auto& found = broadPhase_->findPairs(boxes_, infinite_);
   // A fresh state per pair, how its last manifold solve ended included: nothing of the

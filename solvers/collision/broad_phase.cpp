@@ -7,9 +7,6 @@
 // checked against every box directly; the scene has a handful of them (ground, walls).
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/geometry/shape/box.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -125,42 +122,19 @@ struct BroadPhase<d>::Impl {
       return a.lo[axis] != b.lo[axis] ? a.lo[axis] < b.lo[axis] : a.index < b.index;
     });
     const int m = static_cast<int>(entries.size());
-    auto sweep = [&](int begin, int end, std::vector<std::pair<int, int>>& out) {
-      for (int p = begin; p < end; ++p) {
-        const Entry& e = entries[p];
-        const double hi = e.hi[axis];
-        for (int q = p + 1; q < m && entries[q].lo[axis] <= hi; ++q) {
-          const Entry& f = entries[q];
-          // Without short-circuits: most candidates fail on some axis, unpredictably which, while
-          // the combined test is almost always false, which the branch predictor gets right.
-          bool overlap = !(e.flag & f.flag);
-          for (int k = 0; k < d; ++k) overlap &= (e.lo[k] <= f.hi[k]) & (f.lo[k] <= e.hi[k]);
-          if (overlap) add(e.index, f.index, out);
-        }
+    for (int p = 0; p < m; ++p) {
+      const Entry& e = entries[p];
+      const double hi = e.hi[axis];
+      for (int q = p + 1; q < m && entries[q].lo[axis] <= hi; ++q) {
+        const Entry& f = entries[q];
+        // Without short-circuits: most candidates fail on some axis, unpredictably which, while
+        // the combined test is almost always false, which the branch predictor gets right.
+        bool overlap = !(e.flag & f.flag);
+        for (int k = 0; k < d; ++k) overlap &= (e.lo[k] <= f.hi[k]) & (f.lo[k] <= e.hi[k]);
+        if (overlap) add(e.index, f.index, pairs);
       }
-    };
-    if (m < kParallelSweepEntries || tbb::this_task_arena::max_concurrency() < 2) {
-      sweep(0, m, pairs);
-      return;
     }
-    // Each start of the sweep reads only the sorted entries: fixed chunks in parallel, each into
-    // its own list, joined in chunk order (the caller sorts the pairs anyway, so the result does
-    // not depend on the thread count).
-    const int chunks = (m + kSweepChunk - 1) / kSweepChunk;
-    chunkPairs.resize(chunks);
-    tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& r) {
-      for (int c = r.begin(); c != r.end(); ++c) {
-        chunkPairs[c].clear();
-        sweep(c * kSweepChunk, std::min(m, (c + 1) * kSweepChunk), chunkPairs[c]);
-      }
-    });
-    for (int c = 0; c < chunks; ++c) pairs.insert(pairs.end(), chunkPairs[c].begin(), chunkPairs[c].end());
   }
-  // The sweep's starts run in chunks of this many entries on several threads, from this many
-  // entries on (below it one thread sweeps faster than two hand over).
-  static constexpr int kSweepChunk = 64;
-  static constexpr int kParallelSweepEntries = 256;
-  std::vector<std::vector<std::pair<int, int>>> chunkPairs;
 
   static bool onCandidate(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
     const Context& c = *static_cast<const Context*>(data);

@@ -35,17 +35,33 @@ std::string boxOnBox(const std::string& upperShape) {
          "collider": {"friction": 0.5}}]})";
 }
 
+// The scene packed as Step II packs it, with its one pair; the pair's manifold asked as the
+// contact stages ask it (margin: the contact thickness) and as a fresh narrow phase gives it.
 struct PackedPair {
   Registry registry = test::builtins();
   Simulation<3> sim;
   ContactWorkspace<3> ws;
+  col::ContactQuery query;
   explicit PackedPair(const std::string& scene) : sim(parseScene(scene, "carried.json", {}), registry) {
     ws.pack(sim.world(), 1.0 / 30, true);
     ws.findPairs();
-  }
-  ContactPairState& pair() {
     EXPECT_EQ(ws.pairs.size(), 1u);
-    return ws.pairs.at(0);
+    query.margin = 1e-4;
+  }
+  ContactPairState& pair() { return ws.pairs.at(0); }
+  ContactBody<3>& a() { return ws.bodies[pair().a]; }
+  ContactBody<3>& b() { return ws.bodies[pair().b]; }
+  ContactBody<3>& upper() { return a().isStatic ? b() : a(); }
+  std::vector<col::ContactPoint<3>> carried(bool firstIsB = false) {
+    std::vector<col::ContactPoint<3>> out;
+    if (firstIsB) ws.pairContacts(pair(), true, b(), a(), query, out);
+    else ws.pairContacts(pair(), false, a(), b(), query, out);
+    return out;
+  }
+  std::vector<col::ContactPoint<3>> fresh() {
+    std::vector<col::ContactPoint<3>> out;
+    col::findContacts(*a().geometry, a().candidate, *b().geometry, b().candidate, query, out);
+    return out;
   }
 };
 
@@ -57,21 +73,12 @@ void move(ContactBody<3>& b, const Eigen::Vector3d& dx, double angle, const Eige
 
 TEST(CarriedManifold, MatchesAFreshQueryAfterASmallMove) {
   PackedPair s(boxOnBox(R"({"type": "box", "half_extents": [0.5, 0.5, 0.5]})"));
-  ContactPairState& pair = s.pair();
-  ContactBody<3>& A = s.ws.bodies[pair.a];
-  ContactBody<3>& B = s.ws.bodies[pair.b];
-  ContactBody<3>& upper = A.isStatic ? B : A;
-  col::ContactQuery query;
-  query.margin = 1e-4;
-  std::vector<col::ContactPoint<3>> first;
-  ASSERT_EQ(s.ws.pairContacts(pair, false, A, B, query, first), 4);
+  ASSERT_EQ(s.carried().size(), 4u);
   // What a step's impulses do to a resting box's candidate between two contact stages
   // (pyramid_20: 2-9 mm, up to 6e-4 rad).
-  move(upper, Eigen::Vector3d(6e-4, -5e-3, 3e-4), 4e-4, Eigen::Vector3d(1, 0.3, 0.2));
-  std::vector<col::ContactPoint<3>> carried, fresh;
-  const int n = s.ws.pairContacts(pair, false, A, B, query, carried);
-  col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, query, fresh);
-  ASSERT_EQ(n, static_cast<int>(fresh.size()));
+  move(s.upper(), Eigen::Vector3d(6e-4, -5e-3, 3e-4), 4e-4, Eigen::Vector3d(1, 0.3, 0.2));
+  const auto carried = s.carried(), fresh = s.fresh();
+  ASSERT_EQ(carried.size(), fresh.size());
   for (const auto& c : carried) {
     // The fresh point nearest to it.
     const auto near = std::min_element(fresh.begin(), fresh.end(), [&](const auto& x, const auto& y) {
@@ -82,30 +89,18 @@ TEST(CarriedManifold, MatchesAFreshQueryAfterASmallMove) {
     EXPECT_GT(near->normal.dot(c.normal), 1 - 1e-6);
   }
   // The joint solve asks with the pair's b first: the same points, normals reversed.
-  std::vector<col::ContactPoint<3>> flipped;
-  ASSERT_EQ(s.ws.pairContacts(pair, true, B, A, query, flipped), n);
-  for (int k = 0; k < n; ++k) {
+  const auto flipped = s.carried(true);
+  ASSERT_EQ(flipped.size(), carried.size());
+  for (std::size_t k = 0; k < carried.size(); ++k) {
     EXPECT_EQ(flipped[k].depth, carried[k].depth);
     EXPECT_EQ(flipped[k].normal, (-carried[k].normal).eval());
   }
 }
 
-TEST(CarriedManifold, AMoveBeyondTheReachQueriesAfresh) {
-  PackedPair s(boxOnBox(R"({"type": "box", "half_extents": [0.5, 0.5, 0.5]})"));
-  ContactPairState& pair = s.pair();
-  ContactBody<3>& A = s.ws.bodies[pair.a];
-  ContactBody<3>& B = s.ws.bodies[pair.b];
-  ContactBody<3>& upper = A.isStatic ? B : A;
-  col::ContactQuery query;
-  query.margin = 1e-4;
-  std::vector<col::ContactPoint<3>> first;
-  s.ws.pairContacts(pair, false, A, B, query, first);
-  // 0.1 rad: far beyond 2 % of the box's radius at its corners; the box now stands on one edge.
-  move(upper, Eigen::Vector3d(0, 0.04, 0), 0.1, Eigen::Vector3d(1, 0, 0));
-  std::vector<col::ContactPoint<3>> again, fresh;
-  s.ws.pairContacts(pair, false, A, B, query, again);
-  col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, query, fresh);
-  ASSERT_EQ(fresh.size(), 2u);  // one edge, 7 mm deep
+// The carried points against a fresh query where they must be the fresh ones.
+void expectFresh(PackedPair& s, std::size_t expected) {
+  const auto again = s.carried(), fresh = s.fresh();
+  ASSERT_EQ(fresh.size(), expected);
   ASSERT_EQ(again.size(), fresh.size());
   for (std::size_t k = 0; k < fresh.size(); ++k) {
     EXPECT_NEAR((again[k].point - fresh[k].point).norm(), 0, 1e-12);
@@ -113,25 +108,20 @@ TEST(CarriedManifold, AMoveBeyondTheReachQueriesAfresh) {
   }
 }
 
+TEST(CarriedManifold, AMoveBeyondTheReachQueriesAfresh) {
+  PackedPair s(boxOnBox(R"({"type": "box", "half_extents": [0.5, 0.5, 0.5]})"));
+  s.carried();
+  // 0.1 rad: far beyond 2 % of the box's radius at its corners; the box now stands on one edge,
+  // 7 mm deep.
+  move(s.upper(), Eigen::Vector3d(0, 0.04, 0), 0.1, Eigen::Vector3d(1, 0, 0));
+  expectFresh(s, 2);
+}
+
 TEST(CarriedManifold, ASphereIsAlwaysQueriedAfresh) {
   PackedPair s(boxOnBox(R"({"type": "sphere", "radius": 0.5})"));
-  ContactPairState& pair = s.pair();
-  ContactBody<3>& A = s.ws.bodies[pair.a];
-  ContactBody<3>& B = s.ws.bodies[pair.b];
-  ContactBody<3>& upper = A.isStatic ? B : A;
-  col::ContactQuery query;
-  query.margin = 1e-4;
-  std::vector<col::ContactPoint<3>> first;
-  s.ws.pairContacts(pair, false, A, B, query, first);
-  move(upper, Eigen::Vector3d(1e-3, 0, 0), 0, Eigen::Vector3d(1, 0, 0));
-  std::vector<col::ContactPoint<3>> again, fresh;
-  s.ws.pairContacts(pair, false, A, B, query, again);
-  col::findContacts(*A.geometry, A.candidate, *B.geometry, B.candidate, query, fresh);
-  ASSERT_EQ(again.size(), fresh.size());
-  for (std::size_t k = 0; k < fresh.size(); ++k) {
-    EXPECT_EQ(again[k].point, fresh[k].point);
-    EXPECT_EQ(again[k].depth, fresh[k].depth);
-  }
+  s.carried();
+  move(s.upper(), Eigen::Vector3d(1e-3, 0, 0), 0, Eigen::Vector3d(1, 0, 0));
+  expectFresh(s, 1);
 }
 
 }  // namespace

@@ -4,7 +4,6 @@
 #include "solvers/collision/broad_phase.h"
 
 #include <gtest/gtest.h>
-#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <random>
@@ -79,30 +78,6 @@ void expectBothMethodsMatchBruteForce(int n, unsigned seed) {
 
 TEST(BroadPhase, BothMethodsMatchBruteForceIn3D) { expectBothMethodsMatchBruteForce<3>(500, 1); }
 TEST(BroadPhase, BothMethodsMatchBruteForceIn2D) { expectBothMethodsMatchBruteForce<2>(500, 2); }
-
-// Sweep and prune sweeps in parallel chunks on several threads (from 256 boxes on): the same
-// sorted pairs as on one thread and as brute force.
-template <int d>
-void expectParallelSweepMatchesOneThread(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::vector<Box<d>> boxes;
-  std::vector<char> flags;
-  randomScene<d>(n, 2 * std::pow(n, 1.0 / d), rng, boxes, flags);
-  const Pairs expected = bruteForce<d>(boxes, flags);
-  ASSERT_GT(expected.size(), 500u);
-  for (int threads : {1, 2}) {
-    tbb::task_arena arena(threads);
-    Pairs found;
-    arena.execute([&] {
-      BroadPhase<d> sap(BroadPhaseMethod::SweepAndPrune);
-      found = sap.findPairs(boxes, flags);
-    });
-    EXPECT_EQ(found, expected) << threads << " threads";
-  }
-}
-
-TEST(BroadPhase, ParallelSweepMatchesOneThreadIn3D) { expectParallelSweepMatchesOneThread<3>(2000, 3); }
-TEST(BroadPhase, ParallelSweepMatchesOneThreadIn2D) { expectParallelSweepMatchesOneThread<2>(2000, 4); }
 
 // findPairsTouching: the brute-force pairs with at least one box of the subset, after the tree
 // has seen the boxes before some of them grew (as ContactWorkspace::growPairs uses it), with
