@@ -568,16 +568,17 @@ void ContactWorkspace<d>::resetManifolds(std::size_t pairCount) {
 
 namespace {
 
-// Shapes whose contact normal is a face normal or an edge-edge cross product of a polytope (or a
-// half-space's normal): carried along with the bodies, such a normal and the touching features
-// stay those of a fresh query for small relative motions. A round shape's normal follows the
-// other body's point around it, so spheres, capsules and cylinders are always queried afresh
-// (their queries are closed forms or short searches anyway).
+// Shapes whose contact normal is a face normal or an edge-edge cross product of a convex
+// polytope (or a half-space's normal): carried along with the bodies, such a normal and the
+// touching features stay those of a fresh query for small relative motions. A round shape's
+// normal follows the other body's point around it, so spheres, capsules and cylinders are always
+// queried afresh (their queries are closed forms or short searches anyway), and so are meshes,
+// whose faces meet at any angle: a point carried across an edge of a mesh would keep the plane
+// of the triangle it left.
 template <int d>
 bool carriesFeatures(const col::PreparedGeometry<d>& g) {
   const col::GeometryType t = g.geometry().type;
-  return t == col::GeometryType::Box || t == col::GeometryType::Convex || t == col::GeometryType::Mesh ||
-         t == col::GeometryType::HalfSpace;
+  return t == col::GeometryType::Box || t == col::GeometryType::Convex || t == col::GeometryType::HalfSpace;
 }
 
 // How far, as a fraction of the smaller body's bounding radius, the smaller body may move in the
