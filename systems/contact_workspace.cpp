@@ -599,9 +599,10 @@ constexpr double kManifoldReach = 0.02;
 // points' tangential drift times the normal's relative turn, at most m |dR|, which is held within
 // push-out's tolerance (the overlap push-out leaves alone). A feature that comes within the margin
 // at the new pose is among the points, which were found with the margin plus the reach. What the
-// carried points do not follow: a clipped corner of a face contact that is a material point of
-// neither body (an overhang's edge crossing) stays where the witness points put it, off by at most
-// m / 2 along the face.
+// carried points do not follow: a point whose support moves from under it (a corner sliding over
+// the edge of the face it rests on, or a clipped corner of a face contact that is a material
+// point of neither body, an overhang's edge crossing) stays where the witness points put it, off
+// by at most m / 2 along the face, until the next step's query.
 template <int d>
 int ContactWorkspace<d>::pairContacts(const ContactPairState& pair, bool firstIsB, const ContactBody<d>& first,
                                       const ContactBody<d>& second, const col::ContactQuery& query,
