@@ -118,6 +118,8 @@ struct ContactPairState {
     signed char points = 0;          // 0: nothing remembered
     float angles[kPoints] = {};      // a sliding point's friction direction in its tangent basis
   } end;
+  // The pair's slot in the workspace's manifold store (ContactWorkspace::pairContacts); -1: none.
+  int manifold = -1;
 };
 
 // How one pair update treats the impulse (notes 1.4-1.6, Sec. 2.3.2).
@@ -239,6 +241,15 @@ class ContactWorkspace {
   // level from the bottom, level iterations, eps = (it+1)(li+1)/(iterations*level iterations).
   int contactSweeps(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange, int* clampsApplied);
 
+  // The contact manifold of a pair for the contact stages (Steps III and V) at the bodies'
+  // candidate poses, with `first` (the pair's a, or its b when `firstIsB`) as findContacts's A:
+  // appended to `out`, returns the count. The narrow phase runs once per pair and relative pose;
+  // while the bodies stay within reach of that pose the points are carried along with them
+  // instead (see the definition: which pairs, how far, and what the carried points miss).
+  int pairContacts(const ContactPairState& pair, bool firstIsB, const ContactBody<d>& first,
+                   const ContactBody<d>& second, const solvers::collision::ContactQuery& query,
+                   std::vector<solvers::collision::ContactPoint<d>>& out) const;
+
   // Joint contact solve of body c against the bodies of infinite mass among `count` pairs.
   int updateBodyAgainstFrozen(int c, const int* pairList, int count, ImpulseMode mode, double epsilon, int iterations,
                               double margin, std::vector<solvers::collision::ContactPoint<d>>& scratch,
@@ -347,6 +358,24 @@ class ContactWorkspace {
     double energyChange = 0;
   };
   std::vector<CollisionProbe> probes_;
+  // Per pair slot (ContactPairState::manifold): the manifold the narrow phase last found for the
+  // pair in (a, b) order, each point as its two witness points in their bodies' frames and its
+  // normal in its owner's frame, and where the smaller body (the mover) was in the larger one's
+  // frame then. Written only by an update of its own pair (whose task owns the pair's bodies);
+  // invalid from the start of every step (findPairs), so nothing outlives the step.
+  struct CachedPoint {
+    VecD onA = VecD::Zero(), onB = VecD::Zero(), normal = VecD::Zero();
+    bool normalOnA = false;  // the normal turns with A (A is a half-space), else with B
+  };
+  struct CachedManifold {
+    bool valid = false;
+    double margin = 0, reach = 0;  // the query's margin, and how much more the points cover
+    Eigen::Matrix<double, d, d> relativeR = Eigen::Matrix<double, d, d>::Identity();
+    VecD relativeX = VecD::Zero();
+    std::vector<CachedPoint> points;
+  };
+  mutable std::vector<CachedManifold> manifolds_;
+  void resetManifolds(std::size_t pairCount);
   std::vector<IslandSchedule> schedules_;  // per island (islands are recorded and run at once)
   std::vector<int> memberIndex_;           // per body: its position in its island's members
   int kinematicFrameBody_ = -1;            // the scene's one translating kinematic body, or -1 (pack)
