@@ -31,11 +31,6 @@ std::vector<int> assemblyBodies(const JointAssembly<d>& a, const ContactWorkspac
   return bodyOf;
 }
 
-// The contact points, within `margin`, of the pairs with a jointed body that can move: that body
-// at its pose in the assembly, the others at their base pose (where push-out left them in Step
-// IV, time n+1 in Step V; a static body's collision pose, grounded_box.h). `gainOf(depth)` is
-// the row's gain. With `partnerMotion`, a partner held still in the solve moves with its own
-// velocity at the point (Step V).
 // A body of the assembly as a pose of dimension d (2-D: the plane's part of the lifted pose).
 template <int d>
 col::Pose<d> poseOfBody(const solvers::ConstraintBody& b) {
@@ -58,6 +53,11 @@ Orientation<d> orientationOf(const Eigen::Quaterniond& q, const Orientation<d>& 
   }
 }
 
+// The contact points, within `margin`, of the pairs with a jointed body that can move: that body
+// at its pose in the assembly, the others at their base pose (where push-out left them in Step
+// IV, time n+1 in Step V; a static body's collision pose, grounded_box.h). `gainOf(depth)` is
+// the row's gain. With `partnerMotion`, a partner held still in the solve moves with its own
+// velocity at the point (Step V).
 template <int d, typename GainOf>
 std::vector<solvers::ContactRow> contactRows(const JointAssembly<d>& a, const ContactWorkspace<d>& ws,
                                              const std::vector<int>& bodyOf, double margin, GainOf&& gainOf,
@@ -108,7 +108,7 @@ void postStabilizeWithContacts(World<d>& world, const ContactWorkspace<d>& ws, S
   const ArticulationSolver s = articulationSettings(world);
   JointAssembly<d> a(world);
   const std::vector<int> bodyOf = assemblyBodies(a, ws);
-  const double dt = ws.dt;
+  const double dt = ctx.dt;  // the step Step V's gaps close in
   // Touching or overlapping: no approach (push-out's business); apart: the gap in one step.
   const std::vector<solvers::ContactRow> contacts =
       contactRows(a, ws, bodyOf, kStepFiveMargin, [&](double depth) { return std::min(0.0, depth / dt); }, true);

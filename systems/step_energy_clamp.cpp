@@ -3,9 +3,10 @@
 // (x^{n+1}, v^{n+1}), but not the first contact step (Sec. 2.3.2, "Contact Clamping": clamping
 // it against (x^n, v^n) makes resting contact jitter; "future work"). That step's velocities
 // only move the positions and are then thrown away, so an impulse that turns a spinning body's
-// fall into a rise lifts it without taking the kinetic energy the lift costs: on the short
-// schedule, with one inelastic contact pass, about one random 2-D drop in 600 gained 0.4-1 % of
-// its total energy in one step (the git history of docs/benchmarks.md ("The short schedule on random drops")).
+// fall into a rise lifts it without taking the kinetic energy the lift costs: without this
+// clamp, on the short schedule with its one inelastic contact pass, about one random 2-D drop in
+// 600 gains 0.4-1 % of its total energy in one step (2-D drops 261 and 736,
+// docs/benchmarks_rigid_contact.md).
 //
 // The clamp checks the whole step instead. Under gravity alone the Newmark step keeps the
 // energy E = KE - m g.x exactly (Step I's and Step V's half kicks pay for the fall), collision
