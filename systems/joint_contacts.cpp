@@ -159,8 +159,8 @@ void resolveJointedInterpenetration(World<d>& world, ContactWorkspace<d>& ws, St
     // Passes: the contact points up to twice the deepest overlap apart (the displacements are of
     // that size), linearised at the pass's poses, and the solve; then the points found again
     // where it left the bodies. A body pushed along a capsule by the solve reaches the capsule's
-    // jointed neighbour, whose points the pass did not have (a ring hanging on the joint of an
-    // articulated loop left 1.5 cm inside it after one pass, and went through within 0.1 s).
+    // jointed neighbour, whose points the pass did not have (with one pass a ring hanging on the
+    // joint of an articulated loop is left 1.5 cm inside it, and goes through within 0.1 s).
     deepest = deepestOverlap();
     for (int pass = 0; pass < s.pushOutContactPasses; ++pass) {
       std::vector<solvers::ContactRow> contacts;

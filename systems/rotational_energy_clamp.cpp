@@ -36,10 +36,10 @@ bool turningChangesEnergy(const ContactBody<d>& b) {
 // (Sec. 2.3.2's rule: an energy gain is clamped, a loss left).
 // - Below 5 % nothing is done: resting and tumbling bodies gain and lose a little this way
 //   all the time (in `mixed_pile` at most 1.2 %, in sliver drops 99 % of the cases under
-//   1.6 %), and clamping each of those too changed the chaotic piles' overlaps for the worse
-//   in the sliver-drop tests while the energy stayed within the 0.1 % without it.
+//   1.6 %), and clamping each of those too makes the chaotic piles' overlaps worse in the
+//   sliver-drop tests, while without it the energy stays within 0.1 %.
 // - Turning the body instead, as the energy fix of Sec. 2.2 does, keeps the momentum but needs
-//   large turns where the momentum is tiny (a body at rest in a pile), which made new overlaps
+//   large turns where the momentum is tiny (a body at rest in a pile), which make new overlaps
 //   in `mixed_pile` (1.9 % of a body); the scaling moves nothing.
 // Bodies that neither contact nor push-out turned differently are already fixed and skipped,
 // and so are bodies whose rotational energy does not depend on their orientation.

@@ -91,8 +91,8 @@ int ContactWorkspace<d>::clampStepEnergyGain(World<d>& world, double& removed) {
     rise = std::min(rise, lift);
     // Nor a rise below the island's weight times the contact thickness: push-out lifts resting
     // piles by about its tolerance every step, and stopping them for it (their kinetic energy is
-    // about that small) took the approach from the next step's collision stage, whose pairs
-    // then went unprocessed into contact (2-D drops 5-14 % deep in one step, 6 of 1885).
+    // about that small) takes the approach from the next step's collision stage, whose pairs
+    // then go unprocessed into contact (2-D drops 5-14 % deep in one step, 6 of 1885).
     if (!(rise > settings.thickness * weight) || !(rise > 1e-12 * scale) || kinetic <= 0) return;
     const double s = std::sqrt(std::max(0.0, 1.0 - rise / kinetic));
     for (int m : islands.members[island]) {

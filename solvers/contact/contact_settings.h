@@ -31,7 +31,7 @@ struct ContactSchedule {
   bool closeGaps;
   // Where push-out's rounds leave a pair overlapping by more than this fraction of its smaller
   // body's size (a jam), the jam is pushed apart at once (ContactSettings::pushOutJoint). From
-  // 2 % on the short schedule: from 5 %, the random-drop campaigns' own bound, its 2-D drops kept
+  // 2 % on the short schedule: from 5 %, the random-drop campaigns' own bound, its 2-D drops keep
   // single steps 5-10 % deep (docs/benchmarks_rigid_contact.md).
   double pushOutJointOverlap;
   // A jam still deeper than this after its passes is solved again with more rings of neighbours,

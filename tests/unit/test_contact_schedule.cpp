@@ -8,7 +8,7 @@
 
 #include "scenarios/simulation.h"
 #include "solvers/contact/contact_settings.h"
-#include "support/scene_error.h"
+#include "support/scenes.h"
 
 namespace monolith {
 namespace {
@@ -24,7 +24,7 @@ std::string sceneWithContact(const std::string& contact) {
 
 ContactSettings loaded(const std::string& contact) {
   World<3> world;
-  populateWorld(parseScene(sceneWithContact(contact), "schedule.json"), builtins(), world);
+  populateWorld(parseScene(sceneWithContact(contact), "schedule.json"), test::builtins(), world);
   return world.resource<ContactSettings>();
 }
 
