@@ -14,8 +14,6 @@
 
 #include "ecs/component_pool.h"
 #include "ecs/entity.h"
-#include "solvers/contact/contact_settings.h"
-#include "solvers/fluid/fluid_settings.h"
 
 namespace monolith {
 
@@ -28,14 +26,25 @@ struct RigidRotationSettings {
   bool energyFix = true;   // kinetic-energy orientation fix, Sec. 2.2.2-2.2.4
 };
 
-// Scene-wide physical settings shared by systems (read-only during a step). The contact and
-// fluid settings are declared next to the solvers they steer.
+// Scene-wide physical settings shared by systems (read-only during a step). The settings of one
+// group of systems (contact, fluid) are resources instead (World::resource), declared next to
+// the solvers they steer.
 template <int d>
 struct WorldSettings {
   Vec<d> gravity = Vec<d>::Zero();
   RigidRotationSettings rigidRotation;
-  ContactSettings contact;
-  FluidSolverSettings fluid;
+};
+
+// A scene-wide value of a type the world knows nothing of (a solver's settings): stored under
+// the type's stable name T::kName, as components are, so a plugin finds the same one.
+class ResourceBase {
+ public:
+  virtual ~ResourceBase() = default;
+};
+template <class T>
+class Resource final : public ResourceBase {
+ public:
+  T value;
 };
 
 template <int d>
@@ -157,6 +166,27 @@ class World {
   WorldSettings<d>& settings() { return settings_; }
   const WorldSettings<d>& settings() const { return settings_; }
 
+  // The resource of type T, or T's defaults when none was set (read-only: systems of one stage
+  // may read at once).
+  template <class T>
+  const T& resource() const {
+    auto it = resources_.find(T::kName);
+    if (it != resources_.end())
+      if (const auto* typed = dynamic_cast<const Resource<T>*>(it->second.get())) return typed->value;
+    static const T defaults{};
+    return defaults;
+  }
+  // The resource of type T to change (the scene parser, tests), created with T's defaults; not
+  // during a step.
+  template <class T>
+  T& mutableResource() {
+    auto it = resources_.find(T::kName);
+    if (it == resources_.end()) it = resources_.emplace(T::kName, std::make_unique<Resource<T>>()).first;
+    auto* typed = dynamic_cast<Resource<T>*>(it->second.get());
+    if (!typed) throw std::logic_error(std::string("resource name clash: ") + T::kName);
+    return typed->value;
+  }
+
   // Raw entity table for checkpoints.
   EntityRegistry& entityRegistryMutable() { return entities_; }
   std::vector<std::string>& namesMutable() { return names_; }
@@ -174,6 +204,7 @@ class World {
   std::unordered_map<std::string, Entity> byName_;
   std::map<std::string, std::unique_ptr<PoolBase>> pools_;  // ordered: checkpoints are deterministic
   WorldSettings<d> settings_;
+  std::map<std::string, std::unique_ptr<ResourceBase>> resources_;
 };
 
 }  // namespace monolith

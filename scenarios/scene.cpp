@@ -13,6 +13,8 @@
 #include "components/rigid_body.h"
 #include "components/sleep.h"
 #include "ecs/plugin.h"
+#include "solvers/contact/contact_settings.h"
+#include "solvers/fluid/fluid_settings.h"
 #include "scenarios/plugin_search.h"
 #include "systems/sleep.h"
 #include "scenarios/joint_components.h"
@@ -446,14 +448,17 @@ void parseFluidSolverSettings(const Config& c, FluidSolverSettings& f) {
   c.finish();
 }
 
-// "solvers": {"contact": {...}}: iteration counts and switches of the contact stages (world.h).
+// "solvers": {"contact": {...}}: iteration counts and switches of the contact stages
+// (solvers/contact/contact_settings.h).
 void parseContactSettings(const Config& c, ContactSettings& s) {
   auto count = [&](const char* key, int& value, int min) {
     value = static_cast<int>(c.integer(key, value, min, 100000));
   };
-  // The schedule first: the keys below adjust it.
-  if (c.oneOf("schedule", {"thesis", "short"}, "short") == "short") s.useShortSchedule();
-  else s.useThesisSchedule();
+  // The schedule first (a row of kContactSchedules; an unknown name is refused with the names
+  // allowed): the keys below adjust it.
+  std::vector<std::string> schedules;
+  for (const auto& row : kContactSchedules) schedules.push_back(row.name);
+  s.useSchedule(*findContactSchedule(c.oneOf("schedule", schedules, schedules.front()).c_str()));
   count("collision_iterations", s.collisionIterations, 0);
   count("collision_pair_iterations", s.collisionPairIterations, 1);
   count("contact_iterations", s.contactIterations, 0);
@@ -495,6 +500,8 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
   // Settings and entities are kept only when the whole scene is valid: a caller that catches
   // the SceneError is never left with a half-built world it could simulate by mistake.
   WorldSettings<d> settings = world.settings();
+  ContactSettings contact = world.template resource<ContactSettings>();
+  FluidSolverSettings fluid = world.template resource<FluidSolverSettings>();
   if (scene.json.contains("gravity")) settings.gravity = top.vector("gravity", d);
 
   if (scene.json.contains("solvers")) {
@@ -505,8 +512,8 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
       settings.rigidRotation.energyFix = rr.boolean("energy_fix", true);
       rr.finish();
     }
-    if (solvers.has("fluid")) parseFluidSolverSettings(solvers.child("fluid"), settings.fluid);
-    if (solvers.has("contact")) parseContactSettings(solvers.child("contact"), settings.contact);
+    if (solvers.has("fluid")) parseFluidSolverSettings(solvers.child("fluid"), fluid);
+    if (solvers.has("contact")) parseContactSettings(solvers.child("contact"), contact);
     solvers.finish();
   }
 
@@ -552,7 +559,7 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
     for (std::size_t i = 0; i < created.size(); ++i) {
       if (!world.template get<Sleep<d>>(created[i])) continue;
       const std::string path = "entities[" + std::to_string(i) + "].sleep";
-      if (!settings.contact.sleep)
+      if (!contact.sleep)
         throw SceneError(scene.file, path, "\"solvers\": {\"contact\": {\"sleep\": true}} in the scene (sleeping on)",
                          "sleeping off");
       if (world.template get<FluidObstacle>(created[i]))
@@ -564,7 +571,9 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
     throw;
   }
   world.settings() = settings;
-  if (settings.contact.sleep) enableSleeping(world);
+  world.template mutableResource<ContactSettings>() = contact;
+  world.template mutableResource<FluidSolverSettings>() = fluid;
+  if (contact.sleep) enableSleeping(world);
 }
 
 template void populateWorld<2>(const SceneSpec&, const Registry&, World<2>&);

@@ -279,7 +279,7 @@ void ContactWorkspace<d>::ensureGeometry(World<d>& world) {
       pose.R = rotationOf<d>(rb.orientation);
       // A face within the push-out tolerance of the plane or the support stands on it.
       centreShift_[i] =
-          col::extendBoxThroughGround<d>(g, pose, grounds, world.settings().contact.pushOutTolerance, supports);
+          col::extendBoxThroughGround<d>(g, pose, grounds, world.template resource<ContactSettings>().pushOutTolerance, supports);
     }
     geometries_.push_back(std::make_unique<col::PreparedGeometry<d>>(g));
   }
@@ -306,7 +306,7 @@ bool ContactWorkspace<d>::pack(World<d>& world, double stepDt, bool subtractKick
   ensureGeometry(world);
   dt = stepDt;
   kick = subtractKick;
-  settings = world.settings().contact;
+  settings = world.template resource<ContactSettings>();
   gravity = world.settings().gravity;
   bodies.resize(entities_.size());
   // The pools once (World::get looks each up by name), then the bodies in parallel: each writes

@@ -25,6 +25,7 @@
 #include "solvers/collision/narrow_phase.h"
 #include "solvers/collision/swept_contact.h"
 #include "solvers/contact/contact_graph.h"
+#include "solvers/contact/contact_settings.h"
 #include "solvers/contact/rigid_math.h"
 #include "solvers/parallel/ordered_tasks.h"
 

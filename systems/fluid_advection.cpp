@@ -41,9 +41,9 @@ void FluidAdvection<d>::run(World<d>& world, StepContext& ctx) {
   auto& pool = world.template pool<MacGrid<d>>();
   for (auto& grid : pool.components()) {
     const auto domain = fluidDomainOf(grid);
-    const solvers::FaceBoundary boundary = faceBoundaryOf(domain, world.settings().fluid.advectionWallAtSurface);
+    const solvers::FaceBoundary boundary = faceBoundaryOf(domain, world.template resource<FluidSolverSettings>().advectionWallAtSurface);
     const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(grid.u.data(), grid.u.size());
-    const auto scheme = world.settings().fluid.advection;
+    const auto scheme = world.template resource<FluidSolverSettings>().advection;
     const Eigen::VectorXd advected =
         scheme == FluidSolverSettings::Advection::Eno3 ? solvers::advectFacesEnoRk3(domain.layout, u, ctx.dt, boundary)
         : scheme == FluidSolverSettings::Advection::Weno5

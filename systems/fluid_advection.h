@@ -5,6 +5,7 @@
 // Skipped for unsteady Stokes flow ("advection": "none"). Limits the step by the CFL condition.
 #include "components/mac_grid.h"
 #include "ecs/system.h"
+#include "solvers/fluid/fluid_settings.h"
 
 namespace monolith {
 
@@ -17,7 +18,7 @@ class FluidAdvection final : public System<d> {
   std::vector<std::string> writes() const override { return {MacGrid<d>::kName}; }
   bool needed(const World<d>& w) const override {
     return w.template count<MacGrid<d>>() > 0 &&
-           w.settings().fluid.advection != FluidSolverSettings::Advection::None;
+           w.template resource<FluidSolverSettings>().advection != FluidSolverSettings::Advection::None;
   }
   void run(World<d>& world, StepContext& ctx) override;
   double unitCflDt(const World<d>& world) const override;  // dx / max|u|

@@ -8,6 +8,7 @@
 
 #include "components/fluid_obstacle.h"
 #include "components/level_set.h"
+#include "solvers/fluid/fluid_settings.h"
 #include "solvers/mac_layout.h"
 #include "systems/fluid_domain.h"
 #include "systems/obstacle_geometry.h"
@@ -206,8 +207,8 @@ std::vector<double> rasterizationKey(const World<d>& world, const MacGrid<d>& gr
   put(grid.cells.template cast<double>().eval());
   key.push_back(grid.dx);
   put(grid.origin);
-  key.push_back(world.settings().fluid.cutCells);
-  key.push_back(static_cast<double>(world.settings().fluid.obstacleWall));
+  key.push_back(world.template resource<FluidSolverSettings>().cutCells);
+  key.push_back(static_cast<double>(world.template resource<FluidSolverSettings>().obstacleWall));
   forEachObstacle(world, [&](Entity e, const ObstacleGeometry<d>& obstacle) {
     const RigidBody<d>& body = obstacle.body();
     key.push_back(e.index);
@@ -311,7 +312,7 @@ WallGeometry<d> wallGeometry(const World<d>& world, const MacGrid<d>& grid, cons
   if (grid.solid.empty()) return wall;
   if (grid.obstaclesMove()) wall.velocity.assign(wall.distance.size(), solvers::FluidDomain<d>::kNoWallVelocity);
   const auto isFree = [&](int g) { return gridFaceFree(layout, grid, g); };
-  const bool cellBoundary = world.settings().fluid.obstacleWall == FluidSolverSettings::ObstacleWall::CellBoundary;
+  const bool cellBoundary = world.template resource<FluidSolverSettings>().obstacleWall == FluidSolverSettings::ObstacleWall::CellBoundary;
   const auto visit = [&](int g, int a, const Index& f, int b, int dir) {
     const std::size_t k = solvers::FluidDomain<d>::wallDistanceIndex(g, b, dir > 0);
     const auto x = layout.faceCenter(a, f);
@@ -515,7 +516,7 @@ void RasterizeObstacles<d>::run(World<d>& world, StepContext&) {
     const ObstacleList<d> obstacles = obstacleList(world);
     const CellBox<d> box = obstaclesBox(layout, obstacles);
     std::vector<std::uint8_t> mask;
-    if (world.settings().fluid.cutCells) {
+    if (world.template resource<FluidSolverSettings>().cutCells) {
       std::vector<double> open = openFractions(layout, obstacles, &box);
       mask = coveredCells(layout, open, box);
       if (open != grid.openFraction) grid.openFraction = std::move(open);
@@ -524,7 +525,7 @@ void RasterizeObstacles<d>::run(World<d>& world, StepContext&) {
       grid.openFraction.clear();
     }
     if (mask != grid.solid) grid.solid = std::move(mask);  // unchanged: keep the projection's cache
-    if (world.settings().fluid.obstacleWallDistances()) {
+    if (world.template resource<FluidSolverSettings>().obstacleWallDistances()) {
       WallGeometry<d> wall = wallGeometry(world, grid, obstacles, box);
       grid.obstacleWallDistance = std::move(wall.distance);
       grid.obstacleWallVelocity = std::move(wall.velocity);

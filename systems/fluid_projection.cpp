@@ -32,7 +32,7 @@ FluidProjection<d>::~FluidProjection() = default;
 template <int d>
 void FluidProjection<d>::run(World<d>& world, StepContext& ctx) {
   auto& pool = world.template pool<MacGrid<d>>();
-  const FluidSolverSettings& settings = world.settings().fluid;
+  const FluidSolverSettings& settings = world.template resource<FluidSolverSettings>();
   for (std::size_t g = 0; g < pool.size(); ++g) {
     MacGrid<d>& grid = pool.components()[g];
     const FluidMaterial* material = world.template get<FluidMaterial>(pool.entities()[g]);

@@ -50,7 +50,7 @@ void writeBody(RigidBody<d>& body, const Eigen::VectorXd& v, int b) {
 template <int d>
 solvers::FsiReport coupledSolve(const World<d>& world, StructureCouplingSetup<d>& setup, double rho, double mu, double dt,
                                 Eigen::VectorXd& u, std::unique_ptr<solvers::FluidOperators<d>>& opsOut) {
-  const FluidSolverSettings& settings = world.settings().fluid;
+  const FluidSolverSettings& settings = world.template resource<FluidSolverSettings>();
   auto ops = std::make_unique<solvers::FluidOperators<d>>(
       solvers::buildFluidOperators(setup.domain, solvers::FluidParameters{rho, mu, dt}));
   auto& c = setup.coupling;
@@ -291,7 +291,7 @@ StructureCouplingSetup<d> buildStructureCoupling(const World<d>& world, const Ma
   }
   auto& coupling = setup.coupling;
   coupling.constrainedFaces = solvers::markStructure(setup.domain, mask, viscous);
-  if (viscous) placeStructureWalls(world.settings().fluid.obstacleWall, geometry, setup);
+  if (viscous) placeStructureWalls(world.template resource<FluidSolverSettings>().obstacleWall, geometry, setup);
   const int nc = static_cast<int>(coupling.constrainedFaces.size());
 
   // J = N J_hat R: one sample per (face, adjacent rigid body) at the face centre, and one per
@@ -457,7 +457,7 @@ void writeStructures(World<d>& world, const StructureCouplingSetup<d>& setup) {
 template <int d>
 void FsiHalfStep<d>::run(World<d>& world, StepContext& ctx) {
   auto& couplings = world.template pool<FluidCoupling<d>>();
-  const bool stokes = world.settings().fluid.advection == FluidSolverSettings::Advection::None;
+  const bool stokes = world.template resource<FluidSolverSettings>().advection == FluidSolverSettings::Advection::None;
   const Eigen::Matrix<double, d, 1> g = world.settings().gravity;
   for (std::size_t i = 0; i < couplings.size(); ++i) {
     FluidCoupling<d>& c = couplings.components()[i];
@@ -511,7 +511,7 @@ void FsiHalfStep<d>::run(World<d>& world, StepContext& ctx) {
 
 template <int d>
 void FluidStructureProjection<d>::run(World<d>& world, StepContext& ctx) {
-  const bool stokes = world.settings().fluid.advection == FluidSolverSettings::Advection::None;
+  const bool stokes = world.template resource<FluidSolverSettings>().advection == FluidSolverSettings::Advection::None;
   const Eigen::Matrix<double, d, 1> g = world.settings().gravity;
   auto& couplings = world.template pool<FluidCoupling<d>>();
   // v* = v^n + dt/2 (a^n + a^{n+1}) (step 5): the start velocity plus what the rigid stages added

@@ -31,11 +31,6 @@ std::vector<int> assemblyBodies(const JointAssembly<d>& a, const ContactWorkspac
   return bodyOf;
 }
 
-// The contact points, within `margin`, of the pairs with a jointed body that can move: that body
-// at its pose in the assembly, the others at their base pose (where push-out left them in Step
-// IV, time n+1 in Step V; a static body's collision pose, grounded_box.h). `gainOf(depth)` is
-// the row's gain. With `partnerMotion`, a partner held still in the solve moves with its own
-// velocity at the point (Step V).
 // A body of the assembly as a pose of dimension d (2-D: the plane's part of the lifted pose).
 template <int d>
 col::Pose<d> poseOfBody(const solvers::ConstraintBody& b) {
@@ -58,6 +53,11 @@ Orientation<d> orientationOf(const Eigen::Quaterniond& q, const Orientation<d>& 
   }
 }
 
+// The contact points, within `margin`, of the pairs with a jointed body that can move: that body
+// at its pose in the assembly, the others at their base pose (where push-out left them in Step
+// IV, time n+1 in Step V; a static body's collision pose, grounded_box.h). `gainOf(depth)` is
+// the row's gain. With `partnerMotion`, a partner held still in the solve moves with its own
+// velocity at the point (Step V).
 template <int d, typename GainOf>
 std::vector<solvers::ContactRow> contactRows(const JointAssembly<d>& a, const ContactWorkspace<d>& ws,
                                              const std::vector<int>& bodyOf, double margin, GainOf&& gainOf,
@@ -108,7 +108,7 @@ void postStabilizeWithContacts(World<d>& world, const ContactWorkspace<d>& ws, S
   const ArticulationSolver s = articulationSettings(world);
   JointAssembly<d> a(world);
   const std::vector<int> bodyOf = assemblyBodies(a, ws);
-  const double dt = ws.dt;
+  const double dt = ctx.dt;  // the step Step V's gaps close in
   // Touching or overlapping: no approach (push-out's business). Apart: the gap may close within
   // the step only where the contact stages close gaps (ContactSettings::closeGaps), and a gap
   // within push-out's tolerance counts as touching, as in closableNormalVelocity. On the thesis's
@@ -167,8 +167,8 @@ void resolveJointedInterpenetration(World<d>& world, ContactWorkspace<d>& ws, St
     // Passes: the contact points up to twice the deepest overlap apart (the displacements are of
     // that size), linearised at the pass's poses, and the solve; then the points found again
     // where it left the bodies. A body pushed along a capsule by the solve reaches the capsule's
-    // jointed neighbour, whose points the pass did not have (a ring hanging on the joint of an
-    // articulated loop left 1.5 cm inside it after one pass, and went through within 0.1 s).
+    // jointed neighbour, whose points the pass did not have (with one pass a ring hanging on the
+    // joint of an articulated loop is left 1.5 cm inside it, and goes through within 0.1 s).
     deepest = deepestOverlap();
     for (int pass = 0; pass < s.pushOutContactPasses; ++pass) {
       std::vector<solvers::ContactRow> contacts;

@@ -154,7 +154,7 @@ void ParticleRigidContact<d>::run(World<d>& world, StepContext& ctx) {
     world.template each<Particles<d>>([&](Entity, Particles<d>& p) { scratch_->savedVelocities.push_back(p.v); });
   }
   if (bodies.empty()) return;
-  const double thickness = world.settings().contact.thickness;
+  const double thickness = world.template resource<ContactSettings>().thickness;
   int impulses = 0;
   std::vector<Particles<d>*> pools;
   world.template each<Particles<d>>([&](Entity, Particles<d>& p) { pools.push_back(&p); });
@@ -329,8 +329,8 @@ std::vector<NormalConstraint<d>> DampingSolveContacts<d>::of(World<d>& world, co
   std::vector<NormalConstraint<d>> out;
   if (world.template count<Collider<d>>() == 0) return out;
   const std::vector<BodyView<d>> bodies = bodiesOf(world, shapes_, dt, false);
-  const double thickness = world.settings().contact.thickness;
-  const double tolerance = world.settings().contact.approachTolerance;
+  const double thickness = world.template resource<ContactSettings>().thickness;
+  const double tolerance = world.template resource<ContactSettings>().approachTolerance;
   std::vector<char> taken(p.count(), 0);
   for (const BodyView<d>& b : bodies)
     for (int i = 0; i < p.count(); ++i) {

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "ecs/system.h"
-#include "solvers/contact/joint_push_out.h"
+#include "solvers/contact/push_out_rounds.h"
 #include "systems/contact_workspace.h"
 
 namespace monolith {
@@ -65,7 +65,7 @@ class ShockPropagation final : public RigidContactSystem<d> {
   std::string name() const override { return "shock_propagation"; }
   Stage stage() const override { return Stage::Contact; }
   bool needed(const World<d>& w) const override {
-    return RigidContactSystem<d>::needed(w) && w.settings().contact.shockPropagation;
+    return RigidContactSystem<d>::needed(w) && w.template resource<ContactSettings>().shockPropagation;
   }
   void run(World<d>& world, StepContext& ctx) override;
 };
@@ -78,31 +78,10 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   Stage stage() const override { return Stage::AdvancePositions; }
   void run(World<d>& world, StepContext& ctx) override;
 
-  // One island's push-out plan: its tasks (one per central body and level iteration, then the
-  // level's freezes) and the buffers that build them. Kept per island slot across steps, so a
-  // pile of thousands of small islands does not allocate them anew every step.
-  struct PushTask {
-    int central = -1;  // -1: freeze `frozenBody`
-    int frozenBody = -1;
-    int begin = 0, end = 0;  // the central body's pairs on its level, in `centralPairs`
-    double fraction = 0;
-  };
-  struct IslandPlan {
-    std::vector<PushTask> tasks;
-    std::vector<int> centralPairs;  // per central body and level: its pairs there, in level order
-    std::vector<char> frozen;
-    std::vector<int> touched, levelMembers, solves;
-    std::vector<std::pair<int, int>> bodyPair;  // (level member, pair), grouped by member
-    std::vector<std::pair<int, int>> range;     // per level member: its pairs in centralPairs
-    std::vector<int> pairsByLevel;  // the island's pairs to push apart, ascending level
-    std::vector<std::pair<int, int>> focusByLevel;  // a focused round's bodies: (level, body)
-    solvers::parallel::OrderedTasks order;
-  };
-
  private:
   // The rotational-energy clamp on the momentum Step V starts from (3-D;
-  // systems/rotational_energy_clamp.cpp): what
-  // it needs from before push-out, then the clamp (returns the bodies it scaled).
+  // systems/rotational_energy_clamp.cpp): what it needs from before push-out, then the clamp
+  // (returns the bodies it scaled).
   void rememberRotationalEnergy(const ContactWorkspace<d>& ws);
   int clampEnergyOfRestoredMomentum(ContactWorkspace<d>& ws);
   struct AdvancedState {
@@ -111,61 +90,8 @@ class ResolveInterpenetration final : public RigidContactSystem<d> {
   };
   std::vector<double> energyAtTimeN_;     // per body: the restored momentum's energy at time n
   std::vector<AdvancedState> advanced_;   // per body: Step IV's momentum and orientation
-  std::vector<IslandPlan> plans_;
-  // Per pair: its deepest overlap (m) and that over the smaller body's size, as last measured.
-  // `which(k)` picks the pairs measured again; the others keep their values.
-  template <typename Which>
-  void measurePairs(const ContactWorkspace<d>& ws, Which&& which);
-  std::vector<double> depth_, ratio_;
-  // Per pair: whether it overlaps though Step II did not process it (newOverlap_); returns how
-  // many do.
-  int markNewOverlaps(const ContactWorkspace<d>& ws);
-  // The levels push-out runs by (pairLevel_ per pair): the contact graph's, or with new overlaps
-  // those of its copy with an edge both ways per new overlap (newOverlap_, which a later round
-  // also sets for the pairs it ties, tie_).
-  const solvers::contact::ContactLevels& pushLevels(const ContactWorkspace<d>& ws, int newOverlaps);
-  // One round of push-out over the islands marked in active_; returns the central-body solves.
-  // focused: only the pairs with a body in focus_ (the rounds after the first).
-  int pushApart(ContactWorkspace<d>& ws, const solvers::contact::ContactLevels& levels, bool focused);
-  struct SavedPose {
-    int body;
-    Eigen::Matrix<double, d, 1> x;
-    Orientation<d> q;
-  };
-  std::vector<SavedPose> savedPoses_;  // a later round's bodies before it, to undo it
-  std::vector<char> active_;      // per island: pushed apart in this round
-  std::vector<char> focus_;       // per body: worked on in the next round
-  std::vector<char> partner_;     // per body: a dynamic neighbour of a focus body
-  std::vector<char> tie_;         // per pair of two dynamic bodies: one level in the next round
-  std::vector<std::pair<int, int>> knownPairs_;  // the pairs before a round's growth
-  std::vector<double> knownDepth_, knownRatio_;  // and their measurements
-  std::vector<int> knownIndex_;                  // per pair after the growth: its index before, or -1
-  std::vector<char> moved_;       // per body: in an island push-out worked on
-  // The pairs whose depths growAndMeasure measured again: a body in moved_, or new.
-  bool movedOrNew(const ContactWorkspace<d>& ws, std::size_t k) const;
-  // After bodies in moved_ moved: the broad phase grown where they are, the depths carried over
-  // and measured again (movedOrNew); returns the pairs added.
-  int growAndMeasure(ContactWorkspace<d>& ws);
-  // The jam left after the rounds pushed apart at once (solvers/contact/joint_push_out.h), pass
-  // by pass while each leaves its pairs shallower. Returns the passes kept; adds to newPairs.
-  // The jam is the deep pairs' bodies and `rings` rings of their dynamic neighbours.
-  int pushJamsApart(ContactWorkspace<d>& ws, int rings, int& newPairs);
-  static constexpr int kJointPasses = 16;  // linearisations, at most
-  static constexpr int kJointHalvings = 3;  // of a pass's step that leaves the jam no shallower
-  static constexpr int kJointRings = 2;    // neighbours of neighbours of the deep pairs' bodies
-  static constexpr int kJointRegrowths = 3;  // solves again with 4, 8, 16 rings, at most
-  std::vector<char> jamRing_, jamNext_;    // the bodies a ring grows from, and those it adds
-  static constexpr int kJointSweeps = 2000;  // Gauss-Seidel sweeps per linearisation, at most
-  std::vector<int> jamIndex_;  // per body: its index in the joint solve, or -1 (a fixed partner)
-  std::vector<solvers::contact::JointBody<d>> jamBodies_;
-  std::vector<solvers::contact::JointPoint<d>> jamPoints_;
-  std::vector<solvers::contact::JointMove<d>> jamMoves_;
-  std::vector<solvers::collision::ContactPoint<d>> jamContacts_;  // one pair's narrow phase, kept
-  std::vector<SavedPose> passStart_;  // the jam's bodies and their poses before a pass, to undo it
-  std::vector<char> newOverlap_;  // per pair: not processed in Step II, yet overlapping now (or tied)
-  std::vector<int> pairLevel_;    // per pair: its level in push-out
-  std::vector<std::pair<int, int>> edges_;
-  solvers::contact::ContactLevels pushLevels_;
+  // Push-out's rounds and the storage they keep from step to step.
+  solvers::contact::PushOutRounds<d> pushOut_;
 };
 
 template <int d>
@@ -175,7 +101,7 @@ class VelocityContact final : public RigidContactSystem<d> {
   std::string name() const override { return "velocity_contact"; }
   Stage stage() const override { return Stage::AdvanceVelocity; }
   bool needed(const World<d>& w) const override {
-    return RigidContactSystem<d>::needed(w) && w.settings().contact.velocityContact;
+    return RigidContactSystem<d>::needed(w) && w.template resource<ContactSettings>().velocityContact;
   }
   void run(World<d>& world, StepContext& ctx) override;
 };

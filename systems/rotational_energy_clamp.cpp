@@ -28,18 +28,18 @@ bool turningChangesEnergy(const ContactBody<d>& b) {
 // Step IV turns each body with the momentum contact left it (Step III), and its energy fix
 // (Sec. 2.2) keeps that momentum's energy; push-out then turns bodies further. The step ends by
 // restoring the post-collision momentum (notes 1.3, item 9), whose energy in the new
-// orientation can be far above its energy in the old one when the inertia is far from round:
-// in random scenes a spinning needle came out of one step with 3.9 times its rotational
-// energy after a contact impulse, and push-out's turns added energy the same way (2.8 % of
-// the scene's total energy in all). Where the restored momentum has more than 5 % more energy
+// orientation can be far above its energy in the time-n one when the inertia is far from round:
+// without this clamp a spinning needle in a random scene comes out of one step with 3.9 times
+// its rotational energy after a contact impulse, and push-out's turns add energy the same way
+// (2.8 % of the scene's total energy in all). Where the restored momentum has more than 5 % more energy
 // in the new orientation than in the time-n one, it is scaled down to the time-n energy
 // (Sec. 2.3.2's rule: an energy gain is clamped, a loss left).
 // - Below 5 % nothing is done: resting and tumbling bodies gain and lose a little this way
 //   all the time (in `mixed_pile` at most 1.2 %, in sliver drops 99 % of the cases under
-//   1.6 %), and clamping each of those too changed the chaotic piles' overlaps for the worse
-//   in the sliver-drop tests while the energy stayed within the 0.1 % without it.
+//   1.6 %), and clamping each of those too makes the chaotic piles' overlaps worse in the
+//   sliver-drop tests, while without it the energy stays within 0.1 %.
 // - Turning the body instead, as the energy fix of Sec. 2.2 does, keeps the momentum but needs
-//   large turns where the momentum is tiny (a body at rest in a pile), which made new overlaps
+//   large turns where the momentum is tiny (a body at rest in a pile), which make new overlaps
 //   in `mixed_pile` (1.9 % of a body); the scaling moves nothing.
 // Bodies that neither contact nor push-out turned differently are already fixed and skipped,
 // and so are bodies whose rotational energy does not depend on their orientation.

@@ -133,7 +133,7 @@ template <int d>
 void FallAsleep<d>::run(World<d>& world, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   auto& sleeps = world.template pool<Sleep<d>>();
-  const ContactSettings& settings = world.settings().contact;
+  const ContactSettings& settings = world.template resource<ContactSettings>();
   const int n = static_cast<int>(ws.bodies.size());
   reach_.resize(n);
   reachOf_.resize(n, nullptr);

@@ -3,9 +3,10 @@
 // (x^{n+1}, v^{n+1}), but not the first contact step (Sec. 2.3.2, "Contact Clamping": clamping
 // it against (x^n, v^n) makes resting contact jitter; "future work"). That step's velocities
 // only move the positions and are then thrown away, so an impulse that turns a spinning body's
-// fall into a rise lifts it without taking the kinetic energy the lift costs: on the short
-// schedule, with one inelastic contact pass, about one random 2-D drop in 600 gained 0.4-1 % of
-// its total energy in one step (the git history of docs/benchmarks.md ("The short schedule on random drops")).
+// fall into a rise lifts it without taking the kinetic energy the lift costs: without this
+// clamp, on the short schedule with its one inelastic contact pass, about one random 2-D drop in
+// 600 gains 0.4-1 % of its total energy in one step (2-D drops 261 and 736,
+// docs/benchmarks_rigid_contact.md).
 //
 // The clamp checks the whole step instead. Under gravity alone the Newmark step keeps the
 // energy E = KE - m g.x exactly (Step I's and Step V's half kicks pay for the fall), collision
@@ -90,8 +91,8 @@ int ContactWorkspace<d>::clampStepEnergyGain(World<d>& world, double& removed) {
     rise = std::min(rise, lift);
     // Nor a rise below the island's weight times the contact thickness: push-out lifts resting
     // piles by about its tolerance every step, and stopping them for it (their kinetic energy is
-    // about that small) took the approach from the next step's collision stage, whose pairs
-    // then went unprocessed into contact (2-D drops 5-14 % deep in one step, 6 of 1885).
+    // about that small) takes the approach from the next step's collision stage, whose pairs
+    // then go unprocessed into contact (2-D drops 5-14 % deep in one step, 6 of 1885).
     if (!(rise > settings.thickness * weight) || !(rise > 1e-12 * scale) || kinetic <= 0) return;
     const double s = std::sqrt(std::max(0.0, 1.0 - rise / kinetic));
     for (int m : islands.members[island]) {

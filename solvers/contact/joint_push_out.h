@@ -3,8 +3,8 @@
 // thesis's push-out (push_out.h, App. B) moves one central body against all the bodies it
 // overlaps, level by level. In a jam -- a body wedged between two others that are themselves
 // pressed against a third or a wall -- each such solve pushes its body into a neighbour the
-// solve does not move, and push-out's later rounds are undone (systems/interpenetration.cpp):
-// 2-D random drops kept overlaps of 10-60 % of a thin body's size for a step.
+// solve does not move, and push-out's later rounds are undone (push_out_rounds.h): without this
+// solve 2-D random drops keep overlaps of 10-60 % of a thin body's size for a step.
 //
 // Here every body of the jam moves together: the smallest mass-weighted displacement
 //   min sum_i (m_i |dx_i|^2 + dtheta_i . I_i dtheta_i)

@@ -5,10 +5,9 @@
 //
 // Why not Eigen::LLT: on these fixed 6 x 6 matrices Eigen runs its general unblocked loop with
 // run-time bounds; here the sizes are compile-time constants and the pivots' reciprocals are kept
-// so that the solves multiply. Eigen's LLT calls were 15 % of a short-schedule pyramid_20 step.
-// An L L^T written so made the step about 2 % faster; this L D L^T, which keeps the square
-// roots off the pivots' dependent chain, another 6 % (the git history of docs/benchmarks.md ("Exact finish before
-// the first sweep")).
+// so that the solves multiply. Measured on a short-schedule pyramid_20 step, where Eigen's LLT
+// takes 15 % of the time: an L L^T written so makes the step about 2 % faster, and this L D L^T,
+// which keeps the square roots off the pivots' dependent chain, another 6 %.
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>

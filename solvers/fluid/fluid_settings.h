@@ -1,10 +1,11 @@
 #pragma once
-// Held by WorldSettings (ecs/world.h), read by the fluid systems and the fluid-structure coupling.
+// A world resource (World::resource), read by the fluid systems and the fluid-structure coupling.
 
 namespace monolith {
 
 // How the fluid step of Ch. 5 is taken (scene "solvers": {"fluid": {...}}).
 struct FluidSolverSettings {
+  static constexpr const char* kName = "fluid_settings";  // its name among the world's resources
   enum class Advection { SemiLagrangian, MacCormack, Eno3, Weno5, None };  // None: unsteady Stokes flow (Sec. 5.7)
   enum class Projection { Coupled, Chorin };            // (5.31) vs pressure/viscosity splitting
   enum class Preconditioner { None, Jacobi, IC0, MIC0, Multigrid };

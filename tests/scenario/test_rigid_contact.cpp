@@ -581,33 +581,7 @@ TEST(StepEnergyClamp, LeavesAFallingBodyAloneAndTheThesisScheduleDoesNotUseIt) {
   EXPECT_FALSE(thesisRun.step().count("step_energy_clamped_islands"));
   Simulation<2> defaultRun(loadScene(kScenes + "random_drop_2d_261.json"), registry);
   EXPECT_EQ(defaultRun.step().at("step_energy_clamped_islands"), 0);
-  const ContactSettings& thesis = thesisRun.world().settings().contact;
-  EXPECT_EQ(thesis.contactIterations, 10);
-  EXPECT_EQ(thesis.contactLevelIterations, 2);
-  EXPECT_EQ(thesis.shockLevelIterations, 2);
-  EXPECT_FALSE(thesis.exactManifoldFinish);
-  EXPECT_FALSE(thesis.stepEnergyClamp);
-  EXPECT_FALSE(thesis.closeGaps);
-  const ContactSettings& byDefault = defaultRun.world().settings().contact;
-  EXPECT_EQ(byDefault.contactIterations, 1);
-  EXPECT_TRUE(byDefault.closeGaps);
-  EXPECT_EQ(byDefault.pushOutJointOverlap, 0.02);
-  EXPECT_EQ(ContactSettings{}.contactIterations, 1);  // the struct's own defaults agree
-  EXPECT_TRUE(ContactSettings{}.stepEnergyClamp);
-  EXPECT_EQ(thesis.pushOutJointOverlap, 0.05);
-  const ContactSettings& shortSettings = shortRun.world().settings().contact;
-  EXPECT_EQ(shortSettings.contactIterations, 1);
-  EXPECT_EQ(shortSettings.contactLevelIterations, 1);
-  EXPECT_EQ(shortSettings.shockLevelIterations, 1);
-  EXPECT_TRUE(shortSettings.exactManifoldFinish);
-  EXPECT_TRUE(shortSettings.stepEnergyClamp);
-  EXPECT_TRUE(shortSettings.closeGaps);
-  // A key after the schedule adjusts it.
-  Simulation<2> adjusted(loadScene(kScenes + "random_drop_2d_261.json",
-                                   {{"solvers.contact.schedule", "thesis"}, {"solvers.contact.contact_iterations", "3"}}),
-                         registry);
-  EXPECT_EQ(adjusted.world().settings().contact.contactIterations, 3);
-  EXPECT_EQ(adjusted.world().settings().contact.contactLevelIterations, 2);
+  // Each schedule's values and their selection by name: test_contact_schedule.
 }
 
 TEST(JointPushOut, AJamThatTheRoundsLeaveDeepIsPushedApartAtOnce) {
