@@ -109,3 +109,33 @@ struct RigidBinding {
 };
 
 }  // namespace monolith
+
+namespace monolith {
+
+// Particles of a deformable body embedded in the elements of another deformable body (Sifakis et
+// al. 2007 [138], hard bindings): an embedded particle has no freedom of its own; its position and
+// velocity are the barycentric interpolation of its host element's, x = sum_i w_i x_i. Its mass
+// was distributed to the host element's particles (m_i += w_i m) when the scene was built, the
+// elastic and damping forces on it act on them with the same weights (so linear and angular
+// momentum are kept: sum w_i = 1, sum w_i x_i = x), and it is projected out of the implicit
+// solves with its velocity prescribed (Sec. 4.7.3). Embedded particles carry Particles::fixed == 3.
+template <int d>
+struct EmbeddedBinding {
+  static constexpr const char* kName = "embedded_binding";
+  std::string hosts;             // the host bodies' names, one per line
+  std::vector<int> particle;     // embedded particle indices
+  std::vector<int> host;         // per embedded particle: index into the names
+  std::vector<int> element;      // per embedded particle: the host mesh's element
+  std::vector<double> weight;    // per embedded particle: d+1 barycentric weights
+
+  template <class V>
+  void visitFields(V& visit) {
+    visit("hosts", hosts);
+    visit("particle", particle);
+    visit("host", host);
+    visit("element", element);
+    visit("weight", weight);
+  }
+};
+
+}  // namespace monolith
