@@ -5,6 +5,10 @@
 #include <cmath>
 #include <limits>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+
 #include "solvers/collision/collision_impl.h"
 #include "solvers/contact/rigid_math.h"
 #include "solvers/deformable/face_geometry.h"
@@ -15,6 +19,19 @@ namespace col = solvers::collision;
 namespace ct = solvers::contact;
 
 namespace {
+
+// Deterministic parallel loop over [0, n): a fixed split whatever the thread count, every index
+// written by one task.
+template <class F>
+void parallelFor(int n, F&& f, int grain = 16) {
+  if (n <= 0) return;
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, n, grain),
+      [&](const tbb::blocked_range<int>& r) {
+        for (int i = r.begin(); i != r.end(); ++i) f(i);
+      },
+      tbb::simple_partitioner());
+}
 
 template <int d>
 using Vec = Eigen::Matrix<double, d, 1>;
@@ -114,20 +131,20 @@ FaceContact<d> deepestFacePoint(const RigidFaceBody<d>& body, const Vec<d>* p) {
 }
 
 template <int d>
-std::vector<FaceContact<d>> findFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces,
-                                             Bvh<d>& tree) {
+void findFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces, Bvh<d>& tree,
+                      FaceContactWorkspace<d>& work, std::vector<FaceContact<d>>& out) {
   const int nf = faces.faceCount();
   const std::vector<int>& f = *faces.faces;
-  std::vector<Box<d>> boxes(nf);
-  for (int k = 0; k < nf; ++k) {
+  work.boxes.resize(nf);
+  parallelFor(nf, [&](int k) {
     double pad = 0;
     for (int a = 0; a < d; ++a) pad = std::max(pad, (*faces.thickness)[f[d * k + a]]);
-    boxes[k] = faceBox<d>(*faces.x, &f[d * k], pad);
-  }
-  if (static_cast<int>(tree.size()) != nf) tree.build(boxes);
-  else tree.refit(boxes);
-  std::vector<FaceContact<d>> out;
-  std::vector<int> hits;
+    work.boxes[k] = faceBox<d>(*faces.x, &f[d * k], pad);
+  });
+  if (static_cast<int>(tree.size()) != nf) tree.build(work.boxes);
+  else tree.refit(work.boxes);
+  // The candidate pairs serially (a few BVH queries, one per body), in body order, faces ascending.
+  work.pairs.clear();
   for (int bi = 0; bi < static_cast<int>(bodies.size()); ++bi) {
     const RigidFaceBody<d>& body = bodies[bi];
     // Half-spaces are left to the particle contact: a flat face's deepest point in a half-space is
@@ -140,27 +157,45 @@ std::vector<FaceContact<d>> findFaceContacts(const std::vector<RigidFaceBody<d>>
     Box<d> query;
     query.lo = bounds.min();
     query.hi = bounds.max();
-    hits.clear();
-    tree.query(query, hits);
-    std::sort(hits.begin(), hits.end());
-    for (int face : hits) {
-      Vec<d> p[d];
-      double thickness = 0, friction = body.friction;
-      for (int a = 0; a < d; ++a) {
-        const int i = f[d * face + a];
-        p[a] = at<d>(*faces.x, i);
-        thickness = std::max(thickness, (*faces.thickness)[i]);
-        friction = std::max(friction, (*faces.friction)[i]);
-      }
-      FaceContact<d> c = deepestFacePoint<d>(body, p);
-      if (!(c.distance < thickness)) continue;
-      c.body = bi;
-      c.face = face;
-      c.thickness = thickness;
-      c.friction = friction;
-      out.push_back(c);
-    }
+    work.hits.clear();
+    tree.query(query, work.hits);
+    std::sort(work.hits.begin(), work.hits.end());
+    for (int face : work.hits) work.pairs.emplace_back(bi, face);
   }
+  // The deepest point of every pair, the costly part, in parallel into its own slot.
+  const int np = static_cast<int>(work.pairs.size());
+  work.slots.resize(np);
+  work.close.assign(np, 0);
+  parallelFor(np, [&](int k) {
+    const auto [bi, face] = work.pairs[k];
+    Vec<d> p[d];
+    double thickness = 0, friction = bodies[bi].friction;
+    for (int a = 0; a < d; ++a) {
+      const int i = f[d * face + a];
+      p[a] = at<d>(*faces.x, i);
+      thickness = std::max(thickness, (*faces.thickness)[i]);
+      friction = std::max(friction, (*faces.friction)[i]);
+    }
+    FaceContact<d> c = deepestFacePoint<d>(bodies[bi], p);
+    if (!(c.distance < thickness)) return;
+    c.body = bi;
+    c.face = face;
+    c.thickness = thickness;
+    c.friction = friction;
+    work.slots[k] = c;
+    work.close[k] = 1;
+  });
+  out.clear();
+  for (int k = 0; k < np; ++k)
+    if (work.close[k]) out.push_back(work.slots[k]);
+}
+
+template <int d>
+std::vector<FaceContact<d>> findFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces,
+                                             Bvh<d>& tree) {
+  FaceContactWorkspace<d> work;
+  std::vector<FaceContact<d>> out;
+  findFaceContacts<d>(bodies, faces, tree, work, out);
   return out;
 }
 
@@ -233,6 +268,8 @@ double pushFacesOut(const std::vector<FaceContact<d>>& contacts, const std::vect
   template FaceContact<D> deepestFacePoint<D>(const RigidFaceBody<D>&, const Vec<D>*);                            \
   template std::vector<FaceContact<D>> findFaceContacts<D>(const std::vector<RigidFaceBody<D>>&, const FaceSet<D>&, \
                                                            Bvh<D>&);                                              \
+  template void findFaceContacts<D>(const std::vector<RigidFaceBody<D>>&, const FaceSet<D>&, Bvh<D>&,              \
+                                    FaceContactWorkspace<D>&, std::vector<FaceContact<D>>&);                      \
   template int applyFaceContactImpulses<D>(std::vector<RigidFaceBody<D>>&, FaceSet<D>&,                           \
                                            const std::vector<FaceContact<D>>&, int);                              \
   template double pushFacesOut<D>(const std::vector<FaceContact<D>>&, const std::vector<int>&,                    \

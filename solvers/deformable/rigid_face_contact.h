@@ -78,6 +78,21 @@ FaceContact<d> deepestFacePoint(const RigidFaceBody<d>& body, const Eigen::Matri
 template <int d>
 std::vector<FaceContact<d>> findFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces,
                                              Bvh<d>& tree);
+// Storage findFaceContacts reuses from call to call.
+template <int d>
+struct FaceContactWorkspace {
+  std::vector<Box<d>> boxes;
+  std::vector<int> hits;
+  std::vector<std::pair<int, int>> pairs;  // (body, face) whose boxes overlap
+  std::vector<FaceContact<d>> slots;       // one per pair
+  std::vector<char> close;                 // the pair's deepest point is within the thickness
+};
+// The same into `out`; the face boxes and the deepest points of the (body, face) pairs are
+// computed in parallel, one slot per pair, and kept in pair order: bitwise the same on any thread
+// count.
+template <int d>
+void findFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces, Bvh<d>& tree,
+                      FaceContactWorkspace<d>& work, std::vector<FaceContact<d>>& out);
 
 // Gauss-Seidel sweeps over the contacts, forward and backward in turn: each approaching pair
 // (relative normal velocity at the point < 0) gets the impulse that stops the approach, with
