@@ -65,6 +65,13 @@ void RigidSurfaceContact<d>::run(World<d>& world, StepContext& ctx) {
     if (deepest > 0) particles_.writePositions();
     return;
   }
+  // Step II also sweeps the bodies' centres through the faces over the step: a body fast or small
+  // enough to pass a face between the start and the candidate positions is caught there.
+  if (stage_ == Stage::Collisions) {
+    dm::findSweptFaceContacts<d>(bodies_, faces, particles_.x, ctx.dt, contacts_, sweptTree_, work_, swept_);
+    ctx.diagnostics.set("rigid_surface_swept_contacts", static_cast<double>(swept_.size()));
+    contacts_.insert(contacts_.end(), swept_.begin(), swept_.end());
+  }
   const int impulses = dm::applyFaceContactImpulses<d>(bodies_, faces, contacts_, kContactSweeps);
   ctx.diagnostics.set(name() + "_impulses", impulses);
   if (impulses == 0) return;

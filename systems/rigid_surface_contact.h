@@ -10,6 +10,8 @@
 //    mass and inertia), registered with the particles' collisions before the rigid contact (whose
 //    workspace holds the bodies' velocities from its Step II to Step IV) and so before the
 //    surface collisions, which see the changed velocities;
+//    and, swept, where a body's centre would pass through a face between x^n and the candidate
+//    position (findSweptFaceContacts): a fast or small body cannot tunnel through in one step;
 //  * rigid_surface_contact (Step III, Sec. 4.5): the same with the bodies immovable; the
 //    particles' velocities only steer the position update (particle_push_out restores them);
 //  * rigid_surface_push_out (Step IV, Sec. 4.6.1): a face point inside a body at x^{n+1} is moved
@@ -63,7 +65,8 @@ class RigidSurfaceContact final : public System<d> {
   SurfaceParticles<d> particles_;
   std::vector<double> at_;
   solvers::deformable::FaceContactWorkspace<d> work_;
-  std::vector<solvers::deformable::FaceContact<d>> contacts_;
+  std::vector<solvers::deformable::FaceContact<d>> contacts_, swept_;
+  solvers::deformable::Bvh<d> sweptTree_;  // over the faces' boxes swept over the step
 };
 
 // One system per stage listed (Collisions, Contact, AdvancePositions, AdvanceVelocity).

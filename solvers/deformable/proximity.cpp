@@ -248,6 +248,8 @@ std::vector<Pair> candidatePairs(const CollisionSurface<d>& s, const std::vector
   return pairs;
 }
 
+}  // namespace
+
 // Real roots in [0, 1] of c0 + c1 t + c2 t^2 + c3 t^3, ascending: the interval split at the
 // critical points, a sign change in a piece bisected to round-off.
 std::vector<double> rootsInUnitInterval(double c0, double c1, double c2, double c3) {
@@ -297,6 +299,8 @@ std::vector<double> rootsInUnitInterval(double c0, double c1, double c2, double 
   }
   return roots;
 }
+
+namespace {
 
 // The earliest time in [0, 1] at which the pair, moving along x + t dt v, is coplanar (3-D;
 // collinear in 2-D) and within `tolerance`; negative if none.
