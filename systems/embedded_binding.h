@@ -22,13 +22,7 @@ namespace monolith {
 // embedded particle of `b` (hosts that no longer exist are skipped).
 template <int d, class Add>
 void forEachHostWeight(World<d>& world, const EmbeddedBinding<d>& b, Add add) {
-  std::vector<std::string> names;
-  for (std::string::size_type start = 0; start <= b.hosts.size();) {
-    const auto end = b.hosts.find('\n', start);
-    names.push_back(b.hosts.substr(start, end == std::string::npos ? std::string::npos : end - start));
-    if (end == std::string::npos) break;
-    start = end + 1;
-  }
+  const std::vector<std::string> names = b.hostNames();
   for (std::size_t k = 0; k < b.particle.size(); ++k) {
     const auto host = world.find(names[b.host[k]]);
     const SimplexMesh<d>* mesh = host ? world.template get<SimplexMesh<d>>(*host) : nullptr;

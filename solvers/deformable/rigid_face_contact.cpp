@@ -5,13 +5,11 @@
 #include <cmath>
 #include <limits>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
 
 #include "solvers/collision/collision_impl.h"
 #include "solvers/contact/rigid_math.h"
 #include "solvers/deformable/face_geometry.h"
+#include "solvers/deformable/parallel_indices.h"
 #include "solvers/deformable/proximity.h"
 
 namespace monolith::solvers::deformable {
@@ -21,18 +19,6 @@ namespace ct = solvers::contact;
 
 namespace {
 
-// Deterministic parallel loop over [0, n): a fixed split whatever the thread count, every index
-// written by one task.
-template <class F>
-void parallelFor(int n, F&& f, int grain = 16) {
-  if (n <= 0) return;
-  tbb::parallel_for(
-      tbb::blocked_range<int>(0, n, grain),
-      [&](const tbb::blocked_range<int>& r) {
-        for (int i = r.begin(); i != r.end(); ++i) f(i);
-      },
-      tbb::simple_partitioner());
-}
 
 template <int d>
 using Vec = Eigen::Matrix<double, d, 1>;
@@ -131,58 +117,72 @@ FaceContact<d> deepestFacePoint(const RigidFaceBody<d>& body, const Vec<d>* p) {
   return best;
 }
 
+// The pair's thickness and friction: the largest over the face's particles and the body's friction.
+template <int d>
+void faceMaterial(const FaceSet<d>& faces, const int* idx, double bodyFriction, FaceContact<d>& c) {
+  c.thickness = 0;
+  c.friction = bodyFriction;
+  for (int a = 0; a < d; ++a) {
+    c.thickness = std::max(c.thickness, (*faces.thickness)[idx[a]]);
+    c.friction = std::max(c.friction, (*faces.friction)[idx[a]]);
+  }
+}
+
+// The bodies' (body, face) candidate pairs from `tree`: each bounded, non-mesh body's query box
+// (half-spaces are left to the particle contact, whose deepest point in a flat face is one of
+// its vertices; meshes have no inside), in body order, faces ascending.
+template <int d, class QueryBox>
+void candidatePairs(const std::vector<RigidFaceBody<d>>& bodies, Bvh<d>& tree, FaceContactWorkspace<d>& work,
+                    QueryBox queryBox) {
+  work.pairs.clear();
+  for (int bi = 0; bi < static_cast<int>(bodies.size()); ++bi) {
+    const RigidFaceBody<d>& body = bodies[bi];
+    if (body.geometry->unbounded() || body.geometry->geometry().type == col::GeometryType::Mesh) continue;
+    Box<d> query;
+    if (!queryBox(body, query)) continue;
+    work.hits.clear();
+    tree.query(query, work.hits);
+    std::sort(work.hits.begin(), work.hits.end());
+    for (int face : work.hits) work.pairs.emplace_back(bi, face);
+  }
+}
+
 template <int d>
 void findFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces, Bvh<d>& tree,
                       FaceContactWorkspace<d>& work, std::vector<FaceContact<d>>& out) {
   const int nf = faces.faceCount();
   const std::vector<int>& f = *faces.faces;
   work.boxes.resize(nf);
-  parallelFor(nf, [&](int k) {
+  parallelIndices(nf, [&](int k) {
     double pad = 0;
     for (int a = 0; a < d; ++a) pad = std::max(pad, (*faces.thickness)[f[d * k + a]]);
     work.boxes[k] = faceBox<d>(*faces.x, &f[d * k], pad);
   });
   if (static_cast<int>(tree.size()) != nf) tree.build(work.boxes);
   else tree.refit(work.boxes);
-  // The candidate pairs serially (a few BVH queries, one per body), in body order, faces ascending.
-  work.pairs.clear();
-  for (int bi = 0; bi < static_cast<int>(bodies.size()); ++bi) {
-    const RigidFaceBody<d>& body = bodies[bi];
-    // Half-spaces are left to the particle contact: a flat face's deepest point in a half-space is
-    // one of its vertices. Meshes have no inside.
-    if (body.geometry->unbounded() || body.geometry->geometry().type == col::GeometryType::Mesh) continue;
+  // The candidate pairs serially (a few BVH queries, one per body).
+  candidatePairs<d>(bodies, tree, work, [](const RigidFaceBody<d>& body, Box<d>& query) {
     col::Pose<d> pose;
     pose.x = body.x;
     pose.R = body.R;
     const auto bounds = col::worldBounds<d>(*body.geometry, pose);
-    Box<d> query;
     query.lo = bounds.min();
     query.hi = bounds.max();
-    work.hits.clear();
-    tree.query(query, work.hits);
-    std::sort(work.hits.begin(), work.hits.end());
-    for (int face : work.hits) work.pairs.emplace_back(bi, face);
-  }
+    return true;
+  });
   // The deepest point of every pair, the costly part, in parallel into its own slot.
   const int np = static_cast<int>(work.pairs.size());
   work.slots.resize(np);
   work.close.assign(np, 0);
-  parallelFor(np, [&](int k) {
+  parallelIndices(np, [&](int k) {
     const auto [bi, face] = work.pairs[k];
     Vec<d> p[d];
-    double thickness = 0, friction = bodies[bi].friction;
-    for (int a = 0; a < d; ++a) {
-      const int i = f[d * face + a];
-      p[a] = at<d>(*faces.x, i);
-      thickness = std::max(thickness, (*faces.thickness)[i]);
-      friction = std::max(friction, (*faces.friction)[i]);
-    }
+    for (int a = 0; a < d; ++a) p[a] = at<d>(*faces.x, f[d * face + a]);
     FaceContact<d> c = deepestFacePoint<d>(bodies[bi], p);
-    if (!(c.distance < thickness)) return;
+    faceMaterial<d>(faces, &f[d * face], bodies[bi].friction, c);
+    if (!(c.distance < c.thickness)) return;
     c.body = bi;
     c.face = face;
-    c.thickness = thickness;
-    c.friction = friction;
     work.slots[k] = c;
     work.close[k] = 1;
   });
@@ -210,7 +210,7 @@ void findSweptFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const Fa
     const std::vector<int>& f = *faces.faces;
     const std::vector<double>& end = *faces.x;
     work.boxes.resize(nf);
-    parallelFor(nf, [&](int k) {
+    parallelIndices(nf, [&](int k) {
       Box<d> a = faceBox<d>(start, &f[d * k], 0.0), b = faceBox<d>(end, &f[d * k], 0.0);
       a.lo = a.lo.cwiseMin(b.lo);
       a.hi = a.hi.cwiseMax(b.hi);
@@ -218,23 +218,15 @@ void findSweptFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const Fa
     });
     if (static_cast<int>(tree.size()) != nf) tree.build(work.boxes);
     else tree.refit(work.boxes);
-    work.pairs.clear();
-    for (int bi = 0; bi < static_cast<int>(bodies.size()); ++bi) {
-      const RigidFaceBody<d>& body = bodies[bi];
-      if (body.geometry->unbounded() || body.geometry->geometry().type == col::GeometryType::Mesh) continue;
-      if (body.v.squaredNorm() == 0) continue;
-      Box<d> query;
+    candidatePairs<d>(bodies, tree, work, [&](const RigidFaceBody<d>& body, Box<d>& query) {
       query.lo = body.x.cwiseMin(Vec<d>(body.x - dt * body.v));
       query.hi = body.x.cwiseMax(Vec<d>(body.x - dt * body.v));
-      work.hits.clear();
-      tree.query(query, work.hits);
-      std::sort(work.hits.begin(), work.hits.end());
-      for (int face : work.hits) work.pairs.emplace_back(bi, face);
-    }
+      return body.v.squaredNorm() > 0;
+    });
     const int np = static_cast<int>(work.pairs.size());
     work.slots.resize(np);
     work.close.assign(np, 0);
-    parallelFor(np, [&](int k) {
+    parallelIndices(np, [&](int k) {
       const auto [bi, face] = work.pairs[k];
       const RigidFaceBody<d>& body = bodies[bi];
       const int* idx = &f[d * face];
@@ -268,13 +260,7 @@ void findSweptFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const Fa
         if (n.dot(centre0 - at<d>(start, idx[0])) > 0) n = -n;  // out of the body: towards the far side
         c.normal = n.normalized();
         c.distance = 0;
-        double thickness = 0, friction = body.friction;
-        for (int a = 0; a < d; ++a) {
-          thickness = std::max(thickness, (*faces.thickness)[idx[a]]);
-          friction = std::max(friction, (*faces.friction)[idx[a]]);
-        }
-        c.thickness = thickness;
-        c.friction = friction;
+        faceMaterial<d>(faces, idx, body.friction, c);
         work.slots[k] = c;
         work.close[k] = 1;
         return;

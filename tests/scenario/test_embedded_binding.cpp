@@ -95,24 +95,15 @@ TEST(EmbeddedBinding, EmbeddedParticlesFollowTheirElementsAndMomentumIsKept) {
 // on deformed elements, see docs/benchmarks_deformables.md).
 TEST(EmbeddedBinding, AngularMomentumKeptWithTorqueFreeDampers) {
   const Registry registry = builtins();
-  Simulation<3> sim(loadScene(kScenes + "embedded_bar.json",
-                              {{"time.end", "0.25"},
+  const std::vector<Override> springs = {{"time.end", "0.25"},
                                {"entities.bar.deformable.rayleigh_beta", "0"},
                                {"entities.block.deformable.rayleigh_beta", "0"},
                                {"entities.bar.deformable.model", "\"springs\""},
                                {"entities.block.deformable.model", "\"springs\""},
                                {"entities.bar.deformable.overdamping", "0.3"},
-                               {"entities.block.deformable.overdamping", "0.3"}}),
-                    registry, 1);
-  Simulation<3> two(loadScene(kScenes + "embedded_bar.json",
-                              {{"time.end", "0.25"},
-                               {"entities.bar.deformable.rayleigh_beta", "0"},
-                               {"entities.block.deformable.rayleigh_beta", "0"},
-                               {"entities.bar.deformable.model", "\"springs\""},
-                               {"entities.block.deformable.model", "\"springs\""},
-                               {"entities.bar.deformable.overdamping", "0.3"},
-                               {"entities.block.deformable.overdamping", "0.3"}}),
-                    registry, 2);
+                               {"entities.block.deformable.overdamping", "0.3"}};
+  Simulation<3> sim(loadScene(kScenes + "embedded_bar.json", springs), registry, 1);
+  Simulation<3> two(loadScene(kScenes + "embedded_bar.json", springs), registry, 2);
   double L0 = 0, e0 = 0, drift = 0, e1 = 0;
   while (!sim.finished()) {
     const auto& m = sim.step();
