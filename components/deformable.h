@@ -74,6 +74,19 @@ struct Elasticity {
 
 namespace monolith {
 
+// The names of a binding's bodies, stored one per line (a string field, as checkpoints keep it).
+inline std::vector<std::string> namesOnLines(const std::string& lines) {
+  std::vector<std::string> out;
+  std::string::size_type start = 0;
+  while (start < lines.size()) {
+    const auto end = lines.find('\n', start);
+    out.push_back(lines.substr(start, end == std::string::npos ? std::string::npos : end - start));
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+  return out;
+}
+
 // Particles of a deformable body hard-bound to rigid bodies (Sifakis et al. 2007 [138]): a bound
 // particle has no freedom of its own; it moves with its body at a fixed body-frame offset. Its
 // mass and inertia about the body's centre were added to the body when the scene was built, the
@@ -95,16 +108,37 @@ struct RigidBinding {
     visit("body", body);
     visit("offset", offset);
   }
-  std::vector<std::string> bodyNames() const {
-    std::vector<std::string> out;
-    std::string::size_type start = 0;
-    while (start < bodies.size()) {
-      const auto end = bodies.find('\n', start);
-      out.push_back(bodies.substr(start, end == std::string::npos ? std::string::npos : end - start));
-      if (end == std::string::npos) break;
-      start = end + 1;
-    }
-    return out;
+  std::vector<std::string> bodyNames() const { return namesOnLines(bodies); }
+};
+
+}  // namespace monolith
+
+namespace monolith {
+
+// Particles of a deformable body embedded in the elements of another deformable body (Sifakis et
+// al. 2007 [138], hard bindings): an embedded particle has no freedom of its own; its position and
+// velocity are the barycentric interpolation of its host element's, x = sum_i w_i x_i. Its mass
+// was distributed to the host element's particles (m_i += w_i m) when the scene was built, the
+// elastic and damping forces on it act on them with the same weights (so linear and angular
+// momentum are kept: sum w_i = 1, sum w_i x_i = x), and it is projected out of the implicit
+// solves with its velocity prescribed (Sec. 4.7.3). Embedded particles carry Particles::fixed == 3.
+template <int d>
+struct EmbeddedBinding {
+  static constexpr const char* kName = "embedded_binding";
+  std::string hosts;             // the host bodies' names, one per line
+  std::vector<int> particle;     // embedded particle indices
+  std::vector<int> host;         // per embedded particle: index into the names
+  std::vector<int> element;      // per embedded particle: the host mesh's element
+  std::vector<double> weight;    // per embedded particle: d+1 barycentric weights
+  std::vector<std::string> hostNames() const { return namesOnLines(hosts); }
+
+  template <class V>
+  void visitFields(V& visit) {
+    visit("hosts", hosts);
+    visit("particle", particle);
+    visit("host", host);
+    visit("element", element);
+    visit("weight", weight);
   }
 };
 

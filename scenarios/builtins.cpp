@@ -227,6 +227,7 @@ void registerDimension(Registry& r) {
   if constexpr (d == 3) registerClothSystems(r);  // before the particles' contact of each stage
   registerDeformableSystems<d>(r);
   registerSelfCollisionSystems<d>(r);
+  registerEmbeddingSystems<d>(r);  // last: embedded particles follow the stage's final host state
 }
 
 }  // namespace

@@ -3,12 +3,14 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 
 #include "components/deformable.h"
 #include "components/kinematic.h"
 #include "components/rigid_body.h"
 #include "solvers/deformable/simplex_mesh.h"
 #include "systems/deformable_dynamics.h"
+#include "systems/embedded_binding.h"
 #include "systems/particle_binding.h"
 #include "systems/particle_contact.h"
 
@@ -182,6 +184,70 @@ void parseRigidBindings(World<d>& world, Entity e, const Config& c, Particles<d>
   }
 }
 
+template <int d>
+void parseEmbeddedBindings(World<d>& world, Entity e, const Config& c, Particles<d>& p) {
+  // "embed": [{"body": NAME, "min": [...], "max": [...]}, ...]: the free particles inside the world
+  // box are embedded in the elements of the deformable body NAME (listed before this entity) that
+  // contain them, with barycentric weights (Sifakis et al. 2007); their mass joins the element's
+  // particles in those weights.
+  if (!c.has("embed")) return;
+  const Config list(c.raw()["embed"], c.file(), c.pathOf("embed"));
+  c.markUsed("embed");
+  EmbeddedBinding<d> binding;
+  for (std::size_t k = 0; k < list.arraySize(); ++k) {
+    const Config item = list.element(k);
+    const std::string name = item.string("body");
+    const auto target = world.find(name);
+    Particles<d>* host = target ? world.template get<Particles<d>>(*target) : nullptr;
+    const SimplexMesh<d>* mesh = target ? world.template get<SimplexMesh<d>>(*target) : nullptr;
+    if (!host || !mesh)
+      item.failAt("body", "the name of a deformable (simplex mesh) body listed before this entity", "\"" + name + "\"");
+    if (world.template has<EmbeddedBinding<d>>(*target))
+      item.failAt("body", "a host that is not itself embedded in another body", "\"" + name + "\", embedded");
+    const Vec<d> lo = item.vector("min", d), hi = item.vector("max", d);
+    item.finish();
+    int count = 0;
+    for (std::size_t i = 0; i < p.fixed.size(); ++i) {
+      const Vec<d> x = Eigen::Map<const Vec<d>>(&p.x[d * i]);
+      if (!((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all()) || p.fixed[i]) continue;
+      // The first element (in mesh order) that contains the particle, at the host's positions.
+      int found = -1;
+      Eigen::Matrix<double, d + 1, 1> w;
+      for (int el = 0; el < mesh->elementCount() && found < 0; ++el) {
+        const int* v = &mesh->elements[(d + 1) * el];
+        const Vec<d> x0 = Eigen::Map<const Vec<d>>(&host->x[d * v[0]]);
+        Eigen::Matrix<double, d, d> D;
+        for (int a = 0; a < d; ++a) D.col(a) = Eigen::Map<const Vec<d>>(&host->x[d * v[a + 1]]) - x0;
+        const Vec<d> l = D.inverse() * (x - x0);
+        w(0) = 1 - l.sum();
+        w.template tail<d>() = l;
+        if (w.minCoeff() >= -1e-9) found = el;
+      }
+      if (found < 0) {
+        std::ostringstream where;
+        where << "particle " << i << " at (" << x.transpose() << ") outside every element";
+        item.fail("a box whose free particles all lie inside elements of \"" + name + "\"", where.str());
+      }
+      p.fixed[i] = 3;
+      binding.particle.push_back(static_cast<int>(i));
+      binding.host.push_back(static_cast<int>(k));
+      binding.element.push_back(found);
+      const int* v = &mesh->elements[(d + 1) * found];
+      Vec<d> velocity = Vec<d>::Zero();
+      for (int a = 0; a <= d; ++a) {
+        binding.weight.push_back(w(a));
+        host->m[v[a]] += w(a) * p.m[i];
+        velocity += w(a) * Vec<d>(Eigen::Map<const Vec<d>>(&host->v[d * v[a]]));
+      }
+      Eigen::Map<Vec<d>>(&p.v[d * i]) = velocity;  // it starts with its element's velocity
+      ++count;
+    }
+    if (count == 0) item.fail("a box containing at least one free particle of the mesh", "a box containing none");
+    binding.hosts += (k ? "\n" : "") + name;
+  }
+  world.add(e, binding);
+}
+
 namespace {
 
 template <int d>
@@ -245,6 +311,7 @@ void parseDeformable(World<d>& world, Entity e, const Config& c) {
   // thesis's beam, Sec. 5.11.5).
   if (c.has("particle_mass")) p.m.assign(mesh.x.size(), c.number("particle_mass", Bound::Positive));
   parseRigidBindings<d>(world, e, c, p, true);
+  parseEmbeddedBindings<d>(world, e, c, p);
   world.add(e, p);
   world.add(e, sm);
   world.add(e, el);
@@ -277,13 +344,14 @@ void registerDeformableComponents(Registry& r) {
           std::string(d == 3 ? " | tetgen BASE" : "") +
           "}, model (corotated | neo_hookean | springs), youngs_modulus, poisson_ratio, density, rayleigh_alpha, "
           "rayleigh_beta, overdamping, altitude_stiffness, particle_mass, clamp, position, " +
-          std::string(d == 3 ? "orientation" : "angle") + ", velocity, fixed [{min, max}], bind [{body, min, max}]",
+          std::string(d == 3 ? "orientation" : "angle") + ", velocity, fixed [{min, max}], bind [{body, min, max}], embed [{body, min, max}]",
       parseDeformable<d>,
       [](World<d>& w) {
         w.template ensurePool<Particles<d>>();
         w.template ensurePool<SimplexMesh<d>>();
         w.template ensurePool<Elasticity>();
         w.template ensurePool<RigidBinding<d>>();
+        w.template ensurePool<EmbeddedBinding<d>>();
       },
       ""});
   r.addComponent<d>(ComponentType<d>{"particle", "a single free mass point: mass, position, velocity",
@@ -293,6 +361,8 @@ void registerDeformableComponents(Registry& r) {
   r.addComponentOf<d, SimplexMesh<d>>("(internal) a deformable body's elements and rest positions", nullptr);
   r.addComponentOf<d, Elasticity>("(internal) a deformable body's material", nullptr);
   r.addComponentOf<d, RigidBinding<d>>("(internal) a deformable body's particles hard-bound to rigid bodies", nullptr);
+  r.addComponentOf<d, EmbeddedBinding<d>>("(internal) a deformable body's particles embedded in another body's elements",
+                                          nullptr);
 }
 
 template <int d>
@@ -326,6 +396,14 @@ void registerDeformableSystems(Registry& r) {
 }
 
 template <int d>
+void registerEmbeddingSystems(Registry& r) {
+  r.addSystem<d>({"embedded_bindings",
+                  "particles embedded in another deformable's elements (Sifakis et al. 2007): follow_embedded_hosts "
+                  "(Step IV, Step V); their forces act on the host element's particles in the damping solves",
+                  [] { return makeEmbeddedBindingSystems<d>(); }, ""});
+}
+
+template <int d>
 void registerParticleCollisionSystems(Registry& r) {
   r.addSystem<d>({"particle_collisions",
                   "Step II (Sec. 4.4) particles against rigid bodies, two-way, restitution zero, Coulomb friction",
@@ -336,10 +414,14 @@ template void parseFixedParticles<2>(const Config&, Particles<2>&);
 template void parseFixedParticles<3>(const Config&, Particles<3>&);
 template void parseRigidBindings<2>(World<2>&, Entity, const Config&, Particles<2>&, bool);
 template void parseRigidBindings<3>(World<3>&, Entity, const Config&, Particles<3>&, bool);
+template void parseEmbeddedBindings<2>(World<2>&, Entity, const Config&, Particles<2>&);
+template void parseEmbeddedBindings<3>(World<3>&, Entity, const Config&, Particles<3>&);
 template void registerParticleCollisionSystems<2>(Registry&);
 template void registerParticleCollisionSystems<3>(Registry&);
 template void registerDeformableComponents<2>(Registry&);
 template void registerDeformableComponents<3>(Registry&);
+template void registerEmbeddingSystems<2>(Registry&);
+template void registerEmbeddingSystems<3>(Registry&);
 template void registerDeformableSystems<2>(Registry&);
 template void registerDeformableSystems<3>(Registry&);
 

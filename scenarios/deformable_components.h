@@ -15,6 +15,10 @@ void registerDeformableSystems(Registry& r);
 // which then read the bodies' velocities it changed.
 template <int d>
 void registerParticleCollisionSystems(Registry& r);
+// Particles embedded in other deformables follow their host elements at the end of Steps IV and
+// V: registered after every other system that moves particles.
+template <int d>
+void registerEmbeddingSystems(Registry& r);
 
 // One system of type S, as the registry's system factories return it.
 template <class S, class... Args>
@@ -32,5 +36,10 @@ void parseFixedParticles(const Config& c, Particles<d>& p);
 // `dynamicBodies` only static and kinematic bodies are accepted.
 template <int d>
 void parseRigidBindings(World<d>& world, Entity e, const Config& c, Particles<d>& p, bool dynamicBodies);
+// The entry's "embed": [{body, min, max}, ...]: free particles inside the world box are embedded
+// in the elements of the deformable body named (listed earlier) that contain them; adds the
+// EmbeddedBinding component and the particles' mass to the host's (barycentric weights).
+template <int d>
+void parseEmbeddedBindings(World<d>& world, Entity e, const Config& c, Particles<d>& p);
 
 }  // namespace monolith

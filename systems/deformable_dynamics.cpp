@@ -4,6 +4,7 @@
 
 #include "components/cloth.h"
 #include "components/fluid_coupling.h"
+#include "systems/embedded_binding.h"
 #include "systems/particle_contact.h"
 
 #include "solvers/deformable/simplex_mesh.h"
@@ -46,7 +47,9 @@ std::vector<double> explicitForces(const dm::ForceModel<d>& fm, const Particles<
   std::vector<double> f(p.x.size(), 0.0);
   dm::addElasticForces<d>(fm, p.x.data(), f.data(), rotations);
   for (int i = 0; i < p.count(); ++i)
-    for (int a = 0; a < d; ++a) f[d * i + a] = p.fixed[i] ? 0.0 : f[d * i + a] + p.m[i] * gravity(a);
+    for (int a = 0; a < d; ++a)
+      // An embedded particle keeps its elastic force (its hosts take it); its weight is theirs.
+      f[d * i + a] = p.fixed[i] == 3 ? f[d * i + a] : p.fixed[i] ? 0.0 : f[d * i + a] + p.m[i] * gravity(a);
   return f;
 }
 
@@ -177,30 +180,67 @@ template <int d>
 void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
   const bool half = stage_ == Stage::AdvanceVelocityHalf;
   const Vec<d> g = world.settings().gravity;
+  const double h = half ? 0.5 * ctx.dt : 0.25 * ctx.dt;
   int iterations = 0;
+  // The explicit forces of every body first: an embedded particle's elastic force joins its host's
+  // before the host's solve, whichever comes first in pool order.
+  struct Body {
+    Entity e;
+    Particles<d>* p;
+    const dm::ForceModel<d>* fm;
+    std::vector<dm::MatD<d>> R;
+    std::vector<double> f, Du;
+  };
+  std::vector<Body> bodies;
   world.template each<Particles<d>, SimplexMesh<d>, Elasticity>(
       [&](Entity e, Particles<d>& p, SimplexMesh<d>& mesh, Elasticity& el) {
         // A body coupled to a fluid takes its velocity steps in the coupled solve, its damping
         // inside it (systems/fluid_structure_coupling.h).
         if (world.template has<FluidCoupling<d>>(e)) return;
-        const auto& fm = cache_.get(e, p, mesh, el);
-        std::vector<dm::MatD<d>> R;
-        const std::vector<double> f = explicitForces(fm, p, g, &R);
-        std::vector<double> u;
-        const double h = half ? 0.5 * ctx.dt : 0.25 * ctx.dt;
-        RigidBinding<d>* binding = world.template get<RigidBinding<d>>(e);
-        std::vector<double> Du;
-        std::vector<NormalConstraint<d>> held;
-        if (contacts_ && fm.dampingRows() > 0) held = contacts_->of(world, p, ctx.dt, half ? 0.0 : 0.5);
-        const ImplicitSolveReport r = implicitDampingSolve(fm, p, f, h, u, binding ? &Du : nullptr, &R, &held);
-        iterations = std::max(iterations, r.iterations);
-        // The damping forces the solve put on bound particles act on their bodies: over this
-        // stage's velocity change, h (Step I) or 2h (Step V's extrapolation) times D u.
-        if (binding) applyBoundDamping(world, *binding, p, Du, half ? h : 2 * h);
-        if (half) p.v = u;
-        else
-          for (std::size_t i = 0; i < u.size(); ++i) p.v[i] = 2 * u[i] - p.v[i];
+        Body b{e, &p, &cache_.get(e, p, mesh, el), {}, {}, {}};
+        b.f = explicitForces(*b.fm, p, g, &b.R);
+        bodies.push_back(std::move(b));
       });
+  auto bodyOf = [&](Entity e) -> Body* {
+    for (Body& b : bodies)
+      if (b.e == e) return &b;
+    return nullptr;
+  };
+  const bool embedding = world.template count<EmbeddedBinding<d>>() > 0;
+  if (embedding)
+    for (Body& b : bodies)
+      if (const EmbeddedBinding<d>* eb = world.template get<EmbeddedBinding<d>>(b.e))
+        forEachHostWeight<d>(world, *eb, [&](Entity host, int j, double w, int i) {
+          if (Body* hb = bodyOf(host))
+            for (int a = 0; a < d; ++a) hb->f[d * j + a] += w * b.f[d * i + a];
+        });
+  for (Body& b : bodies) {
+    Particles<d>& p = *b.p;
+    std::vector<double> u;
+    RigidBinding<d>* binding = world.template get<RigidBinding<d>>(b.e);
+    const bool embedded = embedding && world.template has<EmbeddedBinding<d>>(b.e);
+    std::vector<NormalConstraint<d>> held;
+    if (contacts_ && b.fm->dampingRows() > 0) held = contacts_->of(world, p, ctx.dt, half ? 0.0 : 0.5);
+    const ImplicitSolveReport r =
+        implicitDampingSolve(*b.fm, p, b.f, h, u, binding || embedded ? &b.Du : nullptr, &b.R, &held);
+    iterations = std::max(iterations, r.iterations);
+    // The damping forces the solve put on bound particles act on their bodies: over this
+    // stage's velocity change, h (Step I) or 2h (Step V's extrapolation) times D u.
+    if (binding) applyBoundDamping(world, *binding, p, b.Du, half ? h : 2 * h);
+    if (half) p.v = u;
+    else
+      for (std::size_t i = 0; i < u.size(); ++i) p.v[i] = 2 * u[i] - p.v[i];
+  }
+  // The damping forces on embedded particles, over the same duration, to their hosts' particles
+  // in their weights (after every solve of the stage, as the bound particles' to their bodies).
+  if (embedding)
+    for (Body& b : bodies)
+      if (const EmbeddedBinding<d>* eb = world.template get<EmbeddedBinding<d>>(b.e); eb && !b.Du.empty())
+        forEachHostWeight<d>(world, *eb, [&](Entity host, int j, double w, int i) {
+          Particles<d>& hp = *world.template get<Particles<d>>(host);
+          if (hp.fixed[j]) return;
+          for (int a = 0; a < d; ++a) hp.v[d * j + a] += (half ? h : 2 * h) * w * b.Du[d * i + a] / hp.m[j];
+        });
   // Free particles without a mesh (single mass points) feel gravity only: both stages add
   // dt/2 g (Step V's backward Euler over dt/4 plus extrapolation doubles its dt/4).
   world.template each<Particles<d>>([&](Entity e, Particles<d>& p) {
@@ -255,7 +295,7 @@ DeformableTotals measureDeformableTotals(const World<d>& world, ForceModelCache<
     const Entity e = pool->entities()[k];
     const Particles<d>& p = pool->components()[k];
     for (int i = 0; i < p.count(); ++i) {
-      if (p.fixed[i] == 2) continue;  // bound: its mass is part of its rigid body's
+      if (p.fixed[i] >= 2) continue;  // bound or embedded: its mass is part of its body's or host's
       const Eigen::Map<const Vec<d>> x(&p.x[d * i]), v(&p.v[d * i]);
       t.kinetic += 0.5 * p.m[i] * v.squaredNorm();
       if (p.fixed[i] == 0) t.potential -= p.m[i] * g.dot(x);

@@ -93,7 +93,8 @@ class AdvanceDeformableVelocity final : public System<d> {
   }
   Stage stage() const override { return stage_; }
   std::vector<std::string> reads() const override {
-    return {SimplexMesh<d>::kName, Elasticity::kName, Shape<d>::kName, Collider<d>::kName, KinematicMotion<d>::kName};
+    return {SimplexMesh<d>::kName, Elasticity::kName,         Shape<d>::kName,
+            Collider<d>::kName,    KinematicMotion<d>::kName, EmbeddedBinding<d>::kName};
   }
   std::vector<std::string> writes() const override {
     return {Particles<d>::kName, RigidBody<d>::kName, "diagnostics"};  // bodies: damping on bound particles

@@ -67,7 +67,11 @@ std::vector<double> SurfaceCache<d>::positions(World<d>& world) const {
 }
 
 template <int d>
-SurfaceParticles<d>::SurfaceParticles(World<d>& world) {
+void SurfaceParticles<d>::gather(World<d>& world) {
+  pools.clear();
+  x.clear();
+  v.clear();
+  inverseMass.clear();
   world.template each<Particles<d>, SurfaceCollision>([&](Entity, Particles<d>& p, SurfaceCollision&) {
     pools.push_back(&p);
     x.insert(x.end(), p.x.begin(), p.x.end());

@@ -49,7 +49,10 @@ template <int d>
 struct SurfaceParticles {
   std::vector<Particles<d>*> pools;
   std::vector<double> x, v, inverseMass;
-  explicit SurfaceParticles(World<d>& world);
+  SurfaceParticles() = default;
+  explicit SurfaceParticles(World<d>& world) { gather(world); }
+  // Joins the colliding bodies' particles again, reusing the vectors' storage.
+  void gather(World<d>& world);
   void writeVelocities() const { scatter(v, &Particles<d>::v); }
   void writePositions() const { scatter(x, &Particles<d>::x); }
 

@@ -2,12 +2,14 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "solvers/collision/collision_impl.h"
 #include "solvers/collision/narrow_phase.h"
 #include "solvers/contact/central_normal_contact.h"
+#include "solvers/contact/push_out.h"
 #include "systems/contact_workspace.h"
 
 namespace monolith {
@@ -128,6 +130,164 @@ void applyImpulse(BodyView<d>& b, const Vec<d>& r, const Vec<d>& j) {
   if (b.inverseMass == 0) return;
   b.body->v -= j / b.body->mass;
   b.body->L -= crossArm<d>(r, j);
+}
+
+// Interpenetration resolution with particles (Sec. 4.6.1, App. B): one central object at a time,
+// pushed out of every outer object intersecting it in one two-way solve (solvers/contact/push_out,
+// dtau = 1 so displacements come out directly). Positions only: the velocities are untouched, so
+// among dynamic bodies the mass-weighted sum of the displacements is zero (the impulses cancel).
+//  * every rigid body as the central body against the free particles inside it (outer bodies
+//    with q_o = 0, K_o = m_o^{-1} delta) and against the static and kinematic bodies it touches
+//    (static outers, B.3: the ground does not let particles drive a box into it); a static or
+//    kinematic central body decouples (B.3: each particle is moved out alone);
+//  * every particle inside two or more bodies as the central body (r_o = 0: the 3x3 system of
+//    eq. 4.2), its bodies the outer ones: a particle wedged between two bodies pushes both.
+// Two sweeps; the rotations are linearized in the solve, so a turning body leaves second-order
+// overlap for the next sweep.
+constexpr int kPushOutSweeps = 2;
+
+struct PushOutCounts {
+  double deepest = 0;
+  int bodySolves = 0, particleSolves = 0;
+};
+
+template <int d>
+void moveBody(BodyView<d>& b, const Vec<d>& dx, const cc::AngVec<d>& theta) {
+  b.body->x += dx;
+  b.body->orientation = rotatedBy<d>(b.body->orientation, theta);
+  b.x = b.body->x;
+  b.R = b.body->rotation();
+  b.inverseInertia = b.body->worldInverseInertia();
+}
+
+template <int d>
+PushOutCounts pushParticlesOut(std::vector<BodyView<d>>& bodies, const std::vector<Particles<d>*>& pools,
+                               double supportMargin, double tolerance) {
+  PushOutCounts out;
+  struct Inside {
+    Particles<d>* pool;
+    int i;
+    double distance;
+    Vec<d> n;  // out of the body
+  };
+  std::vector<Inside> inside;
+  std::vector<std::pair<std::size_t, int>> candidates;  // (pool, particle) inside two bodies or more
+  std::vector<std::size_t> hosts;
+  std::vector<cc::PushOutOuter<d>> outers;
+  cc::PushOutResult<d> result;
+  std::vector<col::ContactPoint<d>> points;
+  col::ContactQuery query;
+  query.margin = supportMargin;
+  auto position = [](Particles<d>* p, int i) { return Eigen::Map<Vec<d>>(&p->x[d * i]); };
+  auto insideBodies = [&](std::size_t pi, int i) {
+    inside.clear();
+    hosts.clear();
+    for (std::size_t k = 0; k < bodies.size(); ++k) {
+      double distance;
+      Vec<d> n;
+      if (distanceTo(bodies[k], Vec<d>(position(pools[pi], i)), 0.0, distance, n) && distance < -tolerance) {
+        inside.push_back({pools[pi], i, distance, n});
+        hosts.push_back(k);
+      }
+    }
+  };
+  for (int sweep = 0; sweep < kPushOutSweeps; ++sweep) {
+    // Particles inside two or more bodies, each the central body of its own solve, first: the
+    // bodies' own solves below would push such a particle out of one body deeper into the other.
+    candidates.clear();
+    for (std::size_t pi = 0; pi < pools.size(); ++pi)
+      for (int i = 0; i < pools[pi]->count(); ++i) {
+        if (pools[pi]->fixed[i]) continue;
+        int count = 0;
+        for (const BodyView<d>& b : bodies) {
+          double distance;
+          Vec<d> n;
+          if (distanceTo(b, Vec<d>(position(pools[pi], i)), 0.0, distance, n) && distance < -tolerance && ++count == 2) {
+            candidates.push_back({pi, i});
+            break;
+          }
+        }
+      }
+    for (const auto& [pi, i] : candidates) {
+      insideBodies(pi, i);
+      if (inside.size() < 2) continue;  // an earlier solve moved it
+      Particles<d>* p = pools[pi];
+      outers.clear();
+      for (std::size_t k = 0; k < inside.size(); ++k) {
+        const BodyView<d>& o = bodies[hosts[k]];
+        out.deepest = std::max(out.deepest, -inside[k].distance);
+        cc::PushOutOuter<d> outer;
+        outer.isStatic = o.infinite;
+        outer.q = Vec<d>(position(p, i)) - o.x;
+        outer.mass = o.infinite ? std::numeric_limits<double>::infinity() : o.body->mass;
+        outer.inertia = o.infinite ? cc::AngMat<d>::Identity() : cc::AngMat<d>(o.body->worldInertia());
+        outer.displacement = -inside[k].distance * inside[k].n;  // the particle out along n
+        outers.push_back(outer);
+      }
+      cc::PushOutCentral<d> central;
+      central.mass = p->m[i];
+      central.lengthScale = supportMargin;
+      cc::solvePushOut<d>(central, outers, result);
+      position(p, i) += result.centralDisplacement;
+      for (std::size_t k = 0; k < inside.size(); ++k)
+        if (!bodies[hosts[k]].infinite)
+          moveBody(bodies[hosts[k]], result.outerDisplacements[k], result.outerRotations[k]);
+      ++out.particleSolves;
+    }
+    // Every rigid body as the central body against the particles inside it.
+    bool moved = false;
+    for (BodyView<d>& b : bodies) {
+      inside.clear();
+      for (Particles<d>* p : pools)
+        for (int i = 0; i < p->count(); ++i) {
+          if (p->fixed[i]) continue;
+          double distance;
+          Vec<d> n;
+          if (distanceTo(b, Vec<d>(position(p, i)), 0.0, distance, n) && distance < 0) inside.push_back({p, i, distance, n});
+        }
+      if (inside.empty()) continue;
+      moved = true;
+      for (const Inside& q : inside) out.deepest = std::max(out.deepest, -q.distance);
+      if (b.infinite) {
+        for (const Inside& q : inside) position(q.pool, q.i) -= q.distance * q.n;
+        continue;
+      }
+      outers.clear();
+      for (const Inside& q : inside) {
+        cc::PushOutOuter<d> o;
+        o.r = Vec<d>(position(q.pool, q.i)) - b.x;
+        o.mass = q.pool->m[q.i];
+        o.displacement = q.distance * q.n;  // d_o: from the body's surface point to the particle
+        outers.push_back(o);
+      }
+      const std::size_t particleOuters = outers.size();
+      for (const BodyView<d>& other : bodies) {
+        if (!other.infinite || &other == &b) continue;
+        points.clear();
+        col::findContacts<d>(*other.geometry, {other.x, other.R}, *b.geometry, {b.x, b.R}, query, points);
+        for (const col::ContactPoint<d>& c : points) {  // c.normal: out of b towards other
+          cc::PushOutOuter<d> o;
+          o.isStatic = true;
+          o.r = c.point - b.x;
+          o.q = c.point - other.x;
+          o.mass = std::numeric_limits<double>::infinity();
+          o.displacement = -std::max(c.depth, 0.0) * c.normal;
+          outers.push_back(o);
+        }
+      }
+      cc::PushOutCentral<d> central;
+      central.mass = b.body->mass;
+      central.inertia = b.body->worldInertia();
+      central.lengthScale = b.geometry->boundingRadius();
+      cc::solvePushOut<d>(central, outers, result);
+      moveBody(b, result.centralDisplacement, result.centralRotation);
+      for (std::size_t k = 0; k < particleOuters; ++k)
+        position(inside[k].pool, inside[k].i) += result.outerDisplacements[k];
+      ++out.bodySolves;
+    }
+    if (!moved && candidates.empty()) break;
+  }
+  return out;
 }
 
 }  // namespace
@@ -270,22 +430,14 @@ void ParticleRigidContact<d>::run(World<d>& world, StepContext& ctx) {
 
 template <int d>
 void ParticlePushOut<d>::run(World<d>& world, StepContext& ctx) {
-  std::vector<BodyView<d>> bodies = bodiesOf(world, shapes_, 0.0, false);
-  double deepest = 0;
-  for (const BodyView<d>& b : bodies) {
-    world.template each<Particles<d>>([&](Entity, Particles<d>& p) {
-      for (int i = 0; i < p.count(); ++i) {
-        if (p.fixed[i]) continue;
-        Eigen::Map<Vec<d>> x(&p.x[d * i]);
-        double distance;
-        Vec<d> n;
-        if (!distanceTo(b, Vec<d>(x), 0.0, distance, n) || distance >= 0) continue;
-        deepest = std::max(deepest, -distance);
-        x -= distance * n;
-      }
-    });
-  }
-  ctx.diagnostics.max("particle_push_out_depth", deepest);
+  std::vector<BodyView<d>> bodies = bodiesOf(world, shapes_, 0.0, true);
+  std::vector<Particles<d>*> pools;
+  world.template each<Particles<d>>([&](Entity, Particles<d>& p) { pools.push_back(&p); });
+  const PushOutCounts counts = pushParticlesOut<d>(bodies, pools, world.settings().contact.thickness,
+                                                       world.settings().contact.pushOutTolerance);
+  ctx.diagnostics.max("particle_push_out_depth", counts.deepest);
+  ctx.diagnostics.set("particle_push_out_body_solves", counts.bodySolves);
+  ctx.diagnostics.set("particle_push_out_particle_solves", counts.particleSolves);
   std::size_t k = 0;
   world.template each<Particles<d>>([&](Entity, Particles<d>& p) {
     if (k < scratch_->savedVelocities.size() && scratch_->savedVelocities[k].size() == p.v.size())

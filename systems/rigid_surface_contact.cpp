@@ -13,11 +13,12 @@ namespace {
 constexpr int kContactSweeps = 4;
 
 // The bodies with a collider at their current pose (candidateDt = 0) or their candidate pose
-// x + dt v, R advanced by exp(dt w); dynamic ones movable when `twoWay`.
+// x + dt v, R advanced by exp(dt w); dynamic ones movable when `twoWay`. Into `out` and `owners`,
+// reusing their storage.
 template <int d>
-std::vector<dm::RigidFaceBody<d>> rigidFaceBodies(World<d>& world, PreparedShapes<d>& shapes, double candidateDt,
-                                                  bool twoWay, std::vector<RigidBody<d>*>& owners) {
-  std::vector<dm::RigidFaceBody<d>> out;
+void rigidFaceBodies(World<d>& world, PreparedShapes<d>& shapes, double candidateDt, bool twoWay,
+                     std::vector<dm::RigidFaceBody<d>>& out, std::vector<RigidBody<d>*>& owners) {
+  out.clear();
   owners.clear();
   world.template each<RigidBody<d>, Shape<d>, Collider<d>>([&](Entity e, RigidBody<d>& b, Shape<d>& s, Collider<d>& c) {
     dm::RigidFaceBody<d> v;
@@ -41,7 +42,6 @@ std::vector<dm::RigidFaceBody<d>> rigidFaceBodies(World<d>& world, PreparedShape
     out.push_back(v);
     owners.push_back(&b);
   });
-  return out;
 }
 
 }  // namespace
@@ -50,30 +50,36 @@ template <int d>
 void RigidSurfaceContact<d>::run(World<d>& world, StepContext& ctx) {
   const bool candidate = stage_ == Stage::Collisions || stage_ == Stage::Contact;
   const bool twoWay = stage_ == Stage::Collisions || stage_ == Stage::AdvanceVelocity;
-  std::vector<RigidBody<d>*> owners;
-  std::vector<dm::RigidFaceBody<d>> bodies = rigidFaceBodies(world, shapes_, candidate ? ctx.dt : 0.0, twoWay, owners);
-  if (bodies.empty()) return;
+  rigidFaceBodies(world, shapes_, candidate ? ctx.dt : 0.0, twoWay, bodies_, owners_);
+  if (bodies_.empty()) return;
   const dm::CollisionSurface<d>& surface = surfaces_.get(world);
-  SurfaceParticles<d> particles(world);
-  std::vector<double> at = particles.x;
+  particles_.gather(world);
+  at_ = particles_.x;
   if (candidate)
-    for (std::size_t i = 0; i < at.size(); ++i) at[i] += ctx.dt * particles.v[i];
-  dm::FaceSet<d> faces{&surface.faces, &at, &particles.v, &particles.inverseMass, &surface.thickness, &surface.friction};
-  const std::vector<dm::FaceContact<d>> contacts = dm::findFaceContacts<d>(bodies, faces, tree_);
+    for (std::size_t i = 0; i < at_.size(); ++i) at_[i] += ctx.dt * particles_.v[i];
+  dm::FaceSet<d> faces{&surface.faces, &at_, &particles_.v, &particles_.inverseMass, &surface.thickness, &surface.friction};
+  dm::findFaceContacts<d>(bodies_, faces, tree_, work_, contacts_);
   if (stage_ == Stage::AdvancePositions) {
-    const double deepest = dm::pushFacesOut<d>(contacts, surface.faces, particles.inverseMass, particles.x);
+    const double deepest = dm::pushFacesOut<d>(contacts_, surface.faces, particles_.inverseMass, particles_.x);
     ctx.diagnostics.max("rigid_surface_push_out_depth", deepest);
-    if (deepest > 0) particles.writePositions();
+    if (deepest > 0) particles_.writePositions();
     return;
   }
-  const int impulses = dm::applyFaceContactImpulses<d>(bodies, faces, contacts, kContactSweeps);
+  // Step II also sweeps the bodies' centres through the faces over the step: a body fast or small
+  // enough to pass a face between the start and the candidate positions is caught there.
+  if (stage_ == Stage::Collisions) {
+    dm::findSweptFaceContacts<d>(bodies_, faces, particles_.x, ctx.dt, contacts_, sweptTree_, work_, swept_);
+    ctx.diagnostics.set("rigid_surface_swept_contacts", static_cast<double>(swept_.size()));
+    contacts_.insert(contacts_.end(), swept_.begin(), swept_.end());
+  }
+  const int impulses = dm::applyFaceContactImpulses<d>(bodies_, faces, contacts_, kContactSweeps);
   ctx.diagnostics.set(name() + "_impulses", impulses);
   if (impulses == 0) return;
-  particles.writeVelocities();
-  for (std::size_t k = 0; k < bodies.size(); ++k) {
-    if (bodies[k].inverseMass == 0) continue;
-    owners[k]->v += bodies[k].impulse / owners[k]->mass;
-    owners[k]->L += bodies[k].angularImpulse;
+  particles_.writeVelocities();
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    if (bodies_[k].inverseMass == 0) continue;
+    owners_[k]->v += bodies_[k].impulse / owners_[k]->mass;
+    owners_[k]->L += bodies_[k].angularImpulse;
   }
 }
 

@@ -10,13 +10,16 @@
 //    mass and inertia), registered with the particles' collisions before the rigid contact (whose
 //    workspace holds the bodies' velocities from its Step II to Step IV) and so before the
 //    surface collisions, which see the changed velocities;
+//    and, swept, where a body's centre would pass through a face between x^n and the candidate
+//    position (findSweptFaceContacts): a fast or small body cannot tunnel through in one step;
 //  * rigid_surface_contact (Step III, Sec. 4.5): the same with the bodies immovable; the
 //    particles' velocities only steer the position update (particle_push_out restores them);
 //  * rigid_surface_push_out (Step IV, Sec. 4.6.1): a face point inside a body at x^{n+1} is moved
 //    to its surface by moving the face's particles (the body stays);
 //  * rigid_surface_velocity_contact (Step V): two-way at x^{n+1}, after the velocity update.
-// Contacts are found per body in face order and applied serially (Gauss-Seidel, forward and
-// backward sweeps), so results are the same on any number of threads.
+// Contacts are found per body in face order, each (body, face) pair's deepest point on both threads
+// into its own slot, and applied serially (Gauss-Seidel, forward and backward sweeps), so results
+// are the same on any number of threads.
 #include <memory>
 
 #include "components/collider.h"
@@ -55,6 +58,15 @@ class RigidSurfaceContact final : public System<d> {
   SurfaceCache<d> surfaces_{false};
   PreparedShapes<d> shapes_;
   solvers::deformable::Bvh<d> tree_;
+  // Kept from step to step so that a step allocates nothing once warm (the step's data only:
+  // every stage gathers them anew, so checkpoints need none of them).
+  std::vector<solvers::deformable::RigidFaceBody<d>> bodies_;
+  std::vector<RigidBody<d>*> owners_;
+  SurfaceParticles<d> particles_;
+  std::vector<double> at_;
+  solvers::deformable::FaceContactWorkspace<d> work_;
+  std::vector<solvers::deformable::FaceContact<d>> contacts_, swept_;
+  solvers::deformable::Bvh<d> sweptTree_;  // over the faces' boxes swept over the step
 };
 
 // One system per stage listed (Collisions, Contact, AdvancePositions, AdvanceVelocity).

@@ -1,5 +1,7 @@
 #include "solvers/deformable/proximity.h"
 
+#include "solvers/deformable/parallel_indices.h"
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -187,17 +189,6 @@ Box<d> boundsOf(const std::vector<double>& x, const std::vector<double>& v, doub
   return b;
 }
 
-template <class F>
-void parallelIndices(int n, F&& f) {
-  if (n <= 0) return;
-  tbb::parallel_for(
-      tbb::blocked_range<int>(0, n, kGrain),
-      [&](const tbb::blocked_range<int>& r) {
-        for (int i = r.begin(); i != r.end(); ++i) f(i);
-      },
-      tbb::simple_partitioner());
-}
-
 // Candidate pairs whose boxes (over [x, x + dt v], each particle padded by pad) overlap, in a
 // fixed order: points in surface order, each with its faces ascending; then edges, each with the
 // later edges ascending. Pairs sharing a particle are left out.
@@ -206,8 +197,8 @@ std::vector<Pair> candidatePairs(const CollisionSurface<d>& s, const std::vector
                                  double dt, const std::vector<double>& pad) {
   const int nf = s.faceCount(), ne = s.edgeCount(), np = static_cast<int>(s.points.size());
   std::vector<Box<d>> faceBoxes(nf), edgeBoxes(ne);
-  parallelIndices(nf, [&](int f) { faceBoxes[f] = boundsOf<d>(x, v, dt, &s.faces[d * f], d, pad); });
-  parallelIndices(ne, [&](int e) { edgeBoxes[e] = boundsOf<d>(x, v, dt, &s.edges[2 * e], 2, pad); });
+  parallelIndices(nf, [&](int f) { faceBoxes[f] = boundsOf<d>(x, v, dt, &s.faces[d * f], d, pad); }, kGrain);
+  parallelIndices(ne, [&](int e) { edgeBoxes[e] = boundsOf<d>(x, v, dt, &s.edges[2 * e], 2, pad); }, kGrain);
   Bvh<d>& faceTree = s.faceTree;
   Bvh<d>& edgeTree = s.edgeTree;
   faceTree.refit(faceBoxes);
@@ -225,7 +216,7 @@ std::vector<Pair> candidatePairs(const CollisionSurface<d>& s, const std::vector
                               }),
                hits.end());
     std::sort(hits.begin(), hits.end());
-  });
+  }, kGrain);
   parallelIndices(ne, [&](int e) {
     std::vector<int>& hits = edgeHits[e];
     edgeTree.query(edgeBoxes[e], hits);
@@ -239,7 +230,7 @@ std::vector<Pair> candidatePairs(const CollisionSurface<d>& s, const std::vector
                               }),
                hits.end());
     std::sort(hits.begin(), hits.end());
-  });
+  }, kGrain);
   std::vector<Pair> pairs;
   for (int k = 0; k < np; ++k)
     for (int f : pointHits[k]) pairs.push_back({false, s.points[k], f});
@@ -247,6 +238,8 @@ std::vector<Pair> candidatePairs(const CollisionSurface<d>& s, const std::vector
     for (int f : edgeHits[e]) pairs.push_back({true, e, f});
   return pairs;
 }
+
+}  // namespace
 
 // Real roots in [0, 1] of c0 + c1 t + c2 t^2 + c3 t^3, ascending: the interval split at the
 // critical points, a sign change in a piece bisected to round-off.
@@ -297,6 +290,8 @@ std::vector<double> rootsInUnitInterval(double c0, double c1, double c2, double 
   }
   return roots;
 }
+
+namespace {
 
 // The earliest time in [0, 1] at which the pair, moving along x + t dt v, is coplanar (3-D;
 // collinear in 2-D) and within `tolerance`; negative if none.

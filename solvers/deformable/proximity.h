@@ -81,6 +81,11 @@ ProximityReport resolveCollisions(const CollisionSurface<d>& s, const std::vecto
 // coplanarity function changes sign at a time in (0, 1] where they meet (what resolveCollisions
 // removes; a pair merely touching at the start, or sliding in its plane, does not count). For
 // tests and diagnostics.
+// The roots in [0, 1] of c0 + c1 t + c2 t^2 + c3 t^3 (the coplanarity function of a point and a
+// triangle, or of two edges, moving linearly over a step), ascending: the interval is split at the
+// critical points and each piece with a sign change bisected.
+std::vector<double> rootsInUnitInterval(double c0, double c1, double c2, double c3);
+
 template <int d>
 int countCollisions(const CollisionSurface<d>& s, const std::vector<double>& x, const std::vector<double>& v, double dt);
 

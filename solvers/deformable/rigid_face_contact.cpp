@@ -5,9 +5,12 @@
 #include <cmath>
 #include <limits>
 
+
 #include "solvers/collision/collision_impl.h"
 #include "solvers/contact/rigid_math.h"
 #include "solvers/deformable/face_geometry.h"
+#include "solvers/deformable/parallel_indices.h"
+#include "solvers/deformable/proximity.h"
 
 namespace monolith::solvers::deformable {
 
@@ -15,6 +18,7 @@ namespace col = solvers::collision;
 namespace ct = solvers::contact;
 
 namespace {
+
 
 template <int d>
 using Vec = Eigen::Matrix<double, d, 1>;
@@ -113,55 +117,167 @@ FaceContact<d> deepestFacePoint(const RigidFaceBody<d>& body, const Vec<d>* p) {
   return best;
 }
 
+// The pair's thickness and friction: the largest over the face's particles and the body's friction.
 template <int d>
-std::vector<FaceContact<d>> findFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces,
-                                             Bvh<d>& tree) {
-  const int nf = faces.faceCount();
-  const std::vector<int>& f = *faces.faces;
-  std::vector<Box<d>> boxes(nf);
-  for (int k = 0; k < nf; ++k) {
-    double pad = 0;
-    for (int a = 0; a < d; ++a) pad = std::max(pad, (*faces.thickness)[f[d * k + a]]);
-    boxes[k] = faceBox<d>(*faces.x, &f[d * k], pad);
+void faceMaterial(const FaceSet<d>& faces, const int* idx, double bodyFriction, FaceContact<d>& c) {
+  c.thickness = 0;
+  c.friction = bodyFriction;
+  for (int a = 0; a < d; ++a) {
+    c.thickness = std::max(c.thickness, (*faces.thickness)[idx[a]]);
+    c.friction = std::max(c.friction, (*faces.friction)[idx[a]]);
   }
-  if (static_cast<int>(tree.size()) != nf) tree.build(boxes);
-  else tree.refit(boxes);
-  std::vector<FaceContact<d>> out;
-  std::vector<int> hits;
+}
+
+// The bodies' (body, face) candidate pairs from `tree`: each bounded, non-mesh body's query box
+// (half-spaces are left to the particle contact, whose deepest point in a flat face is one of
+// its vertices; meshes have no inside), in body order, faces ascending.
+template <int d, class QueryBox>
+void candidatePairs(const std::vector<RigidFaceBody<d>>& bodies, Bvh<d>& tree, FaceContactWorkspace<d>& work,
+                    QueryBox queryBox) {
+  work.pairs.clear();
   for (int bi = 0; bi < static_cast<int>(bodies.size()); ++bi) {
     const RigidFaceBody<d>& body = bodies[bi];
-    // Half-spaces are left to the particle contact: a flat face's deepest point in a half-space is
-    // one of its vertices. Meshes have no inside.
     if (body.geometry->unbounded() || body.geometry->geometry().type == col::GeometryType::Mesh) continue;
+    Box<d> query;
+    if (!queryBox(body, query)) continue;
+    work.hits.clear();
+    tree.query(query, work.hits);
+    std::sort(work.hits.begin(), work.hits.end());
+    for (int face : work.hits) work.pairs.emplace_back(bi, face);
+  }
+}
+
+template <int d>
+void findFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces, Bvh<d>& tree,
+                      FaceContactWorkspace<d>& work, std::vector<FaceContact<d>>& out) {
+  const int nf = faces.faceCount();
+  const std::vector<int>& f = *faces.faces;
+  work.boxes.resize(nf);
+  parallelIndices(nf, [&](int k) {
+    double pad = 0;
+    for (int a = 0; a < d; ++a) pad = std::max(pad, (*faces.thickness)[f[d * k + a]]);
+    work.boxes[k] = faceBox<d>(*faces.x, &f[d * k], pad);
+  });
+  if (static_cast<int>(tree.size()) != nf) tree.build(work.boxes);
+  else tree.refit(work.boxes);
+  // The candidate pairs serially (a few BVH queries, one per body).
+  candidatePairs<d>(bodies, tree, work, [](const RigidFaceBody<d>& body, Box<d>& query) {
     col::Pose<d> pose;
     pose.x = body.x;
     pose.R = body.R;
     const auto bounds = col::worldBounds<d>(*body.geometry, pose);
-    Box<d> query;
     query.lo = bounds.min();
     query.hi = bounds.max();
-    hits.clear();
-    tree.query(query, hits);
-    std::sort(hits.begin(), hits.end());
-    for (int face : hits) {
-      Vec<d> p[d];
-      double thickness = 0, friction = body.friction;
-      for (int a = 0; a < d; ++a) {
-        const int i = f[d * face + a];
-        p[a] = at<d>(*faces.x, i);
-        thickness = std::max(thickness, (*faces.thickness)[i]);
-        friction = std::max(friction, (*faces.friction)[i]);
-      }
-      FaceContact<d> c = deepestFacePoint<d>(body, p);
-      if (!(c.distance < thickness)) continue;
-      c.body = bi;
-      c.face = face;
-      c.thickness = thickness;
-      c.friction = friction;
-      out.push_back(c);
-    }
-  }
+    return true;
+  });
+  // The deepest point of every pair, the costly part, in parallel into its own slot.
+  const int np = static_cast<int>(work.pairs.size());
+  work.slots.resize(np);
+  work.close.assign(np, 0);
+  parallelIndices(np, [&](int k) {
+    const auto [bi, face] = work.pairs[k];
+    Vec<d> p[d];
+    for (int a = 0; a < d; ++a) p[a] = at<d>(*faces.x, f[d * face + a]);
+    FaceContact<d> c = deepestFacePoint<d>(bodies[bi], p);
+    faceMaterial<d>(faces, &f[d * face], bodies[bi].friction, c);
+    if (!(c.distance < c.thickness)) return;
+    c.body = bi;
+    c.face = face;
+    work.slots[k] = c;
+    work.close[k] = 1;
+  });
+  out.clear();
+  for (int k = 0; k < np; ++k)
+    if (work.close[k]) out.push_back(work.slots[k]);
+}
+
+template <int d>
+std::vector<FaceContact<d>> findFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces,
+                                             Bvh<d>& tree) {
+  FaceContactWorkspace<d> work;
+  std::vector<FaceContact<d>> out;
+  findFaceContacts<d>(bodies, faces, tree, work, out);
   return out;
+}
+
+template <int d>
+void findSweptFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces,
+                           const std::vector<double>& start, double dt, std::vector<FaceContact<d>>& discrete,
+                           Bvh<d>& tree, FaceContactWorkspace<d>& work, std::vector<FaceContact<d>>& out) {
+  out.clear();
+  if constexpr (d == 3) {
+    const int nf = faces.faceCount();
+    const std::vector<int>& f = *faces.faces;
+    const std::vector<double>& end = *faces.x;
+    work.boxes.resize(nf);
+    parallelIndices(nf, [&](int k) {
+      Box<d> a = faceBox<d>(start, &f[d * k], 0.0), b = faceBox<d>(end, &f[d * k], 0.0);
+      a.lo = a.lo.cwiseMin(b.lo);
+      a.hi = a.hi.cwiseMax(b.hi);
+      work.boxes[k] = a;
+    });
+    if (static_cast<int>(tree.size()) != nf) tree.build(work.boxes);
+    else tree.refit(work.boxes);
+    candidatePairs<d>(bodies, tree, work, [&](const RigidFaceBody<d>& body, Box<d>& query) {
+      query.lo = body.x.cwiseMin(Vec<d>(body.x - dt * body.v));
+      query.hi = body.x.cwiseMax(Vec<d>(body.x - dt * body.v));
+      return body.v.squaredNorm() > 0;
+    });
+    const int np = static_cast<int>(work.pairs.size());
+    work.slots.resize(np);
+    work.close.assign(np, 0);
+    parallelIndices(np, [&](int k) {
+      const auto [bi, face] = work.pairs[k];
+      const RigidFaceBody<d>& body = bodies[bi];
+      const int* idx = &f[d * face];
+      // Relative to the face's first vertex: (B - A) x (C - A) . (P - A) as a cubic in t.
+      const Vec<d> o = at<d>(start, idx[0]), od = at<d>(end, idx[0]) - o;
+      const Vec<d> A = at<d>(start, idx[1]) - o, dA = at<d>(end, idx[1]) - at<d>(start, idx[1]) - od;
+      const Vec<d> B = at<d>(start, idx[2]) - o, dB = at<d>(end, idx[2]) - at<d>(start, idx[2]) - od;
+      const Vec<d> centre0 = body.x - dt * body.v;
+      const Vec<d> C = centre0 - o, dC = dt * body.v - od;
+      const Vec<d> AB = A.cross(B), AdB = A.cross(dB) + dA.cross(B), dAdB = dA.cross(dB);
+      const double scale = (A.norm() + dA.norm()) * (B.norm() + dB.norm()) * (C.norm() + dC.norm());
+      const double c0 = AB.dot(C), c1 = AdB.dot(C) + AB.dot(dC), c2 = dAdB.dot(C) + AdB.dot(dC), c3 = dAdB.dot(dC);
+      if (std::abs(c0) <= 1e-12 * scale) return;  // starts in the face's plane: the discrete test's case
+      for (double t : rootsInUnitInterval(c0, c1, c2, c3)) {
+        if (t <= 0) continue;
+        Vec<d> p[d];
+        for (int a = 0; a < d; ++a) p[a] = at<d>(start, idx[a]) + t * (at<d>(end, idx[a]) - at<d>(start, idx[a]));
+        const Vec<d> centre = centre0 + t * dt * body.v;
+        const Eigen::Vector3d w = closestOnTriangle(centre, p[0], p[1], p[2]);
+        const Vec<d> q = w(0) * p[0] + w(1) * p[1] + w(2) * p[2];
+        if ((q - centre).norm() > 1e-9 * (1 + centre.norm())) continue;  // crosses the plane beside the face
+        FaceContact<d> c;
+        c.body = bi;
+        c.face = face;
+        c.point = Vec<d>::Zero();
+        for (int a = 0; a < d; ++a) {
+          c.weights[a] = w(a);
+          c.point += w(a) * at<d>(end, idx[a]);
+        }
+        Vec<d> n = (at<d>(start, idx[1]) - at<d>(start, idx[0])).cross(at<d>(start, idx[2]) - at<d>(start, idx[0]));
+        if (n.dot(centre0 - at<d>(start, idx[0])) > 0) n = -n;  // out of the body: towards the far side
+        c.normal = n.normalized();
+        c.distance = 0;
+        faceMaterial<d>(faces, idx, body.friction, c);
+        work.slots[k] = c;
+        work.close[k] = 1;
+        return;
+      }
+    });
+    for (int k = 0; k < np; ++k)
+      if (work.close[k]) out.push_back(work.slots[k]);
+    // A crossing pair's discrete contact is dropped: at the candidate positions the centre is
+    // already past the face, and that contact's normal would push the body on through.
+    discrete.erase(std::remove_if(discrete.begin(), discrete.end(),
+                                  [&](const FaceContact<d>& c) {
+                                    for (const FaceContact<d>& s : out)
+                                      if (s.body == c.body && s.face == c.face) return true;
+                                    return false;
+                                  }),
+                   discrete.end());
+  }
 }
 
 template <int d>
@@ -233,6 +349,11 @@ double pushFacesOut(const std::vector<FaceContact<d>>& contacts, const std::vect
   template FaceContact<D> deepestFacePoint<D>(const RigidFaceBody<D>&, const Vec<D>*);                            \
   template std::vector<FaceContact<D>> findFaceContacts<D>(const std::vector<RigidFaceBody<D>>&, const FaceSet<D>&, \
                                                            Bvh<D>&);                                              \
+  template void findFaceContacts<D>(const std::vector<RigidFaceBody<D>>&, const FaceSet<D>&, Bvh<D>&,              \
+                                    FaceContactWorkspace<D>&, std::vector<FaceContact<D>>&);                      \
+  template void findSweptFaceContacts<D>(const std::vector<RigidFaceBody<D>>&, const FaceSet<D>&,                 \
+                                         const std::vector<double>&, double, std::vector<FaceContact<D>>&,         \
+                                         Bvh<D>&, FaceContactWorkspace<D>&, std::vector<FaceContact<D>>&);         \
   template int applyFaceContactImpulses<D>(std::vector<RigidFaceBody<D>>&, FaceSet<D>&,                           \
                                            const std::vector<FaceContact<D>>&, int);                              \
   template double pushFacesOut<D>(const std::vector<FaceContact<D>>&, const std::vector<int>&,                    \

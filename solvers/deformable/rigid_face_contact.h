@@ -78,7 +78,36 @@ FaceContact<d> deepestFacePoint(const RigidFaceBody<d>& body, const Eigen::Matri
 template <int d>
 std::vector<FaceContact<d>> findFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces,
                                              Bvh<d>& tree);
+// Storage findFaceContacts reuses from call to call.
+template <int d>
+struct FaceContactWorkspace {
+  std::vector<Box<d>> boxes;
+  std::vector<int> hits;
+  std::vector<std::pair<int, int>> pairs;  // (body, face) whose boxes overlap
+  std::vector<FaceContact<d>> slots;       // one per pair
+  std::vector<char> close;                 // the pair's deepest point is within the thickness
+};
+// The same into `out`; the face boxes and the deepest points of the (body, face) pairs are
+// computed in parallel, one slot per pair, and kept in pair order: bitwise the same on any thread
+// count.
+template <int d>
+void findFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces, Bvh<d>& tree,
+                      FaceContactWorkspace<d>& work, std::vector<FaceContact<d>>& out);
 
+// The swept test (3-D; 2-D returns none): the centre of each moving body, from x - dt v to its
+// candidate x (the bodies at their candidate poses), against every face moving from `start` to
+// start + dt v (faces.v); where the centre passes through a face within the step (a root of the
+// point-triangle coplanarity cubic with the centre inside the triangle) the body would tunnel
+// through it between the discrete tests' positions. Each such (body, face) pair becomes a contact
+// (replacing the pair's contact in `discrete`, whose normal, found past the face, would push the
+// body on through) at the crossing's barycentric weights (the point the face's
+// candidate positions give them, so that impulses there keep angular momentum), its normal the
+// face normal turned towards the side the centre came from. `tree` is built over the faces'
+// swept boxes. In body order, faces ascending.
+template <int d>
+void findSweptFaceContacts(const std::vector<RigidFaceBody<d>>& bodies, const FaceSet<d>& faces,
+                           const std::vector<double>& start, double dt, std::vector<FaceContact<d>>& discrete,
+                           Bvh<d>& tree, FaceContactWorkspace<d>& work, std::vector<FaceContact<d>>& out);
 // Gauss-Seidel sweeps over the contacts, forward and backward in turn: each approaching pair
 // (relative normal velocity at the point < 0) gets the impulse that stops the approach, with
 // Coulomb friction. Returns the number of impulses applied.
