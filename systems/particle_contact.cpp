@@ -433,8 +433,8 @@ void ParticlePushOut<d>::run(World<d>& world, StepContext& ctx) {
   std::vector<BodyView<d>> bodies = bodiesOf(world, shapes_, 0.0, true);
   std::vector<Particles<d>*> pools;
   world.template each<Particles<d>>([&](Entity, Particles<d>& p) { pools.push_back(&p); });
-  const PushOutCounts counts = pushParticlesOut<d>(bodies, pools, world.settings().contact.thickness,
-                                                       world.settings().contact.pushOutTolerance);
+  const ContactSettings& settings = world.template resource<ContactSettings>();
+  const PushOutCounts counts = pushParticlesOut<d>(bodies, pools, settings.thickness, settings.pushOutTolerance);
   ctx.diagnostics.max("particle_push_out_depth", counts.deepest);
   ctx.diagnostics.set("particle_push_out_body_solves", counts.bodySolves);
   ctx.diagnostics.set("particle_push_out_particle_solves", counts.particleSolves);
