@@ -138,6 +138,11 @@ struct ArticulationSolver {
   // post_tolerance. Projected Gauss-Seidel converges linearly, and what 50 sweeps left of a
   // resting pile's gravity kick stayed in its velocities (docs/benchmarks_articulation.md).
   int contactSolveSweeps = 500;
+  // With colliders: rolling resistance (a length, m) at the jointed bodies' contact points in
+  // that projection: their relative turn about the contact's tangents is stopped while the
+  // angular impulse stays within this x the normal impulse (solvers::ContactRow::rolling).
+  // Coulomb friction cannot stop a ball or a capsule rolling without slipping; 0: free rolling.
+  double rollingResistance = 0;
 
   template <class V>
   void visitFields(V& visit) {
@@ -152,6 +157,7 @@ struct ArticulationSolver {
     visit("push_out_contact_sweeps", pushOutContactSweeps);
     visit("push_out_contact_passes", pushOutContactPasses);
     visit("contact_solve_sweeps", contactSolveSweeps);
+    visit("rolling_resistance", rollingResistance);
   }
 };
 

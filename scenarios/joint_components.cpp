@@ -207,6 +207,7 @@ void parseArticulation(World<d>& world, Entity e, const Config& c) {
   s.pushOutContactPasses =
       static_cast<int>(c.integer("push_out_contact_passes", s.pushOutContactPasses, 1, 1000));
   s.contactSolveSweeps = static_cast<int>(c.integer("contact_solve_sweeps", s.contactSolveSweeps, 1, 1000000));
+  s.rollingResistance = c.number("rolling_resistance", s.rollingResistance, Bound::NonNegative);
   world.add(e, s);
 }
 
@@ -273,7 +274,7 @@ void registerJointComponents(Registry& r) {
   r.addComponentOf<d, ArticulationSolver>(
       "how the scene's joints are solved (one per scene): post_stabilization/pre_stabilization \"pairwise\" or "
       "\"global\", pre_stabilize, post_iterations, post_tolerance, pre_iterations, pre_tolerance, contact_rounds, "
-      "push_out_contact_sweeps, push_out_contact_passes, contact_solve_sweeps",
+      "push_out_contact_sweeps, push_out_contact_passes, contact_solve_sweeps, rolling_resistance (m)",
       parseArticulation<d>);
 }
 

@@ -117,9 +117,10 @@ void postStabilizeWithContacts(World<d>& world, const ContactWorkspace<d>& ws, S
   // stayed (one ragdoll at rest: kinetic energy 1.3e-3 J, 3.4e-7 J with the same rule).
   const bool closeGaps = ws.settings.closeGaps;
   const double tolerance = ws.settings.pushOutTolerance;
-  const std::vector<solvers::ContactRow> contacts = contactRows(
+  std::vector<solvers::ContactRow> contacts = contactRows(
       a, ws, bodyOf, kStepFiveMargin,
       [&](double depth) { return closeGaps && -depth > tolerance ? std::min(0.0, depth / dt) : 0.0; }, true);
+  for (solvers::ContactRow& c : contacts) c.rolling = s.rollingResistance;
   const solvers::ProjectionReport r =
       solvers::projectWithContacts(a.rows(), contacts, a.bodies, s.contactSolveSweeps, s.postTolerance);
   a.writeBack();

@@ -28,9 +28,19 @@
 // any step, relative to that value (the project's rule: at most 0.1 %).
 //
 // usage: compare_bullet SCENE.json [--dt 1/60|SECONDS] [--end SECONDS] [--iterations N] [--sleep] [--ccd]
+//                       [--multibody]
 //   --ccd: Bullet's continuous collision detection on every dynamic body (off by default, as in
 //   Bullet).
+//   --multibody: the jointed bodies as Bullet btMultiBody trees (Featherstone's articulated-body
+//   algorithm in reduced coordinates, btMultiBodyDynamicsWorld) instead of rigid bodies held by
+//   btPoint2PointConstraints (maximal coordinates, sequential impulses). A tree whose root is
+//   jointed to the world gets a fixed base at that anchor; one whose root is a free body gets
+//   that body as a floating base. Its bodies must have no collider and start at rest (refused
+//   with the JSON path otherwise), and Bullet's default multibody damping is off.
 #include <btBulletDynamicsCommon.h>
+#include <BulletDynamics/Featherstone/btMultiBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
+#include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
 #include <LinearMath/btConvexHullComputer.h>
 
 #include <algorithm>
@@ -50,17 +60,20 @@ namespace {
 
 using namespace comparisons;
 constexpr double kInfinite = std::numeric_limits<double>::infinity();
-constexpr const char* kUsage = "SCENE.json [--dt 1/60|SECONDS] [--end SECONDS] [--iterations N] [--sleep] [--ccd]";
+constexpr const char* kUsage =
+    "SCENE.json [--dt 1/60|SECONDS] [--end SECONDS] [--iterations N] [--sleep] [--ccd] [--multibody]";
 
 struct Options : CommonOptions {
-  int iterations = 10;  // btContactSolverInfo's default
-  bool ccd = false;     // Bullet's continuous collision detection for fast bodies
+  int iterations = 10;     // btContactSolverInfo's default
+  bool ccd = false;        // Bullet's continuous collision detection for fast bodies
+  bool multibody = false;  // jointed bodies as btMultiBody trees instead of point-to-point constraints
 };
 
 Options parse(int argc, char** argv) {
   Options o;
   static_cast<CommonOptions&>(o) = parseCommon(argc, argv, kUsage, [&](const std::string& a, auto&& next) {
     if (a == "--ccd") o.ccd = true;
+    else if (a == "--multibody") o.multibody = true;
     else if (a == "--iterations") o.iterations = static_cast<int>(positive(next(), a.c_str(), kUsage));
     else return false;
     return true;
@@ -220,6 +233,13 @@ struct Scene {
     btVector3 inParent, inChild;
   };
   std::vector<JointPivots> pivots;
+  // The scene's spherical joints (body indices, -1: the world; the world anchor), whichever way
+  // they are carried over.
+  struct JointSpec {
+    int parent, child;
+    btVector3 anchor;
+  };
+  std::vector<JointSpec> jointSpecs;
 };
 
 Scene load(const Options& o) {
@@ -232,11 +252,9 @@ Scene load(const Options& o) {
   if (root.contains("gravity")) s.gravity = vec3(root["gravity"], o.scene + ": gravity");
   s.time = sceneTime(root, o);
   if (!root.contains("entities") || !root["entities"].is_array()) fail(o.scene + ": entities: expected an array");
-  struct WorldJoint {
-    int parent, child;
-    btVector3 anchor;
-  };
+  using WorldJoint = Scene::JointSpec;
   std::vector<WorldJoint> names;
+  std::vector<bool> jointed(root["entities"].is_array() ? root["entities"].size() : 0, false);
   for (std::size_t e = 0; e < root["entities"].size(); ++e) {
     const json& entity = root["entities"][e];
     const std::string path = o.scene + ": entities[" + std::to_string(e) + "]";
@@ -257,6 +275,8 @@ Scene load(const Options& o) {
         if (p < 0) fail(path + ".joint.parent: the parent must be an earlier entity here");
       }
       names.push_back({p, static_cast<int>(e), vec3(j["anchor"], path + ".joint.anchor")});
+      jointed[e] = true;
+      if (p >= 0) jointed[p] = true;
     }
     const json& rb = entity["rigid_body"];
     refuseOtherKeys(rb, {"static", "mass", "inertia", "position", "orientation", "velocity", "angular_velocity"},
@@ -303,8 +323,23 @@ Scene load(const Options& o) {
     s.sizes.push_back(size);
     s.start.push_back(pose.getOrigin());
   }
+  s.jointSpecs = names;
+  if (o.multibody) {
+    // A multibody's links are carried over as bodies of the articulated-body algorithm alone.
+    for (std::size_t e = 0; e < jointed.size(); ++e) {
+      if (!jointed[e]) continue;
+      const json& entity = root["entities"][e];
+      const std::string path = o.scene + ": entities[" + std::to_string(e) + "]";
+      if (entity.contains("collider")) fail(path + ".collider: a body of a multibody (--multibody) has no collider here");
+      const json& rb = entity["rigid_body"];
+      if (rb.value("static", false)) fail(path + ".rigid_body.static: a multibody's body must be dynamic here");
+      for (const char* key : {"velocity", "angular_velocity"})
+        if (rb.contains(key) && vec3(rb[key], path + ".rigid_body." + key).length2() != 0)
+          fail(path + ".rigid_body." + key + ": a multibody starts at rest here");
+    }
+  }
   // Joints need every entity to be a body (checked above), so entity index = body index.
-  for (const WorldJoint& j : names) {
+  for (const WorldJoint& j : o.multibody ? std::vector<WorldJoint>{} : names) {
     Scene::JointPivots p;
     p.parent = j.parent, p.child = j.child;
     btRigidBody& child = *s.bodies[j.child];
@@ -328,6 +363,105 @@ Scene load(const Options& o) {
   return s;
 }
 
+// The scene's jointed bodies as btMultiBody trees (--multibody). The rigid bodies load() made
+// for them only carry their mass, inertia and initial pose; they are not added to the world.
+struct MultiBodies {
+  struct Link {
+    int body = -1;    // the scene's body
+    int parent = -1;  // the parent's link, -1: the base
+    btVector3 parentComToPivot, pivotToCom;  // in the parent's frame, in the link's frame
+  };
+  struct Tree {
+    std::unique_ptr<btMultiBody> body;
+    int baseBody = -1;  // the floating base's scene body, -1: a fixed base at the root's anchor
+    std::vector<Link> links;
+  };
+  std::vector<Tree> trees;
+  std::vector<bool> member;  // per scene body: in a tree (and not in the rigid-body world)
+
+  // Per tree: the links' (and base's, at 0) world-to-local rotations and centres, and their
+  // angular and linear velocities in their own frames.
+  struct Kinematics {
+    btAlignedObjectArray<btQuaternion> worldToLocal;
+    btAlignedObjectArray<btVector3> origin;
+    std::vector<btVector3> omega, v;
+  };
+  static Kinematics kinematics(btMultiBody& mb) {
+    Kinematics k;
+    k.worldToLocal.resize(mb.getNumLinks() + 1);
+    k.origin.resize(mb.getNumLinks() + 1);
+    mb.forwardKinematics(k.worldToLocal, k.origin);
+    k.omega.resize(mb.getNumLinks() + 1);
+    k.v.resize(mb.getNumLinks() + 1);
+    mb.compTreeLinkVelocities(k.omega.data(), k.v.data());
+    return k;
+  }
+};
+
+MultiBodies buildMultiBodies(const Scene& scene) {
+  MultiBodies m;
+  const int n = static_cast<int>(scene.bodies.size());
+  m.member.assign(n, false);
+  std::vector<int> parentOf(n, -2), jointOf(n, -1);  // -2: no joint, -1: jointed to the world
+  for (std::size_t j = 0; j < scene.jointSpecs.size(); ++j) {
+    parentOf[scene.jointSpecs[j].child] = scene.jointSpecs[j].parent;
+    jointOf[scene.jointSpecs[j].child] = static_cast<int>(j);
+  }
+  std::vector<int> rootOf(n, -1);
+  for (const auto& j : scene.jointSpecs) {
+    // Parents come before their children (load() requires it), so a parent's root is known.
+    const int root = j.parent < 0 ? j.child : (parentOf[j.parent] == -2 ? j.parent : rootOf[j.parent]);
+    rootOf[j.child] = root;
+    if (j.parent >= 0 && parentOf[j.parent] == -2) rootOf[j.parent] = j.parent;
+    m.member[j.child] = true;
+    if (j.parent >= 0) m.member[j.parent] = true;
+  }
+  const auto massOf = [&](int b) { return btScalar(1) / scene.bodies[b]->getInvMass(); };
+  const auto poseOf = [&](int b) { return scene.bodies[b]->getCenterOfMassTransform(); };
+  for (int r = 0; r < n; ++r) {
+    if (!m.member[r] || rootOf[r] != r) continue;
+    MultiBodies::Tree t;
+    const bool fixed = parentOf[r] == -1;
+    t.baseBody = fixed ? -1 : r;
+    std::vector<int> linkOf(n, -1);
+    for (int b = 0; b < n; ++b)
+      if (m.member[b] && rootOf[b] == r && (fixed || b != r)) {
+        linkOf[b] = static_cast<int>(t.links.size());
+        t.links.push_back({b, -1, {}, {}});
+      }
+    const btVector3 basePosition = fixed ? scene.jointSpecs[jointOf[r]].anchor : poseOf(r).getOrigin();
+    const btQuaternion baseRotation = fixed ? btQuaternion::getIdentity() : poseOf(r).getRotation();
+    t.body = std::make_unique<btMultiBody>(static_cast<int>(t.links.size()), fixed ? btScalar(0) : massOf(r),
+                                           fixed ? btVector3(0, 0, 0) : scene.bodies[r]->getLocalInertia(), fixed,
+                                           /*canSleep=*/false);
+    t.body->setBasePos(basePosition);
+    t.body->setWorldToBaseRot(baseRotation.inverse());
+    for (std::size_t k = 0; k < t.links.size(); ++k) {
+      MultiBodies::Link& link = t.links[k];
+      const Scene::JointSpec& j = scene.jointSpecs[jointOf[link.body]];
+      const bool onBase = j.parent < 0 || j.parent == t.baseBody;
+      link.parent = onBase ? -1 : linkOf[j.parent];
+      const btVector3 parentX = onBase ? basePosition : poseOf(j.parent).getOrigin();
+      const btQuaternion parentQ = onBase ? baseRotation : poseOf(j.parent).getRotation();
+      const btTransform pose = poseOf(link.body);
+      link.parentComToPivot = quatRotate(parentQ.inverse(), j.anchor - parentX);
+      link.pivotToCom = quatRotate(pose.getRotation().inverse(), pose.getOrigin() - j.anchor);
+      t.body->setupSpherical(static_cast<int>(k), massOf(link.body), scene.bodies[link.body]->getLocalInertia(),
+                             link.parent, (pose.getRotation().inverse() * parentQ).normalized(), link.parentComToPivot,
+                             link.pivotToCom, /*disableParentCollision=*/true);
+    }
+    t.body->finalizeMultiDof();
+    // Bullet's multibody defaults damp (0.04) and cap joint speeds (100 rad/s): neither is in
+    // the scene.
+    t.body->setLinearDamping(0);
+    t.body->setAngularDamping(0);
+    t.body->setMaxCoordinateVelocity(btScalar(1e30));
+    t.body->setHasSelfCollision(false);
+    m.trees.push_back(std::move(t));
+  }
+  return m;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -340,15 +474,26 @@ int main(int argc, char** argv) {
   btCollisionDispatcher dispatcher(&configuration);
   btDbvtBroadphase broadphase;
   btSequentialImpulseConstraintSolver solver;
-  btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &configuration);
+  btMultiBodyConstraintSolver multiBodySolver;
+  MultiBodies multi;
+  if (o.multibody) multi = buildMultiBodies(scene);
+  std::unique_ptr<btDiscreteDynamicsWorld> worldPointer;
+  if (o.multibody)
+    worldPointer = std::make_unique<btMultiBodyDynamicsWorld>(&dispatcher, &broadphase, &multiBodySolver, &configuration);
+  else
+    worldPointer = std::make_unique<btDiscreteDynamicsWorld>(&dispatcher, &broadphase, &solver, &configuration);
+  btDiscreteDynamicsWorld& world = *worldPointer;
   world.setGravity(scene.gravity);
   world.getSolverInfo().m_numIterations = o.iterations;
+  const auto inWorld = [&](std::size_t i) { return !o.multibody || !multi.member[i]; };
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     scene.bodies[i]->setUserIndex(static_cast<int>(i));
-    world.addRigidBody(scene.bodies[i].get());
+    if (inWorld(i)) world.addRigidBody(scene.bodies[i].get());
   }
   for (auto& j : scene.joints) world.addConstraint(j.get(), true);
-  // The largest distance between a joint's two pivots (m).
+  for (auto& t : multi.trees) static_cast<btMultiBodyDynamicsWorld&>(world).addMultiBody(t.body.get());
+  // The largest distance between a joint's two pivots (m); for a multibody, between the pivot as
+  // its parent link places it and as its own link does.
   const auto jointError = [&] {
     double worst = 0;
     for (const auto& p : scene.pivots) {
@@ -356,19 +501,53 @@ int main(int argc, char** argv) {
       const btVector3 b = scene.bodies[p.child]->getCenterOfMassTransform() * p.inChild;
       worst = std::max(worst, double((a - b).length()));
     }
+    for (auto& t : multi.trees) {
+      const MultiBodies::Kinematics k = MultiBodies::kinematics(*t.body);
+      for (std::size_t i = 0; i < t.links.size(); ++i) {
+        const MultiBodies::Link& l = t.links[i];
+        const int p = l.parent + 1;
+        const btVector3 a = k.origin[p] + quatRotate(k.worldToLocal[p].inverse(), l.parentComToPivot);
+        const btVector3 b = k.origin[int(i) + 1] - quatRotate(k.worldToLocal[int(i) + 1].inverse(), l.pivotToCom);
+        worst = std::max(worst, double((a - b).length()));
+      }
+    }
     return worst;
   };
+  // A multibody's links at their scene poses (the construction's convention checked; single
+  // precision accumulates along a long chain: 1e-5 m at the end of 1000 links of 0.1 m).
+  double builtOff = 0;
+  for (auto& t : multi.trees) {
+    const MultiBodies::Kinematics k = MultiBodies::kinematics(*t.body);
+    for (std::size_t i = 0; i < t.links.size(); ++i) {
+      const btTransform pose = scene.bodies[t.links[i].body]->getCenterOfMassTransform();
+      const btQuaternion turn = k.worldToLocal[int(i) + 1] * pose.getRotation();  // (+-1, 0) when they agree
+      const double off = (k.origin[int(i) + 1] - pose.getOrigin()).length() + btVector3(turn.x(), turn.y(), turn.z()).length();
+      builtOff = std::max(builtOff, off);
+      if (off > 1e-3) fail("--multibody: link " + std::to_string(i) + " built away from its scene pose");
+    }
+  }
   double jointErrorMax = 0;
 
   // Kinetic and total (kinetic + gravity's potential) energy of the dynamic bodies.
   const auto energies = [&] {
     double kinetic = 0, potential = 0;
-    for (const auto& body : scene.bodies) {
-      if (body->getInvMass() == 0) continue;
+    for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+      const auto& body = scene.bodies[i];
+      if (body->getInvMass() == 0 || !inWorld(i)) continue;
       const double m = 1 / double(body->getInvMass());
       const btVector3 v = body->getLinearVelocity(), w = body->getAngularVelocity();
       kinetic += 0.5 * m * double(v.length2()) + 0.5 * double(w.dot(body->getInvInertiaTensorWorld().inverse() * w));
       potential -= m * double(scene.gravity.dot(body->getCenterOfMassPosition()));
+    }
+    for (auto& t : multi.trees) {
+      const MultiBodies::Kinematics k = MultiBodies::kinematics(*t.body);
+      for (int i = t.baseBody < 0 ? 1 : 0; i <= t.body->getNumLinks(); ++i) {
+        const double m = i == 0 ? t.body->getBaseMass() : t.body->getLink(i - 1).m_mass;
+        const btVector3 I = i == 0 ? t.body->getBaseInertia() : t.body->getLink(i - 1).m_inertiaLocal;
+        const btVector3 w = k.omega[i];
+        kinetic += 0.5 * m * double(k.v[i].length2()) + 0.5 * double(w.dot(I * w));
+        potential -= m * double(scene.gravity.dot(k.origin[i]));
+      }
     }
     return std::make_pair(kinetic, kinetic + potential);
   };
@@ -397,11 +576,20 @@ int main(int argc, char** argv) {
     const btRigidBody& b = *scene.bodies[i];
     if (b.getInvMass() == 0) continue;
     ++dynamic;
-    drift = std::max(drift, double((b.getCenterOfMassPosition() - scene.start[i]).length()));
+    if (inWorld(i)) drift = std::max(drift, double((b.getCenterOfMassPosition() - scene.start[i]).length()));
+  }
+  for (auto& t : multi.trees) {
+    const MultiBodies::Kinematics k = MultiBodies::kinematics(*t.body);
+    if (t.baseBody >= 0) drift = std::max(drift, double((k.origin[0] - scene.start[t.baseBody]).length()));
+    for (std::size_t i = 0; i < t.links.size(); ++i)
+      drift = std::max(drift, double((k.origin[int(i) + 1] - scene.start[t.links[i].body]).length()));
   }
   const double kinetic = energies().first;
+  const double energyChange = energies().second - initialEnergy;
   for (auto& j : scene.joints) world.removeConstraint(j.get());
-  for (auto& b : scene.bodies) world.removeRigidBody(b.get());
+  for (auto& t : multi.trees) static_cast<btMultiBodyDynamicsWorld&>(world).removeMultiBody(t.body.get());
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i)
+    if (inWorld(i)) world.removeRigidBody(scene.bodies[i].get());
 
   std::printf("| engine | scene | bodies | dt | steps | solver iterations | sleeping | us/step | max drift | final KE | "
               "max penetration / size | max energy rise | CCD |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
@@ -411,6 +599,10 @@ int main(int argc, char** argv) {
               energyRise(highestEnergy, initialEnergy).c_str(), o.ccd ? "on" : "off");
   if (!scene.joints.empty())
     std::printf("\n%zu point-to-point joints: max joint error %.3e m, energy end - start %.4g J\n", scene.joints.size(),
-                jointErrorMax, energies().second - initialEnergy);
+                jointErrorMax, energyChange);
+  if (!multi.trees.empty())
+    std::printf("\n%zu spherical joints in %zu multibodies (Featherstone): max joint error %.3e m, energy end - start %.4g J "
+                "(links built within %.1e of their scene poses)\n",
+                scene.jointSpecs.size(), multi.trees.size(), jointErrorMax, energyChange, builtOff);
   return 0;
 }

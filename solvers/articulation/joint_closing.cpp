@@ -1,6 +1,7 @@
 #include "solvers/articulation/joint_closing.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "solvers/rigid_rotation.h"
 
@@ -15,6 +16,9 @@ struct LinearContact {
   Eigen::Matrix3d dirs;
   double inverseK[3] = {0, 0, 0};
   double impulse[3] = {0, 0, 0};
+  // Rolling resistance: angular rows about the two tangents (dirs' columns 1 and 2).
+  double inverseKRolling[2] = {0, 0};
+  double rollingImpulse[2] = {0, 0};
 };
 
 std::vector<LinearContact> linearise(const std::vector<ContactRow>& contacts, const std::vector<ConstraintBody>& bodies) {
@@ -33,6 +37,11 @@ std::vector<LinearContact> linearise(const std::vector<ContactRow>& contacts, co
       const Eigen::Vector3d turnA = l.armA.cross(n), turnB = l.armB.cross(n);
       const double K = A.invMass + B.invMass + turnA.dot(A.invInertia * turnA) + turnB.dot(B.invInertia * turnB);
       l.inverseK[row] = K > 0 ? 1 / K : 0;
+    }
+    for (int row = 0; row < 2 && c.rolling > 0; ++row) {
+      const Eigen::Vector3d t = l.dirs.col(row + 1);
+      const double K = t.dot(A.invInertia * t) + t.dot(B.invInertia * t);
+      l.inverseKRolling[row] = K > 0 ? 1 / K : 0;
     }
   }
   return linear;
@@ -60,8 +69,20 @@ void applyContactImpulse(const ContactRow& c, const LinearContact& l, int row, d
   if (B.invMass > 0) B.angularImpulse += torqueB;
 }
 
+// An angular impulse `delta` about the tangent `t` on a, its opposite on b.
+void applyRollingImpulse(const ContactRow& c, const Eigen::Vector3d& t, double delta, std::vector<ConstraintBody>& moves) {
+  ConstraintBody& A = moves[c.a];
+  ConstraintBody& B = moves[c.b];
+  A.w += A.invInertia * (delta * t);
+  B.w -= B.invInertia * (delta * t);
+  if (A.invMass > 0) A.angularImpulse += delta * t;
+  if (B.invMass > 0) B.angularImpulse -= delta * t;
+}
+
 // One projected Gauss-Seidel sweep over the contact rows; returns the largest normal row left
-// short of its gain.
+// short of its gain and, at points with rolling resistance, the largest velocity change of
+// their friction and rolling rows (rolling resistance turns slip into roll and back, so those
+// rows must settle too; without it one friction update per point stops the slip).
 double sweepContacts(const std::vector<ContactRow>& contacts, std::vector<LinearContact>& linear,
                      std::vector<ConstraintBody>& moves) {
   double worst = 0;
@@ -80,8 +101,25 @@ double sweepContacts(const std::vector<ContactRow>& contacts, std::vector<Linear
                       l.impulse[2] - relativeMove(c, l, moves, 2) * l.inverseK[2]);
     if (t.norm() > bound) t *= bound / t.norm();
     for (int row = 1; row < 3; ++row) {
-      applyContactImpulse(c, l, row, t(row - 1) - l.impulse[row], moves);
+      const double delta = t(row - 1) - l.impulse[row];
+      if (c.rolling > 0 && l.inverseK[row] > 0) worst = std::max(worst, std::abs(delta) / l.inverseK[row]);
+      applyContactImpulse(c, l, row, delta, moves);
       l.impulse[row] = t(row - 1);
+    }
+    if (c.rolling <= 0) continue;
+    // Rolling resistance: no relative turn about the tangents, while the angular impulse stays in
+    // the disc of rolling x the normal impulse (dissipative like friction: it only ever opposes
+    // the relative turn it finds, up to stopping it).
+    const Eigen::Vector3d turn = moves[c.a].w - moves[c.b].w;
+    Eigen::Vector2d r(l.rollingImpulse[0] - l.dirs.col(1).dot(turn) * l.inverseKRolling[0],
+                      l.rollingImpulse[1] - l.dirs.col(2).dot(turn) * l.inverseKRolling[1]);
+    const double rollingBound = c.rolling * l.impulse[0];
+    if (r.norm() > rollingBound) r *= rollingBound / r.norm();
+    for (int row = 0; row < 2; ++row) {
+      const double delta = r(row) - l.rollingImpulse[row];
+      if (l.inverseKRolling[row] > 0) worst = std::max(worst, std::abs(delta) / l.inverseKRolling[row]);
+      applyRollingImpulse(c, l.dirs.col(row + 1), delta, moves);
+      l.rollingImpulse[row] = r(row);
     }
   }
   return worst;

@@ -21,6 +21,10 @@ struct ContactRow {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitY();  // unit, out of b towards a
   double gain = 0;  // the least separation the displacements must add along the normal (< 0: may approach)
   double friction = 0;  // Coulomb coefficient: the point's tangential slip is held while |t| <= friction n
+  // Rolling resistance (a length): the bodies' relative turn about the tangent plane's axes is
+  // held while that angular impulse stays within rolling x the normal impulse (the normal force
+  // acting that far ahead of the contact point). 0: free rolling.
+  double rolling = 0;
   // The motion of a relative to b at the point that the bodies' own moves leave out (a partner
   // held still in the solve but moving: its velocity at the point, with the sign of its side).
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();
@@ -40,7 +44,8 @@ PreStabilizationReport closeJointsAgainstContacts(const std::vector<JointDefinit
 
 // Step V (Sec. 4.7.1, 4.7.3: contacts as temporary joints in the constrained solve): the
 // velocities projected onto the joints and the contacts together, by projected Gauss-Seidel;
-// each sweep goes over the contact rows (normal >= gain, friction in the cone), then once over
+// each sweep goes over the contact rows (normal >= gain, friction in the cone, rolling resistance
+// in its disc), then once over
 // the joints (projectPairwise, the rows set to zero). The impulses' torques are added to the
 // bodies' angularImpulse. Returns the sweeps and the joints' residual after the last one.
 ProjectionReport projectWithContacts(const std::vector<JointRows>& joints, const std::vector<ContactRow>& contacts,

@@ -194,6 +194,37 @@ TEST(JointClosing, ContactRowsStopTheApproachAndHoldSlipWithinTheFrictionCone) {
   }
 }
 
+// A ball (m = 2, R = 0.07, I = 2/5 m R^2) rolling without slipping at u along x on the ground,
+// with gravity's kick of one step in its velocity: Coulomb friction alone keeps the roll; rolling
+// resistance r slows it by the torque r N's share, Δv = 5 r g dt / (7 R) (the rolling ball's
+// deceleration 5 r g / (7 R)), and stops a slow roll; the kinetic energy never rises.
+TEST(JointClosing, RollingResistanceSlowsARollingBallAsItsTorquePredicts) {
+  const double m = 2, R = 0.07, g = 9.81, dt = 1.0 / 30, I = 0.4 * m * R * R;
+  auto roll = [&](double u, double rolling) {
+    std::vector<ConstraintBody> bodies(2);
+    ConstraintBody& ball = bodies[1];
+    ball.invMass = 1 / m;
+    ball.invInertia = Eigen::Matrix3d::Identity() / I;
+    ball.x = Eigen::Vector3d(0, R, 0);
+    ball.v = Eigen::Vector3d(u, -g * dt, 0);
+    ball.w = Eigen::Vector3d(0, 0, -u / R);  // no slip at the contact point
+    ContactRow c;
+    c.a = 1, c.b = 0, c.point = Eigen::Vector3d::Zero(), c.normal = Eigen::Vector3d::UnitY(), c.friction = 0.6;
+    c.rolling = rolling;
+    const double before = 0.5 * m * ball.v.squaredNorm() + 0.5 * I * ball.w.squaredNorm();
+    projectWithContacts({}, {c}, bodies, 200, 1e-14);
+    const double after = 0.5 * m * ball.v.squaredNorm() + 0.5 * I * ball.w.squaredNorm();
+    EXPECT_LE(after, before);
+    EXPECT_NEAR(ball.v.y(), 0.0, 1e-12);
+    EXPECT_NEAR(ball.v.x() + R * ball.w.z(), 0.0, 1e-12) << "rolls without slipping";
+    return ball.v.x();
+  };
+  EXPECT_NEAR(roll(0.1, 0.0), 0.1, 1e-12);
+  const double r = 1e-3;
+  EXPECT_NEAR(roll(0.1, r), 0.1 - 5 * r * g * dt / (7 * R), 1e-12);
+  EXPECT_NEAR(roll(0.002, r), 0.0, 1e-12) << "a roll slower than one step's resistance stops";
+}
+
 // Two unit bodies on a ball joint 0.1 m apart, the child on a floor (a contact row that lets it
 // gain separation but not lose it), the parent below it (over a hole): closing the joint moves
 // the parent up to the child and not the child into the floor, where closeJoints alone moves
