@@ -11,6 +11,12 @@
 // keeps contacts up to 0.5 cm deep on purpose (b2_linearSlop) and is tuned for bodies of 0.1 to
 // 10 m: figures for centimetre bodies are outside its design range.
 //
+// Joints: a "revolute" joint (a pin) with a world `anchor` and a parent that is "world" or an
+// earlier entity becomes a b2RevoluteJoint (the linked bodies do not collide, as in Monolith);
+// in a jointed scene a body without a `collider` touches nothing. Other joint types, frames,
+// limits and PD are refused with the JSON path. The largest distance between a joint's two
+// anchors over the run is printed after the row.
+//
 // Prints the row of compare_bullet: us/step, largest distance of a dynamic body from its start
 // after the run, final kinetic energy, deepest contact penetration over the smaller body's size
 // at any step (Box2D's separations at its contact points after the step), and the largest rise
@@ -81,24 +87,48 @@ double smallestWidth(const std::vector<b2Vec2>& v) {
   return width;
 }
 
+// A pin of the scene: body indices (-1: the world) and the world anchor at the initial poses.
+struct Pin {
+  int parent = -1, child = -1;
+  b2Vec2 anchor;
+};
+
 struct Body {
   b2Body* body = nullptr;
   double size = kInfinite;  // smallest extent (Monolith's minimumSize); infinite for a plane
   b2Vec2 start;
 };
 
-// Builds the scene's bodies in `world`; returns them in entity order.
-std::vector<Body> load(const Options& o, const json& root, b2World& world) {
+// Builds the scene's bodies in `world`; returns them in entity order, and the pins in `pins`.
+std::vector<Body> load(const Options& o, const json& root, b2World& world, std::vector<Pin>& pins) {
   refuseOtherKeys(root, {"description", "dimension", "time", "gravity", "entities", "solvers", "checks"}, o.scene + ":",
                   "Box2D");
   if (root.value("dimension", 3) != 2) fail(o.scene + ": dimension: only 2-D scenes run in Box2D");
   if (root.contains("gravity")) world.SetGravity(vec2(root["gravity"], o.scene + ": gravity"));
   if (!root.contains("entities") || !root["entities"].is_array()) fail(o.scene + ": entities: expected an array");
   std::vector<Body> bodies;
+  bool jointed = false;
+  for (const json& entity : root["entities"]) jointed = jointed || (entity.is_object() && entity.contains("joint"));
   for (std::size_t e = 0; e < root["entities"].size(); ++e) {
     const json& entity = root["entities"][e];
     const std::string path = o.scene + ": entities[" + std::to_string(e) + "]";
-    refuseOtherKeys(entity, {"name", "shape", "rigid_body", "collider"}, path, "Box2D");
+    refuseOtherKeys(entity, {"name", "shape", "rigid_body", "collider", "joint"}, path, "Box2D");
+    if (entity.contains("joint")) {
+      const json& j = entity["joint"];
+      refuseOtherKeys(j, {"type", "parent", "anchor"}, path + ".joint", "Box2D");
+      if (j.value("type", "") != "revolute") fail(path + ".joint.type: only revolute joints (pins) run in Box2D here");
+      if (!j.contains("anchor")) fail(path + ".joint.anchor: a world anchor is needed here");
+      Pin pin;
+      pin.child = static_cast<int>(e);
+      pin.anchor = vec2(j["anchor"], path + ".joint.anchor");
+      const std::string parent = j.value("parent", "world");
+      if (parent != "world") {
+        for (std::size_t k = 0; k < e; ++k)
+          if (root["entities"][k].value("name", "") == parent) pin.parent = static_cast<int>(k);
+        if (pin.parent < 0) fail(path + ".joint.parent: the parent must be an earlier entity here");
+      }
+      pins.push_back(pin);
+    }
     if (!entity.contains("rigid_body")) fail(path + ".rigid_body: every entity must be a rigid body here");
     if (!entity.contains("shape")) fail(path + ".shape: a rigid body needs a shape");
     const json& rb = entity["rigid_body"];
@@ -183,6 +213,9 @@ std::vector<Body> load(const Options& o, const json& root, b2World& world) {
       fail(path + ".shape.type: '" + type + "' is not carried over (box, disk, polygon and plane are)");
     }
     fixture.density = isStatic ? 0.0f : float(mass / area);
+    // Monolith's bodies without a collider touch nothing; in a jointed scene (a chain that swings
+    // through itself) Box2D's must not either.
+    if (jointed && !entity.contains("collider")) fixture.filter.maskBits = 0;
     made.body->CreateFixture(&fixture);
     bodies.push_back(made);
   }
@@ -199,8 +232,28 @@ int main(int argc, char** argv) {
   world.SetAllowSleeping(o.sleep);
   MinimumCoefficients coefficients;
   world.SetContactListener(&coefficients);
-  std::vector<Body> bodies = load(o, root, world);
+  std::vector<Pin> pins;
+  std::vector<Body> bodies = load(o, root, world, pins);
   for (std::size_t i = 0; i < bodies.size(); ++i) bodies[i].body->GetUserData().pointer = i;
+  // Pins to the world hang on one static body without a fixture.
+  b2Body* ground = nullptr;
+  std::vector<b2Joint*> joints;
+  for (const Pin& pin : pins) {
+    if (pin.parent < 0 && !ground) {
+      b2BodyDef def;
+      ground = world.CreateBody(&def);
+    }
+    b2RevoluteJointDef def;
+    def.Initialize(pin.parent < 0 ? ground : bodies[pin.parent].body, bodies[pin.child].body, pin.anchor);
+    joints.push_back(world.CreateJoint(&def));
+  }
+  // The largest distance between a joint's two anchors (m).
+  const auto jointError = [&] {
+    double worst = 0;
+    for (const b2Joint* j : joints) worst = std::max(worst, double((j->GetAnchorA() - j->GetAnchorB()).Length()));
+    return worst;
+  };
+  double jointErrorMax = 0;
 
   // Kinetic and total (kinetic + gravity's potential) energy of the dynamic bodies.
   const auto energies = [&] {
@@ -233,6 +286,7 @@ int main(int argc, char** argv) {
         penetration = std::max(penetration, -double(manifold.separations[p]) / size);
     }
     highestEnergy = std::max(highestEnergy, energies().second);
+    jointErrorMax = std::max(jointErrorMax, jointError());
   }
   double drift = 0;
   int dynamic = 0;
@@ -250,5 +304,8 @@ int main(int argc, char** argv) {
               1 / time.dt, time.steps, o.velocityIterations, o.positionIterations, o.sleep ? "on" : "off",
               1e6 * wall / time.steps, drift, energies().first, penetration,
               energyRise(highestEnergy, initialEnergy).c_str());
+  if (!joints.empty())
+    std::printf("\n%zu revolute joints: max joint error %.3e m, energy end - start %.4g J\n", joints.size(),
+                jointErrorMax, energies().second - initialEnergy);
   return 0;
 }
