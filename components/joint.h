@@ -143,6 +143,10 @@ struct ArticulationSolver {
   // angular impulse stays within this x the normal impulse (solvers::ContactRow::rolling).
   // Coulomb friction cannot stop a ball or a capsule rolling without slipping; 0: free rolling.
   double rollingResistance = 0;
+  // With colliders: after Step III's shock propagation, the jointed bodies' velocities projected
+  // onto their joints and contacts together, as in Step V (systems/articulation.h,
+  // preStabilizeWithContacts).
+  bool stepThreeContactSolve = false;
 
   template <class V>
   void visitFields(V& visit) {
@@ -158,6 +162,7 @@ struct ArticulationSolver {
     visit("push_out_contact_passes", pushOutContactPasses);
     visit("contact_solve_sweeps", contactSolveSweeps);
     visit("rolling_resistance", rollingResistance);
+    visit("step_three_contact_solve", stepThreeContactSolve);
   }
 };
 

@@ -208,6 +208,7 @@ void parseArticulation(World<d>& world, Entity e, const Config& c) {
       static_cast<int>(c.integer("push_out_contact_passes", s.pushOutContactPasses, 1, 1000));
   s.contactSolveSweeps = static_cast<int>(c.integer("contact_solve_sweeps", s.contactSolveSweeps, 1, 1000000));
   s.rollingResistance = c.number("rolling_resistance", s.rollingResistance, Bound::NonNegative);
+  s.stepThreeContactSolve = c.boolean("step_three_contact_solve", false);
   world.add(e, s);
 }
 
@@ -274,7 +275,7 @@ void registerJointComponents(Registry& r) {
   r.addComponentOf<d, ArticulationSolver>(
       "how the scene's joints are solved (one per scene): post_stabilization/pre_stabilization \"pairwise\" or "
       "\"global\", pre_stabilize, post_iterations, post_tolerance, pre_iterations, pre_tolerance, contact_rounds, "
-      "push_out_contact_sweeps, push_out_contact_passes, contact_solve_sweeps, rolling_resistance (m)",
+      "push_out_contact_sweeps, push_out_contact_passes, contact_solve_sweeps, rolling_resistance (m), step_three_contact_solve",
       parseArticulation<d>);
 }
 

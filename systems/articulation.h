@@ -118,6 +118,14 @@ void resolveJointedInterpenetration(World<d>& world, ContactWorkspace<d>& ws, St
 template <int d>
 void postStabilizeWithContacts(World<d>& world, const ContactWorkspace<d>& ws, StepContext& ctx);
 
+// Step III, after shock propagation, with `step_three_contact_solve` (called from
+// systems/contact.cpp): the same projection of the jointed bodies' velocities onto their joints
+// and contacts as Step V's, at the time-n poses, a gap allowed to close within the step; so
+// that the poses Step IV reaches open neither the joints nor the contacts by what contact's
+// last sweeps and shock propagation left.
+template <int d>
+void preStabilizeWithContacts(World<d>& world, const ContactWorkspace<d>& ws, StepContext& ctx);
+
 // All the joint systems, sharing one velocity memory.
 template <int d>
 std::vector<std::unique_ptr<System<d>>> makeJointSystems();

@@ -57,13 +57,20 @@ void Contact<d>::run(World<d>& world, StepContext& ctx) {
 // after a level is processed its bodies are frozen (infinite mass), so the bodies above cannot
 // push them back down. Everything is unfrozen at the end.
 template <int d>
-void ShockPropagation<d>::run(World<d>&, StepContext& ctx) {
+void ShockPropagation<d>::run(World<d>& world, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (ws.bodies.empty()) return;
   std::vector<int> impulses(ws.islands.members.size(), 0);
   ws.forEachIsland(
       [&](int island) { impulses[island] = ws.propagateShock(island, ImpulseMode::Contact, false, nullptr, nullptr); });
   ws.unpack(false);
+  // Joints (systems/articulation.h): the jointed bodies' velocities onto their joints and
+  // contacts together, where the scene asks for it.
+  if (world.template count<ArticulationJoint<d>>() > 0 && articulationSettings(world).stepThreeContactSolve) {
+    preStabilizeWithContacts(world, ws, ctx);
+    ws.reloadVelocities();
+    ws.updateAllCandidates();
+  }
   int total = 0;
   for (int n : impulses) total += n;
   ctx.diagnostics.set("shock_propagation_impulses", total);

@@ -103,11 +103,40 @@ std::vector<solvers::ContactRow> contactRows(const JointAssembly<d>& a, const Co
 
 }  // namespace
 
-template <int d>
-void postStabilizeWithContacts(World<d>& world, const ContactWorkspace<d>& ws, StepContext& ctx) {
+namespace {
+
+// The jointed bodies' velocities projected onto their joints and their contact points together
+// (the points within kStepFiveMargin, the other bodies held still with their own velocities);
+// `gainOf(depth)` is a point's gain. Returns the contact rows' count.
+template <int d, typename GainOf>
+std::size_t projectJointsAndContacts(World<d>& world, const ContactWorkspace<d>& ws, StepContext& ctx,
+                                     GainOf&& gainOf) {
   const ArticulationSolver s = articulationSettings(world);
   JointAssembly<d> a(world);
   const std::vector<int> bodyOf = assemblyBodies(a, ws);
+  std::vector<solvers::ContactRow> contacts = contactRows(a, ws, bodyOf, kStepFiveMargin, gainOf, true);
+  for (solvers::ContactRow& c : contacts) c.rolling = s.rollingResistance;
+  const solvers::ProjectionReport r =
+      solvers::projectWithContacts(a.rows(), contacts, a.bodies, s.contactSolveSweeps, s.postTolerance);
+  a.writeBack();
+  ctx.diagnostics.max("joint_post_iterations", r.iterations);
+  return contacts.size();
+}
+
+}  // namespace
+
+template <int d>
+void preStabilizeWithContacts(World<d>& world, const ContactWorkspace<d>& ws, StepContext& ctx) {
+  // Touching or overlapping: no approach; apart: the gap may close within the step (the
+  // positions Step IV reaches with these velocities are what this serves).
+  const double dt = ctx.dt, tolerance = ws.settings.pushOutTolerance;
+  const std::size_t n = projectJointsAndContacts(
+      world, ws, ctx, [&](double depth) { return -depth > tolerance ? std::min(0.0, depth / dt) : 0.0; });
+  ctx.diagnostics.set("joint_step_iii_contacts", static_cast<double>(n));
+}
+
+template <int d>
+void postStabilizeWithContacts(World<d>& world, const ContactWorkspace<d>& ws, StepContext& ctx) {
   const double dt = ctx.dt;  // the step Step V's gaps close in
   // Touching or overlapping: no approach (push-out's business). Apart: the gap may close within
   // the step only where the contact stages close gaps (ContactSettings::closeGaps), and a gap
@@ -117,15 +146,10 @@ void postStabilizeWithContacts(World<d>& world, const ContactWorkspace<d>& ws, S
   // stayed (one ragdoll at rest: kinetic energy 1.3e-3 J, 3.4e-7 J with the same rule).
   const bool closeGaps = ws.settings.closeGaps;
   const double tolerance = ws.settings.pushOutTolerance;
-  std::vector<solvers::ContactRow> contacts = contactRows(
-      a, ws, bodyOf, kStepFiveMargin,
-      [&](double depth) { return closeGaps && -depth > tolerance ? std::min(0.0, depth / dt) : 0.0; }, true);
-  for (solvers::ContactRow& c : contacts) c.rolling = s.rollingResistance;
-  const solvers::ProjectionReport r =
-      solvers::projectWithContacts(a.rows(), contacts, a.bodies, s.contactSolveSweeps, s.postTolerance);
-  a.writeBack();
-  ctx.diagnostics.set("joint_step_v_contacts", static_cast<double>(contacts.size()));
-  ctx.diagnostics.max("joint_post_iterations", r.iterations);
+  const std::size_t n = projectJointsAndContacts(world, ws, ctx, [&](double depth) {
+    return closeGaps && -depth > tolerance ? std::min(0.0, depth / dt) : 0.0;
+  });
+  ctx.diagnostics.set("joint_step_v_contacts", static_cast<double>(n));
 }
 
 template <int d>
@@ -198,6 +222,8 @@ void resolveJointedInterpenetration(World<d>& world, ContactWorkspace<d>& ws, St
   ctx.diagnostics.set("joint_push_out_error_left", r.errorAfter);
 }
 
+template void preStabilizeWithContacts<2>(World<2>&, const ContactWorkspace<2>&, StepContext&);
+template void preStabilizeWithContacts<3>(World<3>&, const ContactWorkspace<3>&, StepContext&);
 template void postStabilizeWithContacts<2>(World<2>&, const ContactWorkspace<2>&, StepContext&);
 template void postStabilizeWithContacts<3>(World<3>&, const ContactWorkspace<3>&, StepContext&);
 template void resolveJointedInterpenetration<2>(World<2>&, ContactWorkspace<2>&, StepContext&);
