@@ -26,7 +26,7 @@
 #include "solvers/collision/swept_contact.h"
 #include "solvers/contact/contact_graph.h"
 #include "solvers/contact/contact_settings.h"
-#include "solvers/contact/manifold_problem.h"
+#include "solvers/contact/manifold_solve_end.h"
 #include "solvers/contact/rigid_math.h"
 #include "solvers/parallel/ordered_tasks.h"
 

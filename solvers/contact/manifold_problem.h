@@ -14,11 +14,11 @@
 // clamps the energy and applies the result.
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <vector>
 
 #include "solvers/contact/impulse.h"
 #include "solvers/contact/manifold_pgs.h"
+#include "solvers/contact/manifold_solve_end.h"
 
 namespace monolith::solvers::contact {
 
@@ -28,16 +28,6 @@ inline Vec<d> spinVelocity(const AngVec<d>& w, const Vec<d>& r) {
   if constexpr (d == 3) return w.cross(r);
   else return Vec<d>(-w(0) * r.y(), w(0) * r.x());
 }
-
-// How the last solve of a pair's manifold ended, per point in the narrow phase's order: the
-// exact finish starts the pair's next solve from it (one pass instead of one per point that
-// turns to sliding). ContactPairState keeps one per pair, within the step.
-struct ManifoldSolveEnd {
-  static constexpr int kPoints = 8;
-  std::uint16_t states = 0;    // 2 bits of PointState per point
-  signed char points = 0;      // 0: nothing remembered
-  float angles[kPoints] = {};  // a sliding point's friction direction in its tangent basis
-};
 
 // The normal velocity a contact point may keep while its bodies close the gap they have at the
 // base poses (ContactSettings::closeGaps). The point is found at the candidate poses, which are
