@@ -15,7 +15,7 @@
 #include "solvers/collision/grounded_box.h"
 #include "solvers/contact/energy_clamp.h"
 #include "solvers/contact/impulse.h"
-#include "solvers/contact/manifold_pgs.h"
+#include "solvers/contact/manifold_problem.h"
 
 namespace monolith {
 
@@ -55,13 +55,6 @@ Eigen::Matrix<double, d, d> rotationOf(const Orientation<d>& q) {
   else return Eigen::Rotation2Dd(q).toRotationMatrix();
 }
 
-// w x r written out (2-D: w is a 1-vector about z).
-template <int d>
-inline Eigen::Matrix<double, d, 1> spinFast(const con::AngVec<d>& w, const Eigen::Matrix<double, d, 1>& r) {
-  if constexpr (d == 3) return w.cross(r);
-  else return Eigen::Vector2d(-w(0) * r.y(), w(0) * r.x());
-}
-
 // False when the bodies' bounding balls (about their centres of mass, at the candidate poses)
 // are farther apart than the margin: no contact is possible, the narrow phase can be skipped.
 template <int d>
@@ -99,21 +92,23 @@ con::AngMat<d> splitInverseInertiaAt(const ContactBody<d>& b, const col::Pose<d>
   return b.inverseInertia0;
 }
 
-// The net impulse J of a solved set of points on the body they act on, its angular impulse
-// about that body's centre tau = sum r_a x j, and how many points carry an impulse.
+// The manifold problem of the thread's contact updates (ContactWorkspace::findPairImpulse and
+// updateBodyAgainstFrozen): its storage is kept from update to update.
 template <int d>
-int netImpulse(const std::vector<con::PgsPoint<d>>& points, Eigen::Matrix<double, d, 1>& J, con::AngVec<d>& tau) {
-  J.setZero();
-  tau.setZero();
-  int active = 0;
-  for (const auto& p : points) {
-    const Eigen::Matrix<double, d, 1> j = p.impulse();
-    if (j.squaredNorm() == 0) continue;
-    ++active;
-    J += j;
-    tau += con::cross<d>(p.ra, j);
-  }
-  return active;
+con::ManifoldProblem<d>& threadProblem() {
+  thread_local con::ManifoldProblem<d> problem;
+  return problem;
+}
+
+// The targets of a contact update's points (ManifoldProblem::add).
+inline con::ManifoldTargets targetsOf(const ContactSettings& settings, double dt, double restitution, bool closeGaps) {
+  con::ManifoldTargets t;
+  t.restitution = restitution;
+  t.closeGaps = closeGaps;
+  t.dt = dt;
+  t.gapTolerance = settings.pushOutTolerance;
+  t.approachTolerance = settings.approachTolerance;
+  return t;
 }
 
 // The normal impulse a pair's friction may still lean on in this stage (shock propagation):
@@ -122,84 +117,6 @@ double stageAllowance(const ContactPairState& pair, double mu) {
   if (!(mu > 0)) return 0;
   const auto& f = pair.stageFriction;
   return std::max(0.0, pair.stageNormal - std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) / mu);
-}
-
-// Shock propagation solves an update again leaning on the stage (findPairImpulse) when the
-// plain one leaves a slip above this fraction of the update's largest speed (approach or slip):
-// the creeping stacks it is for keep nearly all their slip, while a projected Gauss-Seidel solve
-// that converged leaves about its stop tolerance (1e-7 of it). Measured on pyramid_20 at the
-// thesis's schedule, 1 s: a re-solve for 9 % of shock propagation's sliding updates at 1e-3,
-// 57 % at the stop tolerance; an off-centre box stays put at 1e-4 to 1e-2 alike.
-constexpr double kLeanSlip = 1e-3;
-
-// The largest slip the solved impulses leave: the tangential relative velocity at each point
-// after them, from the bodies' velocities before the solve (a joint solve's partners: their
-// point velocities, PgsPoint::partnerVelocity).
-template <int d>
-double slipLeft(const std::vector<con::PgsPoint<d>>& points, const con::PgsBodies<d>& before) {
-  using VecD = Eigen::Matrix<double, d, 1>;
-  VecD J = VecD::Zero();
-  con::AngVec<d> tauA = con::AngVec<d>::Zero(), tauB = con::AngVec<d>::Zero();
-  for (const auto& p : points) {
-    const VecD j = p.impulse();
-    J += j;
-    tauA += con::cross<d>(p.ra, j);
-    tauB += con::cross<d>(p.rb, j);
-  }
-  const VecD va = before.va + before.inverseMassA * J, vb = before.vb - before.inverseMassB * J;
-  const con::AngVec<d> wa = before.wa + before.inverseInertiaA * tauA, wb = before.wb - before.inverseInertiaB * tauB;
-  double worst = 0;
-  for (const auto& p : points) {
-    const VecD vrel = va + spinFast<d>(wa, p.ra) - vb - spinFast<d>(wb, p.rb) - p.partnerVelocity;
-    worst = std::max(worst, (vrel - vrel.dot(p.n) * p.n).norm());
-  }
-  return worst;
-}
-
-// Shock propagation (kLeanSlip): where the plain solve, from `before`, leaves a slip above
-// `slipBound`, solves again from `before` with each point's friction leaning on its share of
-// the stage's normal impulse (preloadOf(k), PgsPoint::frictionPreload), by projected
-// Gauss-Seidel (the closed forms have only the plain law). The points are prepared for sweeps in
-// full again: they may have had only the closed form's or the exact finish's preparation.
-template <int d, typename PreloadOf>
-void solveAgainLeaningOnStage(std::vector<con::PgsPoint<d>>& points, con::PgsBodies<d>& state,
-                              const con::PgsBodies<d>& before, double slipBound, double inverseMass,
-                              const con::AngMat<d>& Ia, const con::AngMat<d>& Ib, PreloadOf&& preloadOf,
-                              int iterations, double tolerance) {
-  if (!(slipLeft<d>(points, before) > slipBound)) return;
-  state = before;
-  state.setExactFinish(false);
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    points[k].prepareForSolve(false, inverseMass, Ia, Ib);
-    points[k].normalImpulse = 0;
-    points[k].tangentImpulse.setZero();
-    points[k].frictionPreload = preloadOf(k);
-  }
-  con::pgsSolve<d>(points, state, iterations, tolerance);
-}
-
-// The normal velocity a contact point may keep while its bodies close the gap they have at the
-// base poses (ContactSettings::closeGaps). The point is found at the candidate poses, which are
-// the base poses moved by dt times the velocities, so to first order the bodies are apart by
-// gap = -depth - dt v_n at the base: they may approach at up to gap/dt and end the step just
-// touching. Zero where they already overlap at the base (push-out separates them) or when gaps
-// are not closed (the thesis: every point within the margin counts as touching). A gap within
-// `tolerance` (push-out's: the overlap it leaves alone) counts as touching too: the estimate is
-// first order, a turning body's candidate points lie off it by (dt omega)^2 |r| / 2, and closing
-// such phantom gaps kept a resting pyramid creeping (1e-6 in 3 s instead of 1e-16).
-inline double closableNormalVelocity(bool closeGaps, double depth, double vn, double dt, double tolerance) {
-  if (!closeGaps) return 0.0;
-  const double gap = -depth - dt * vn;
-  return gap > tolerance ? -gap / dt : 0.0;
-}
-
-// A point's target normal velocity: -e v_n where it approaches (contact's e = -1 + eps removes
-// the fraction eps of the approach, notes 1.6), but never more of the approach than the gap
-// leaves to remove (the approach at gap/dt is kept); where it does not approach (beyond closing
-// the gap) it must not start to.
-inline double targetNormalVelocity(bool approaching, double restitution, double vn, double closable) {
-  if (!approaching) return closable;
-  return closable < 0 ? std::min(-restitution * vn, closable) : -restitution * vn;
 }
 
 // Adds a solved update's impulses (on body `a` of the pair when sign = 1, on `b` when -1; the
@@ -212,38 +129,6 @@ void addToStage(ContactPairState& pair, const con::PgsPoint<d>* begin, const con
     const Eigen::Matrix<double, d, 1> f = p->T * p->tangentImpulse;
     for (int k = 0; k < d; ++k) pair.stageFriction[k] += sign * scale * f[k];
   }
-}
-
-// The pair's manifold solve starts where its last one ended (ContactPairState::end), if
-// the narrow phase gave as many points; the point order of a manifold that barely moved is the
-// same. Only a start: the exact finish still checks every condition and changes what fails.
-template <int d>
-void recallEndStates(const ContactPairState& pair, std::vector<con::PgsPoint<d>>& points) {
-  if (pair.end.points != static_cast<int>(points.size())) return;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    con::PgsPoint<d>& p = points[i];
-    p.startState = static_cast<con::PointState>((pair.end.states >> (2 * i)) & 3u);
-    if (p.startState != con::PointState::Sliding) continue;
-    const double angle = pair.end.angles[i];
-    if constexpr (d == 3) p.startDirection = Eigen::Vector2d(std::cos(angle), std::sin(angle));
-    else p.startDirection[0] = angle == 0 ? 1.0 : -1.0;
-  }
-}
-
-template <int d>
-void rememberEndStates(ContactPairState& pair, const std::vector<con::PgsPoint<d>>& points) {
-  pair.end.points = 0;
-  if (points.size() > static_cast<std::size_t>(ContactPairState::SolveEnd::kPoints)) return;
-  pair.end.states = 0;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const con::PgsPoint<d>& p = points[i];
-    const con::PointState state = con::stateFromImpulses(p);
-    pair.end.states |= static_cast<std::uint16_t>(static_cast<unsigned>(state) << (2 * i));
-    if (state != con::PointState::Sliding) continue;
-    if constexpr (d == 3) pair.end.angles[i] = static_cast<float>(std::atan2(p.tangentImpulse[1], p.tangentImpulse[0]));
-    else pair.end.angles[i] = p.tangentImpulse[0] >= 0 ? 0.0f : 3.14159265f;
-  }
-  pair.end.points = static_cast<signed char>(points.size());
 }
 
 }  // namespace
@@ -788,10 +673,6 @@ typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
   // positions, as GBF 2003 and Sec. 2.3.2 compute them; mapping points back through the body's
   // rotation to time n, as the level-set code does for surface vertices, is wrong for round
   // shapes: a rolling disk's deepest point is not a material point).
-  using Point = con::PgsPoint<d>;
-  thread_local std::vector<Point> points;
-  points.clear();
-  bool anyApproaching = false;
   const bool finiteA = !A.infinite(), finiteB = !B.infinite();
   con::PgsBodies<d> state;
   state.va = A.v;
@@ -802,81 +683,30 @@ typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
   state.inverseMassB = B.inverseMass();
   state.movesA = finiteA;  // bodies of infinite mass take no impulse
   state.movesB = finiteB;
-  double speedScale = 0;
   const double allowance = shockFriction && !collision ? stageAllowance(pair, impulse.friction) : 0.0;
-  bool anySliding = false;
+  // Collisions keep the thesis's test (no gaps closed): they meet the time-n velocity, not the
+  // one the candidates moved with, and a body they stop above a gap falls through it in contact.
+  con::ManifoldProblem<d>& problem = threadProblem<d>();
+  problem.start(con::ManifoldProblem<d>::Shape::Pair, state,
+                targetsOf(settings, dt, impulse.restitution, settings.closeGaps && !collision));
   for (const auto& c : scratch) {
     if (c.depth < -query.margin) continue;
-    Point& p = points.emplace_back();  // in place: a prepared point is ~90 numbers
-    p.ra = c.point - poseA.x;
-    p.rb = c.point - poseB.x;
-    p.n = c.normal;
-    const VecD vrel = state.va + spinFast<d>(state.wa, p.ra) - state.vb - spinFast<d>(state.wb, p.rb);
-    const double vn = vrel.dot(p.n);
-    // Collisions keep the thesis's test: they meet the time-n velocity, not the one the
-    // candidates moved with, and a body they stop above a gap falls through it in contact.
-    const double closable =
-        closableNormalVelocity(settings.closeGaps && !collision, c.depth, vn, dt, settings.pushOutTolerance);
-    const bool approaching = vn < closable - settings.approachTolerance;
-    anyApproaching = anyApproaching || approaching;
-    if (allowance > 0) {
-      const double slip = (vrel - vn * p.n).norm();
-      anySliding = anySliding || slip > settings.approachTolerance;
-      speedScale = std::max(speedScale, slip);
-    }
-    p.target = targetNormalVelocity(approaching, impulse.restitution, vn, closable);
-    p.mu = impulse.friction;
-    speedScale = std::max(speedScale, std::abs(p.target) + std::abs(vn));
+    problem.add(VecD(c.point - poseA.x), VecD(c.point - poseB.x), c.normal, VecD::Zero(), c.depth, impulse.friction,
+                allowance > 0);
   }
-  if (!anyApproaching && !anySliding) return {};
-  // K and the Jacobian rows only when something approaches or slides (a solve follows).
+  if (!problem.needsSolve()) return {};
+  problem.setLeaning(0, allowance);
+  // The rows only when something approaches or slides (a solve follows).
   const con::AngMat<d> Ia = finiteA ? splitA : con::AngMat<d>::Zero();
   const con::AngMat<d> Ib = finiteB ? splitB : con::AngMat<d>::Zero();
-  state.inverseInertiaA = Ia;
-  state.inverseInertiaB = Ib;
-  state.setExactFinish(settings.exactManifoldFinish);
-  const bool onePoint = points.size() == 1;
-  if (onePoint) points[0].prepareOnePoint(A.inverseMass() + B.inverseMass(), Ia, Ib);
-  else
-    for (Point& p : points) p.prepareForSolve(state.exactFinish, A.inverseMass() + B.inverseMass(), Ia, Ib);
-
-  // Working copies (state): the impulse of the whole pair is found first, then (second contact
-  // step, collisions) clamped as one against the state before it (Sec. 2.3.2) and applied.
-  const double tolerance = 1e-7 * speedScale + 1e-12;
-  const con::PgsBodies<d> before = state;
-  if (!anyApproaching) {
-    // Only a slip (shock propagation): the plain law has no normal impulse to stop it with.
-  } else if (onePoint) {
-    // One point: the impulse of notes 1.5 (sticking, else sliding along K(n - mu t)).
-    Point& p = points[0];
-    const VecD vrel = state.va + spinFast<d>(state.wa, p.ra) - state.vb - spinFast<d>(state.wb, p.rb);
-    // Its target as a restitution (the same one unless the gap bounds it; vn < 0 here).
-    con::ImpulseSettings toTarget = impulse;
-    const double vn = vrel.dot(p.n);
-    if (p.target != -impulse.restitution * vn) toTarget.restitution = -p.target / vn;
-    const VecD j = con::pointImpulse<d>(p.K, vrel, p.n, toTarget);
-    p.normalImpulse = j.dot(p.n);
-    p.tangentImpulse = p.T.transpose() * (j - p.normalImpulse * p.n);
-  } else {
-    // Several points (a face contact): the pair's impulses are solved together by projected
-    // Gauss-Seidel on accumulated impulses (normal >= 0, friction inside the Coulomb disk), so
-    // a box lying flat stops at all its corners at once instead of rocking between them as
-    // one-point-at-a-time impulses do.
-    if (state.exactFinish) recallEndStates<d>(pair, points);
-    con::pgsSolve<d>(points, state, iterations, tolerance);
-    if (state.exactFinish) rememberEndStates<d>(pair, points);
-  }
-  const double slipBound = std::max(tolerance + settings.approachTolerance, kLeanSlip * speedScale);
-  if (anySliding) {
-    const double share = allowance / double(points.size());
-    solveAgainLeaningOnStage<d>(points, state, before, slipBound, A.inverseMass() + B.inverseMass(), Ia, Ib,
-                                [&](std::size_t) { return share; }, iterations, tolerance);
-  }
+  problem.solve(A.inverseMass() + B.inverseMass(), Ia, Ib, settings.exactManifoldFinish, iterations, &impulse,
+                &pair.end);
   // Net impulse on A and its angular impulse about A's centre.
   VecD J;
   con::AngVec<d> tau;
-  const int active = netImpulse<d>(points, J, tau);
+  const int active = problem.netImpulse(J, tau);
   if (active == 0) return {};
+  const auto& points = problem.points();
   double scale = 1;
   if (clamp) {
     // Energy of the non-split base state; a partner of infinite mass that moves (kinematic)
@@ -925,20 +755,16 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
   // them pair after pair instead leaves a residual slip that shows as a slow creep.
   ContactBody<d>& C = bodies[c];
   if (C.infinite()) return 0;
-  using Point = con::PgsPoint<d>;
-  thread_local std::vector<Point> points;
-  points.clear();
   col::ContactQuery query;
   query.margin = margin;
-  const double restitution = -1.0 + epsilon;
-  const con::AngMat<d> Iinv = C.inverseInertiaCandidate;
   con::PgsBodies<d> state;  // C is body a; the partners are frozen (their velocity per point)
   state.va = C.v;
-  state.wa = Iinv * C.L;
+  state.wa = C.inverseInertiaCandidate * C.L;
   state.inverseMassA = C.inverseMass();
   state.movesA = true;
-  bool anyApproaching = false, anySliding = false;
-  double slipScale = 0;
+  con::ManifoldProblem<d>& problem = threadProblem<d>();
+  problem.start(con::ManifoldProblem<d>::Shape::AgainstFrozen, state,
+                targetsOf(settings, dt, -1.0 + epsilon, settings.closeGaps));
   VecD frameVelocity = VecD::Zero();
   bool frameSet = false, frameKinematic = false;
   // Each pair's points, [pointsEnd[q-1], pointsEnd[q]): their friction leans on what that pair
@@ -951,67 +777,40 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
     const bool cIsA = pair.a == c;
     const ContactBody<d>& P = bodies[cIsA ? pair.b : pair.a];
     scratch.clear();
-    pointsEnd[q] = static_cast<int>(points.size());
+    const std::size_t first = problem.size();
+    pointsEnd[q] = static_cast<int>(first);
     if (!mayTouch<d>(C, P, margin)) continue;
     if (pairContacts(pair, !cIsA, C, P, query, scratch) == 0) continue;
     const double mu = std::min(C.friction, P.friction);
-    const std::size_t first = points.size();
     const double allowance = stageAllowance(pair, mu);
+    const con::AngVec<d> partnerSpin = P.inverseInertiaCandidate * P.L;
     for (const auto& cp : scratch) {
       if (cp.depth < -margin) continue;
-      Point& p = points.emplace_back();
-      p.ra = cp.point - C.candidate.x;
-      p.n = cp.normal;  // out of P towards C: C is "A" in findContacts above
-      p.partnerVelocity = P.v + spinFast<d>(P.inverseInertiaCandidate * P.L, VecD(cp.point - P.candidate.x));
+      const VecD fromP = cp.point - P.candidate.x;
       // The clamp's frame (clampFrameVelocity): a kinematic partner's if there is one.
       if (!frameSet || (P.kinematic && !frameKinematic)) {
-        frameVelocity = clampFrameVelocity(P, VecD(cp.point - P.candidate.x));
+        frameVelocity = clampFrameVelocity(P, fromP);
         frameSet = true;
         frameKinematic = P.kinematic;
       }
-      const VecD vrel = state.va + spinFast<d>(state.wa, p.ra) - p.partnerVelocity;
-      const double vn = vrel.dot(p.n);
-      const double closable = closableNormalVelocity(settings.closeGaps, cp.depth, vn, dt, settings.pushOutTolerance);
-      const bool approaching = vn < closable - settings.approachTolerance;
-      anyApproaching = anyApproaching || approaching;
-      p.target = targetNormalVelocity(approaching, restitution, vn, closable);
-      p.mu = mu;
-      if (allowance > 0) {
-        const double slip = (vrel - vn * p.n).norm();
-        anySliding = anySliding || slip > settings.approachTolerance;
-        slipScale = std::max(slipScale, slip);
-      }
+      // The normal out of P towards C: C is "A" in pairContacts above.
+      problem.add(VecD(cp.point - C.candidate.x), VecD::Zero(), cp.normal,
+                  VecD(P.v + con::spinVelocity<d>(partnerSpin, fromP)), cp.depth, mu, allowance > 0);
     }
-    for (std::size_t k = first; k < points.size(); ++k)
-      points[k].frictionPreload = allowance / double(points.size() - first);
-    pointsEnd[q] = static_cast<int>(points.size());
+    problem.setLeaning(first, allowance);
+    pointsEnd[q] = static_cast<int>(problem.size());
     if (mode != ImpulseMode::Collision) pair.contacted = true;
   }
-  if (!anyApproaching && !anySliding) return 0;
-  const con::AngMat<d> none = con::AngMat<d>::Zero();
-  double speedScale = slipScale;
-  // The plain solve first (the points' allowances kept aside); as in findPairImpulse, solved
-  // again leaning on them where it leaves a slip.
-  thread_local std::vector<double> preloads;
-  preloads.clear();
-  for (Point& p : points) preloads.push_back(std::exchange(p.frictionPreload, 0.0));
-  state.setExactFinish(settings.exactManifoldFinish);
-  for (Point& p : points) {
-    p.prepareForSolve(state.exactFinish, C.inverseMass(), Iinv, none);
-    speedScale = std::max(speedScale, std::abs(p.target));
-  }
-  const double tolerance = 1e-7 * speedScale + 1e-12;
-  state.inverseInertiaA = Iinv;
-  const con::PgsBodies<d> before = state;
-  if (anyApproaching) con::pgsSolve<d>(points, state, iterations, tolerance);
-  const double slipBound = std::max(tolerance + settings.approachTolerance, kLeanSlip * speedScale);
-  if (anySliding)
-    solveAgainLeaningOnStage<d>(points, state, before, slipBound, C.inverseMass(), Iinv, none,
-                                [&](std::size_t k) { return preloads[k]; }, iterations, tolerance);
+  if (!problem.needsSolve()) return 0;
+  // The plain solve first; as in findPairImpulse, solved again leaning on the stage where it
+  // leaves a slip.
+  problem.solve(C.inverseMass(), C.inverseInertiaCandidate, con::AngMat<d>::Zero(), settings.exactManifoldFinish,
+                iterations, nullptr, nullptr);
   VecD J;
   con::AngVec<d> tau;
-  const int active = netImpulse<d>(points, J, tau);
+  const int active = problem.netImpulse(J, tau);
   if (active == 0) return 0;
+  const auto& points = problem.points();
   double scale = 1;
   if (settings.energyClamp && mode == ImpulseMode::ClampedContact) {
     // The partners have infinite mass here; energy is measured in the frame clampFrameVelocity

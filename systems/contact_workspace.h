@@ -26,6 +26,7 @@
 #include "solvers/collision/swept_contact.h"
 #include "solvers/contact/contact_graph.h"
 #include "solvers/contact/contact_settings.h"
+#include "solvers/contact/manifold_solve_end.h"
 #include "solvers/contact/rigid_math.h"
 #include "solvers/parallel/ordered_tasks.h"
 
@@ -110,15 +111,9 @@ struct ContactPairState {
   // may lean on (ContactWorkspace::findPairImpulse, "shockFriction").
   double stageNormal = 0;
   std::array<double, 3> stageFriction = {0, 0, 0};
-  // How the pair's last manifold solve ended, per point in the narrow phase's order: the exact
-  // finish starts the next solve of the pair from it (one pass instead of one per point that
-  // turns to sliding). Within the step only (findPairs starts it empty).
-  struct SolveEnd {
-    static constexpr int kPoints = 8;
-    std::uint16_t states = 0;        // 2 bits of solvers::contact::PointState per point
-    signed char points = 0;          // 0: nothing remembered
-    float angles[kPoints] = {};      // a sliding point's friction direction in its tangent basis
-  } end;
+  // How the pair's last manifold solve ended: the exact finish starts the next solve of the
+  // pair from it. Within the step only (findPairs starts it empty).
+  solvers::contact::ManifoldSolveEnd end;
   // The pair's slot in the workspace's manifold store (ContactWorkspace::pairContacts); -1: none.
   int manifold = -1;
 };

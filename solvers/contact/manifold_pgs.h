@@ -29,12 +29,19 @@ struct PgsPoint {
   using TangentMat = Eigen::Matrix<double, d - 1, d - 1>;
   using AngTangent = Eigen::Matrix<double, kAngularDim<d>, d - 1>;
 
+  // Fields a solve writes before it reads them (the tangent basis, K's blocks, the Jacobian rows,
+  // the offsets) have no initial value: a contact update builds thousands of points a step, and
+  // zeroing the ~90 numbers of each was 4 % of pyramid_20's step. The constructor is written
+  // out so that `points.emplace_back()` does not zero them either (value-initialisation does,
+  // for a class whose default constructor the compiler defines).
+  PgsPoint() {}
+
   VecD ra = VecD::Zero(), rb = VecD::Zero(), n = VecD::Zero();  // lever arms, normal out of b
-  Mat<d> K = Mat<d>::Zero();  // K_a + K_b at the point (impulse.h): prepareOnePoint only
+  Mat<d> K;                   // K_a + K_b at the point (impulse.h): prepareOnePoint only
   double target = 0, mu = 0;  // target normal velocity, Coulomb coefficient
   // Normal impulse the point's friction may lean on beyond its own: the Coulomb disk's radius is
   // mu (lambda + frictionPreload). Shock propagation sets it from what the pair carried earlier
-  // in the stage (ContactWorkspace::findPairImpulse); otherwise 0, the plain Coulomb law.
+  // in the stage (ManifoldProblem::solve); otherwise 0, the plain Coulomb law.
   double frictionPreload = 0;
   // Constant velocity of the partner at the point (joint solve against frozen bodies), else 0.
   VecD partnerVelocity = VecD::Zero();
@@ -47,25 +54,25 @@ struct PgsPoint {
   TangentVec startDirection = TangentVec::UnitX();
 
   // Prepared by prepare(): tangent basis, K's normal and tangent-plane blocks, Jacobian rows.
-  TangentBasis T = TangentBasis::Zero();
-  double kn = 1, inverseKn = 1;
-  TangentVec TKn = TangentVec::Zero();  // T^T K n: tangent velocity per unit normal impulse
-  TangentMat tangentMass = TangentMat::Zero();
-  double inverseTangentMassNorm2 = 1;  // 1 / |tangentMass|_F^2
+  TangentBasis T;
+  double kn, inverseKn;
+  TangentVec TKn;  // T^T K n: tangent velocity per unit normal impulse
+  TangentMat tangentMass;
+  double inverseTangentMassNorm2;  // 1 / |tangentMass|_F^2
   // Ktt = T^T K T = Q diag(tangentStiffness) Q^T, Q = [(c, s), (-s, c)] in 3-D (1 x 1 in 2-D):
   // the metric of the friction projection (projectFriction).
-  double tangentStiffness[d - 1] = {};
-  double eigenCos = 1, eigenSin = 0;
-  AngVec<d> raN = AngVec<d>::Zero(), rbN = AngVec<d>::Zero(), IaRaN = AngVec<d>::Zero(), IbRbN = AngVec<d>::Zero();
-  AngTangent raT = AngTangent::Zero(), rbT = AngTangent::Zero(), IaRaT = AngTangent::Zero(), IbRbT = AngTangent::Zero();
-  double biasN = 0;                      // n . partnerVelocity
-  TangentVec biasT = TangentVec::Zero();  // T^T partnerVelocity
-  // Set by pgsSolve: the constant part of the relative normal and tangent velocities.
-  double offsetN = 0;
-  TangentVec offsetT = TangentVec::Zero();
+  double tangentStiffness[d - 1];
+  double eigenCos, eigenSin;
+  AngVec<d> raN, rbN, IaRaN, IbRbN;
+  AngTangent raT, rbT, IaRaT, IbRbT;
+  double biasN;      // n . partnerVelocity
+  TangentVec biasT;  // T^T partnerVelocity
+  // Set by pgsOffsets: the constant part of the relative normal and tangent velocities.
+  double offsetN;
+  TangentVec offsetT;
   // What prepareRows leaves for prepareSweeps.
-  double inverseMasses_ = 0;
-  bool rotatesA_ = false, rotatesB_ = false;
+  double inverseMasses_;
+  bool rotatesA_, rotatesB_;
 
   // inverseMasses: m_a^{-1} + m_b^{-1}; Ia, Ib: the inverse inertias the impulses are applied
   // with (zero for a body of infinite mass). K's blocks come from the Jacobian rows:
@@ -77,29 +84,41 @@ struct PgsPoint {
   }
   // The Jacobian rows and what the exact finish needs (manifold_polish.h).
   void prepareRows(double inverseMasses, const AngMat<d>& Ia, const AngMat<d>& Ib) {
+    prepareRows(inverseMasses, Ia, Ib, !Ia.isZero(0), !Ib.isZero(0));
+  }
+  // The same with whether each inverse inertia is non-zero given (a solve tells once for all its
+  // points). A body of infinite mass (zero inverse inertia) adds nothing to K: its terms are
+  // skipped and its I^{-1}(r x u) are zero.
+  void prepareRows(double inverseMasses, const AngMat<d>& Ia, const AngMat<d>& Ib, bool rotatesA, bool rotatesB) {
     setTangentBasis();
-    // A body of infinite mass (zero inverse inertia) adds nothing to K: its terms are skipped,
-    // its I^{-1}(r x u) stay zero (a fresh point).
-    rotatesA_ = !Ia.isZero(0), rotatesB_ = !Ib.isZero(0);
+    rotatesA_ = rotatesA, rotatesB_ = rotatesB;
     inverseMasses_ = inverseMasses;
     raN = crossOf(ra, n);
     rbN = crossOf(rb, n);
     if (rotatesA_) IaRaN = Ia * raN;
+    else IaRaN.setZero();
     if (rotatesB_) IbRbN = Ib * rbN;
+    else IbRbN.setZero();
     biasN = n.dot(partnerVelocity);
     for (int k = 0; k < d - 1; ++k) {
       raT.col(k) = crossOf(ra, T.col(k));
       rbT.col(k) = crossOf(rb, T.col(k));
       if (rotatesA_) IaRaT.col(k) = Ia * raT.col(k);
+      else IaRaT.col(k).setZero();
       if (rotatesB_) IbRbT.col(k) = Ib * rbT.col(k);
+      else IbRbT.col(k).setZero();
       biasT[k] = T.col(k).dot(partnerVelocity);
     }
   }
   // What a solve needs before it starts: with the exact finish, which may end it before any
   // sweep, only the rows (pgsSweeps prepares the rest if it sweeps: PgsBodies::sweepsPrepared).
   void prepareForSolve(bool exactFinish, double inverseMasses, const AngMat<d>& Ia, const AngMat<d>& Ib) {
-    if (exactFinish) prepareRows(inverseMasses, Ia, Ib);
-    else prepare(inverseMasses, Ia, Ib);
+    prepareForSolve(exactFinish, inverseMasses, Ia, Ib, !Ia.isZero(0), !Ib.isZero(0));
+  }
+  void prepareForSolve(bool exactFinish, double inverseMasses, const AngMat<d>& Ia, const AngMat<d>& Ib,
+                       bool rotatesA, bool rotatesB) {
+    prepareRows(inverseMasses, Ia, Ib, rotatesA, rotatesB);
+    if (!exactFinish) prepareSweeps();
   }
   // K's normal and tangent-plane blocks, which only the sweeps use (after prepareRows). A solve
   // that the exact finish ends before its first sweep never needs them.

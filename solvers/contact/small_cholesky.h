@@ -90,9 +90,12 @@ class SmallCholesky {
 
  private:
   // L and L D both: the factorisation's inner products take L(i, k) L(j, k) D(k) as l_ times
-  // ld_, one multiply each, and the solves read l_ alone (144 more numbers on the stack).
-  double l_[n][n] = {}, ld_[n][n] = {};
-  double pivot_[n] = {}, inversePivot_[n] = {};
+  // ld_, one multiply each, and the solves read l_ alone (144 more numbers on the stack). No
+  // initial values: the factorisations write every entry that is read (the strict lower
+  // triangles and the pivots), and zeroing them cost about 1 % of a pyramid step (a few
+  // factorisations per pair update).
+  double l_[n][n], ld_[n][n];
+  double pivot_[n], inversePivot_[n];
 };
 
 }  // namespace monolith::solvers::contact

@@ -29,13 +29,12 @@ struct CubeOnPlane {
   explicit CubeOnPlane(double mu) {
     for (double x : {-0.5, 0.5})
       for (double z : {-0.5, 0.5}) {
-        PgsPoint<3> p;
+        PgsPoint<3>& p = points.emplace_back();
         p.ra = V3(x, -0.5, z);
         p.rb = V3(x, -0.5, z);  // unused when b does not move
         p.n = V3::UnitY();
         p.mu = mu;
         p.target = 0;  // approaching corners stop; the others must not start to approach
-        points.push_back(p);
       }
     for (auto& p : points) p.prepare(1 / mass, inverseInertia, M3::Zero());
   }
@@ -142,13 +141,12 @@ TEST(ManifoldPgs, TwoMovingBodiesKeepTheirTotalMomentum) {
   std::vector<PgsPoint<3>> points;
   for (double x : {-0.5, 0.5})
     for (double z : {-0.5, 0.5}) {
-      PgsPoint<3> p;
+      PgsPoint<3>& p = points.emplace_back();
       p.ra = V3(x, -0.5, z);
       p.rb = V3(x, 0.5, z);  // the top face of b, 1 below a's centre
       p.n = V3::UnitY();
       p.mu = 1.0;
       p.target = 0;
-      points.push_back(p);
     }
   const M3 I = 6.0 * M3::Identity();
   for (auto& p : points) p.prepare(2.0, I, I);
@@ -378,12 +376,11 @@ TEST(ExactManifoldFinish, TwoMovingBodiesEndExactlyWithoutApproachAndKeepTheirMo
   std::vector<PgsPoint<3>> points;
   for (double x : {-0.5, 0.5})
     for (double z : {-0.5, 0.5}) {
-      PgsPoint<3> p;
+      PgsPoint<3>& p = points.emplace_back();
       p.ra = V3(x, -0.5, z);
       p.rb = V3(x, 0.5, z);
       p.n = V3::UnitY();
       p.mu = 1.0;
-      points.push_back(p);
     }
   for (auto& p : points) p.prepare(2.0, I, I);
   const V3 momentum = s.va + s.vb;
@@ -490,11 +487,10 @@ TEST(ExactManifoldFinish, BoxLandingFlatIn2DIsAtRestToRounding) {
   s.exactFinish = true;
   std::vector<PgsPoint<2>> points;
   for (double x : {-0.5, 0.5}) {
-    PgsPoint<2> p;
+    PgsPoint<2>& p = points.emplace_back();
     p.ra = V2(x, -0.5);
     p.n = V2::UnitY();
     p.mu = 0.8;
-    points.push_back(p);
   }
   for (auto& p : points) p.prepare(1.0, s.inverseInertiaA, Eigen::Matrix<double, 1, 1>::Zero());
   pgsSolve<2>(points, s, 7, 1e-12);
