@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 namespace monolith::solvers::contact {
 
@@ -112,10 +113,12 @@ void solveDense(const std::vector<JointBody<d>>& bodies, const std::vector<Joint
 // target, since no earlier sweep from t on is quiet for that component; the components left
 // behind run on from where they are (a component never sweeps beyond S, so nothing is undone),
 // until all stop at the same sweep. `sweepOver(list, count)` sweeps the listed points and
-// returns the sweep's largest correction.
+// returns the sweep's largest correction. Returns false, having swept nothing, on one thread or
+// when the points form one component (the caller then sweeps them all in order).
 template <int d, class SweepOver>
-void sweepComponents(std::size_t bodyCount, const std::vector<JointPoint<d>>& points, int sweeps, double tolerance,
+bool sweepComponents(std::size_t bodyCount, const std::vector<JointPoint<d>>& points, int sweeps, double tolerance,
                      SweepOver&& sweepOver) {
+  if (tbb::this_task_arena::max_concurrency() <= 1) return false;  // the same sweeps, in one loop
   // Components by union-find over the jam's bodies (a fixed partner joins nothing).
   std::vector<int> parent(bodyCount);
   std::iota(parent.begin(), parent.end(), 0);
@@ -149,11 +152,7 @@ void sweepComponents(std::size_t bodyCount, const std::vector<JointPoint<d>>& po
     for (std::size_t k = 0; k < points.size(); ++k)
       if (componentOfPoint[k] >= 0) list[next[componentOfPoint[k]]++] = static_cast<int>(k);
   }
-  if (components <= 1) {
-    for (int sweep = 0; sweep < sweeps; ++sweep)
-      if (sweepOver(list.data(), list.size()) <= tolerance) break;
-    return;
-  }
+  if (components <= 1) return false;
   // Per component: sweeps done, whether the last was quiet, and the sweep it stops at
   // (`sweeps`: none quiet from the target on).
   std::vector<int> done(components, 0), stop(components, 0);
@@ -181,7 +180,7 @@ void sweepComponents(std::size_t bodyCount, const std::vector<JointPoint<d>>& po
         },
         tbb::simple_partitioner());
     const int latest = *std::max_element(stop.begin(), stop.end());
-    if (std::all_of(stop.begin(), stop.end(), [&](int s) { return s == latest; })) return;
+    if (std::all_of(stop.begin(), stop.end(), [&](int s) { return s == latest; })) return true;
     target = latest;
   }
 }
@@ -234,12 +233,12 @@ double solveJointPushOut(const std::vector<JointBody<d>>& bodies, const std::vec
     solveDense<d>(bodies, points, rows, lambda);
     for (std::size_t k = 0; k < points.size(); ++k) apply(k, lambda[k]);
   } else {
-    // One Gauss-Seidel sweep over the given points (ascending); returns the largest correction
-    // of a point's separation in it.
-    auto sweepOver = [&](const int* list, std::size_t count) {
+    // One Gauss-Seidel sweep over the points pointAt(0), ..., pointAt(count - 1) (ascending);
+    // returns the largest correction of a point's separation in it.
+    auto sweepPoints = [&](auto&& pointAt, std::size_t count) {
       double largest = 0;
       for (std::size_t i = 0; i < count; ++i) {
-        const std::size_t k = static_cast<std::size_t>(list[i]);
+        const std::size_t k = pointAt(i);
         if (!(rows[k].inverseMass > 0)) continue;
         const double next = std::max(0.0, lambda[k] + (points[k].depth - gained(k)) * rows[k].inverseMass);
         const double change = next - lambda[k];
@@ -250,7 +249,13 @@ double solveJointPushOut(const std::vector<JointBody<d>>& bodies, const std::vec
       }
       return largest;
     };
-    sweepComponents(bodies.size(), points, sweeps, tolerance, sweepOver);
+    auto sweepOver = [&](const int* list, std::size_t count) {
+      return sweepPoints([list](std::size_t i) { return static_cast<std::size_t>(list[i]); }, count);
+    };
+    if (!sweepComponents(bodies.size(), points, sweeps, tolerance, sweepOver)) {
+      for (int sweep = 0; sweep < sweeps; ++sweep)
+        if (sweepPoints([](std::size_t i) { return i; }, points.size()) <= tolerance) break;
+    }
   }
   double violation = 0;
   for (std::size_t k = 0; k < points.size(); ++k) violation = std::max(violation, points[k].depth - gained(k));
