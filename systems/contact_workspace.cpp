@@ -531,22 +531,41 @@ col::Pose<d> ContactWorkspace<d>::reAdvanced(const ContactBody<d>& b, double k) 
 
 template <int d>
 void ContactWorkspace<d>::rebuildPairsFrom(const std::vector<std::pair<int, int>>& found) {
-  // `found` is sorted and contains every known pair (the boxes only grew): walk both lists.
-  std::vector<ContactPairState> merged(found.size());
+  // `found` is sorted and contains every known pair (the boxes only grew): walk both lists for
+  // where each pair comes from (a known pair's index, or -1 for a new one), then fill the new
+  // list at once, each pair in its own slot (the states are large: copying them one after
+  // another was most of a pour's rebuild), and give the new pairs their manifold slots in order.
+  // This thread's buffers, by reference: the workers below must write into these, not their own.
+  thread_local std::vector<int> sourceBuffer;
+  thread_local std::vector<ContactPairState> mergedBuffer;
+  std::vector<int>& source = sourceBuffer;
+  std::vector<ContactPairState>& merged = mergedBuffer;
+  source.resize(found.size());
   std::size_t old = 0;
   for (std::size_t k = 0; k < found.size(); ++k) {
-    if (old < pairs.size() && pairs[old].a == found[k].first && pairs[old].b == found[k].second) {
-      merged[k] = pairs[old++];
-    } else {
-      merged[k].a = found[k].first;
-      merged[k].b = found[k].second;
-      merged[k].manifold = static_cast<int>(manifolds_.size());
-      manifolds_.emplace_back();
-      merged[k].level = levels.levelOf.empty() ? 0 : std::max(levels.levelOf[merged[k].a], levels.levelOf[merged[k].b]);
-    }
+    const bool known = old < pairs.size() && pairs[old].a == found[k].first && pairs[old].b == found[k].second;
+    source[k] = known ? static_cast<int>(old++) : -1;
   }
   if (old != pairs.size()) throw std::logic_error("ContactWorkspace: a grown broad phase lost a pair");
-  pairs = std::move(merged);
+  merged.resize(found.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, found.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k) {
+      if (source[k] >= 0) {
+        merged[k] = pairs[source[k]];
+        continue;
+      }
+      merged[k] = ContactPairState{};
+      merged[k].a = found[k].first;
+      merged[k].b = found[k].second;
+      merged[k].level = levels.levelOf.empty() ? 0 : std::max(levels.levelOf[merged[k].a], levels.levelOf[merged[k].b]);
+    }
+  });
+  for (std::size_t k = 0; k < found.size(); ++k) {
+    if (source[k] >= 0) continue;
+    merged[k].manifold = static_cast<int>(manifolds_.size());
+    manifolds_.emplace_back();
+  }
+  pairs.swap(merged);
   const int n = static_cast<int>(bodies.size());
   con::computeIslands(n, found, infinite_, islands);
   tasks_.setIslands(islands, infinite_);
