@@ -534,7 +534,8 @@ void ContactWorkspace<d>::rebuildPairsFrom(const std::vector<std::pair<int, int>
   // `found` is sorted and contains every known pair (the boxes only grew): walk both lists for
   // where each pair comes from (a known pair's index, or -1 for a new one), then fill the new
   // list at once, each pair in its own slot (the states are large: copying them one after
-  // another was most of a pour's rebuild), and give the new pairs their manifold slots in order.
+  // another was a quarter of a pour's rebuild, the islands and level lists the rest), and give
+  // the new pairs their manifold slots in order.
   // This thread's buffers, by reference: the workers below must write into these, not their own.
   thread_local std::vector<int> sourceBuffer;
   thread_local std::vector<ContactPairState> mergedBuffer;
