@@ -20,19 +20,12 @@ namespace monolith {
 template <int d>
 using Vec = Eigen::Matrix<double, d, 1>;
 
-// How rigid orientations are advanced in Step IV (Sec. 4.4.1, App. A, Sec. 2.2).
-struct RigidRotationSettings {
-  int order = 2;           // 1: exp(dt w*) [169]; 2: Sec. 4.4.1; 3: App. A
-  bool energyFix = true;   // kinetic-energy orientation fix, Sec. 2.2.2-2.2.4
-};
-
 // Scene-wide physical settings shared by systems (read-only during a step). The settings of one
-// group of systems (contact, fluid) are resources instead (World::resource), declared next to
-// the solvers they steer.
+// group of systems (contact, fluid, the rigid rotation rule) are resources instead
+// (World::resource), declared next to the solvers they steer.
 template <int d>
 struct WorldSettings {
   Vec<d> gravity = Vec<d>::Zero();
-  RigidRotationSettings rigidRotation;
 };
 
 // A scene-wide value of a type the world knows nothing of (a solver's settings): stored under

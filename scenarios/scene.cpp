@@ -15,6 +15,7 @@
 #include "ecs/plugin.h"
 #include "solvers/contact/contact_settings.h"
 #include "solvers/fluid/fluid_settings.h"
+#include "solvers/rigid_rotation_settings.h"
 #include "scenarios/plugin_search.h"
 #include "systems/sleep.h"
 #include "scenarios/joint_components.h"
@@ -502,14 +503,15 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
   WorldSettings<d> settings = world.settings();
   ContactSettings contact = world.template resource<ContactSettings>();
   FluidSolverSettings fluid = world.template resource<FluidSolverSettings>();
+  RigidRotationSettings rotation = world.template resource<RigidRotationSettings>();
   if (scene.json.contains("gravity")) settings.gravity = top.vector("gravity", d);
 
   if (scene.json.contains("solvers")) {
     const Config solvers = top.child("solvers");
     if (solvers.has("rigid_rotation")) {
       const Config rr = solvers.child("rigid_rotation");
-      settings.rigidRotation.order = static_cast<int>(rr.integer("order", 2, 1, 3));
-      settings.rigidRotation.energyFix = rr.boolean("energy_fix", true);
+      rotation.order = static_cast<int>(rr.integer("order", 2, 1, 3));
+      rotation.energyFix = rr.boolean("energy_fix", true);
       rr.finish();
     }
     if (solvers.has("fluid")) parseFluidSolverSettings(solvers.child("fluid"), fluid);
@@ -573,6 +575,7 @@ void populateWorld(const SceneSpec& scene, const Registry& registry, World<d>& w
   world.settings() = settings;
   world.template mutableResource<ContactSettings>() = contact;
   world.template mutableResource<FluidSolverSettings>() = fluid;
+  world.template mutableResource<RigidRotationSettings>() = rotation;
   if (contact.sleep) enableSleeping(world);
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "solvers/rigid_rotation.h"
+#include "solvers/rigid_rotation_settings.h"
 #include "systems/parallel.h"
 #include "systems/rigid_inertia.h"
 
@@ -14,7 +15,7 @@ void AdvanceRigidPositions<d>::run(World<d>& world, StepContext& ctx) {
   auto& forces = world.template pool<RigidForces<d>>();  // one per dynamic body
   auto& bodies = world.template pool<RigidBody<d>>();
   const double dt = ctx.dt;
-  const RigidRotationSettings rule = world.settings().rigidRotation;
+  const RigidRotationSettings rule = world.template resource<RigidRotationSettings>();
   reports_.assign(forces.size(), BodyReport{});
 
   const auto* sleeps = world.template findPool<Sleep<d>>();

@@ -9,6 +9,7 @@
 #include "components/sleep.h"
 #include "solvers/articulation/joint_constraints.h"
 #include "solvers/rigid_rotation.h"
+#include "solvers/rigid_rotation_settings.h"
 #include "systems/joint_assembly.h"
 #include "systems/rigid_inertia.h"
 
@@ -181,7 +182,7 @@ void preStabilizeJointVelocities(World<d>& world, StepContext& ctx) {
   const ArticulationSolver s = articulationSettings(world);
   JointAssembly<d> a(world);
   const double dt = ctx.dt;
-  const RigidRotationSettings rule = world.settings().rigidRotation;
+  const RigidRotationSettings rule = world.template resource<RigidRotationSettings>();
   std::vector<solvers::BodyInertia> inertia(a.bodies.size());
   if constexpr (d == 3)
     for (std::size_t i = 1; i < a.bodies.size(); ++i)

@@ -398,10 +398,7 @@ void ContactWorkspace<d>::findPairs() {
   resetManifolds(found.size());
   con::computeIslands(n, found, infinite_, islands);
   islandPairsByLevel = islands.pairs;
-  memberIndex_.assign(n, -1);
-  for (const auto& members : islands.members)
-    for (std::size_t k = 0; k < members.size(); ++k) memberIndex_[members[k]] = static_cast<int>(k);
-  schedules_.resize(islands.members.size());
+  tasks_.setIslands(islands, infinite_);
 }
 
 template <int d>
@@ -419,28 +416,45 @@ col::Pose<d> ContactWorkspace<d>::reAdvanced(const ContactBody<d>& b, double k) 
 
 template <int d>
 void ContactWorkspace<d>::rebuildPairsFrom(const std::vector<std::pair<int, int>>& found) {
-  // `found` is sorted and contains every known pair (the boxes only grew): walk both lists.
-  std::vector<ContactPairState> merged(found.size());
+  // `found` is sorted and contains every known pair (the boxes only grew): walk both lists for
+  // where each pair comes from (a known pair's index, or -1 for a new one), then fill the new
+  // list at once, each pair in its own slot (the states are large: copying them one after
+  // another was a quarter of a pour's rebuild, the islands and level lists the rest), and give
+  // the new pairs their manifold slots in order.
+  // This thread's buffers, by reference: the workers below must write into these, not their own.
+  thread_local std::vector<int> sourceBuffer;
+  thread_local std::vector<ContactPairState> mergedBuffer;
+  std::vector<int>& source = sourceBuffer;
+  std::vector<ContactPairState>& merged = mergedBuffer;
+  source.resize(found.size());
   std::size_t old = 0;
   for (std::size_t k = 0; k < found.size(); ++k) {
-    if (old < pairs.size() && pairs[old].a == found[k].first && pairs[old].b == found[k].second) {
-      merged[k] = pairs[old++];
-    } else {
-      merged[k].a = found[k].first;
-      merged[k].b = found[k].second;
-      merged[k].manifold = static_cast<int>(manifolds_.size());
-      manifolds_.emplace_back();
-      merged[k].level = levels.levelOf.empty() ? 0 : std::max(levels.levelOf[merged[k].a], levels.levelOf[merged[k].b]);
-    }
+    const bool known = old < pairs.size() && pairs[old].a == found[k].first && pairs[old].b == found[k].second;
+    source[k] = known ? static_cast<int>(old++) : -1;
   }
   if (old != pairs.size()) throw std::logic_error("ContactWorkspace: a grown broad phase lost a pair");
-  pairs = std::move(merged);
+  merged.resize(found.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, found.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k) {
+      if (source[k] >= 0) {
+        merged[k] = pairs[source[k]];
+        continue;
+      }
+      merged[k] = ContactPairState{};
+      merged[k].a = found[k].first;
+      merged[k].b = found[k].second;
+      merged[k].level = levels.levelOf.empty() ? 0 : std::max(levels.levelOf[merged[k].a], levels.levelOf[merged[k].b]);
+    }
+  });
+  for (std::size_t k = 0; k < found.size(); ++k) {
+    if (source[k] >= 0) continue;
+    merged[k].manifold = static_cast<int>(manifolds_.size());
+    manifolds_.emplace_back();
+  }
+  pairs.swap(merged);
   const int n = static_cast<int>(bodies.size());
   con::computeIslands(n, found, infinite_, islands);
-  memberIndex_.assign(n, -1);
-  for (const auto& members : islands.members)
-    for (std::size_t k = 0; k < members.size(); ++k) memberIndex_[members[k]] = static_cast<int>(k);
-  schedules_.resize(islands.members.size());
+  tasks_.setIslands(islands, infinite_);
   sortIslandPairsByLevel();
 }
 
@@ -834,68 +848,15 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
 }
 
 template <int d>
-void ContactWorkspace<d>::startOrder(solvers::parallel::OrderedTasks& order, int island, std::size_t taskBound) const {
-  const int members = static_cast<int>(islands.members[island].size());
+int ContactWorkspace<d>::taskGrain() const {
   // Blocks of 4 updates: measured on 2 threads (docs/benchmarks.md) against 1, 2, 8 and 16, it
   // keeps pyramid_20's speed-up and stops the cheap sphere-pair checks of a pour from costing
   // more to hand over than to run. With the exact finish most manifold solves end before their
   // first sweep, so an update costs less and blocks of 2 hand over better: on 2 threads the
   // short-schedule pyramid_20 step took 17 % less time with 2 than with 4 (16: 19 % more),
   // while at the defaults and in the 250-sphere pour 2 cost 2-5 % more (the git history of docs/benchmarks.md
-  // ("Exact finish before the first sweep")). One thread (or one body): no dependencies needed.
-  // Nor when the sequence cannot have the blocks OrderedTasks::run needs to share it (a small
-  // island): recording the dependencies of tasks that will run in order anyway cost the
-  // falling 250-sphere pour a fifth of its step on 2 threads (the git history of docs/benchmarks.md ("Pours on two
-  // threads")).
-  const int grain = settings.exactManifoldFinish ? 2 : 4;
-  const bool shareable = taskBound >= static_cast<std::size_t>(solvers::parallel::OrderedTasks::kMinimumBlocks) *
-                                          static_cast<std::size_t>(grain);
-  order.reset(members, grain, members > 1 && shareable && tbb::this_task_arena::max_concurrency() > 1);
-}
-
-template <int d>
-void ContactWorkspace<d>::addOrdered(solvers::parallel::OrderedTasks& order, const std::vector<char>& frozen,
-                                     const int* touched, int count) const {
-  if (!order.tracking()) {
-    order.add(nullptr, 0, nullptr, 0);
-    return;
-  }
-  // Room for every touched body, filled by index (this runs once per recorded task).
-  thread_local std::vector<int> writes, reads;
-  if (writes.size() < static_cast<std::size_t>(count)) writes.resize(count), reads.resize(count);
-  int writeCount = 0, readCount = 0;
-  for (int i = 0; i < count; ++i) {
-    const ContactBody<d>& b = bodies[touched[i]];
-    if (b.immovable()) continue;
-    const int local = memberIndex_[touched[i]];
-    if (frozen[local]) reads[readCount++] = local;
-    else writes[writeCount++] = local;
-  }
-  order.add(writes.data(), writeCount, reads.data(), readCount);
-}
-
-template <int d>
-typename ContactWorkspace<d>::IslandSchedule& ContactWorkspace<d>::startSchedule(int island, ImpulseMode mode,
-                                                                                  std::size_t taskBound,
-                                                                                  double* clampEnergyChange,
-                                                                                  int* clampsApplied) {
-  IslandSchedule& s = schedules_[island];
-  s.mode = mode;
-  s.energyOut = clampEnergyChange;
-  s.clampsOut = clampsApplied;
-  s.impulseSum = 0;  // the per-task result slots are sized by runSchedule
-  startOrder(s.order, island, taskBound);
-  s.collisionSweepRecorded = false;
-  s.tasks.clear();
-  s.jointPairs.clear();
-  s.frozen.assign(islands.members[island].size(), 0);
-  return s;
-}
-
-template <int d>
-bool ContactWorkspace<d>::infiniteIn(const IslandSchedule& s, int body) const {
-  const ContactBody<d>& b = bodies[body];
-  return b.immovable() || (memberIndex_[body] >= 0 && s.frozen[memberIndex_[body]]);
+  // ("Exact finish before the first sweep")).
+  return settings.exactManifoldFinish ? 2 : 4;
 }
 
 // What a collision check leaves for the skip test (notes 1.4): the bodies it moved carry its
@@ -909,83 +870,47 @@ void markCollisionChecked(ContactPairState& pair, ContactBody<d>& A, ContactBody
   pair.checkedStamp = stamp + 1;
 }
 
-// One update's counts added to a sweep's sums, each where it is wanted (an energy change only
-// where a clamp acted or the change is not zero, so that a sum of zeros stays exactly as it was).
-inline void addUpdateCounts(int impulses, int clamps, double energyChange, int* impulseSum, int* clampsOut,
-                            double* energyOut) {
-  if (impulseSum) *impulseSum += impulses;
-  if (clampsOut) *clampsOut += clamps;
-  if (energyOut && (clamps != 0 || energyChange != 0)) *energyOut += energyChange;
-}
-
 template <int d>
-void ContactWorkspace<d>::runTask(IslandSchedule& s, const SweepTask& t, int k,
-                                  std::vector<col::ContactPoint<d>>& scratch) {
-  // Results go to per-task slots, written only when not zero (most updates apply nothing, and
-  // neighbouring slots may belong to tasks running on the other core).
-  double energyChange = 0;
-  int clampCount = 0, impulseCount = 0;
+TaskCounts ContactWorkspace<d>::runTask(const SweepTask& t, ImpulseMode mode, const std::vector<int>& lists) {
+  thread_local std::vector<col::ContactPoint<d>> scratch;  // per worker thread
+  TaskCounts c;
   switch (t.kind) {
     case SweepTask::Kind::Collision: {
       ContactPairState& pair = pairs[t.index];
       ContactBody<d>& A = bodies[pair.a];
       ContactBody<d>& B = bodies[pair.b];
       // Checked after both bodies last moved: nothing new to find (notes 1.4).
-      if (pair.checkedStamp > std::max(A.movedStamp, B.movedStamp)) return;
-      impulseCount = updatePair(pair, ImpulseMode::Collision, 0.0, t.iterations, 0.0, scratch, &energyChange,
-                                &clampCount);
-      markCollisionChecked(pair, A, B, t.stamp, impulseCount > 0);
+      if (pair.checkedStamp > std::max(A.movedStamp, B.movedStamp)) return c;
+      c.impulses = updatePair(pair, ImpulseMode::Collision, 0.0, t.iterations, 0.0, scratch, &c.energyChange,
+                              &c.clamps);
+      markCollisionChecked(pair, A, B, t.stamp, c.impulses > 0);
       break;
     }
     case SweepTask::Kind::Pair:
-      impulseCount = updatePair(pairs[t.index], s.mode, t.epsilon, t.iterations, settings.thickness, scratch,
-                                &energyChange, &clampCount, t.shockFriction);
+      c.impulses = updatePair(pairs[t.index], mode, t.epsilon, t.iterations, settings.thickness, scratch,
+                              &c.energyChange, &c.clamps, t.shockFriction);
       break;
     case SweepTask::Kind::Joint:
-      impulseCount = updateBodyAgainstFrozen(t.index, s.jointPairs.data() + t.listBegin, t.listEnd - t.listBegin,
-                                             s.mode, t.epsilon, t.iterations, settings.thickness, scratch,
-                                             &energyChange, &clampCount);
+      c.impulses = updateBodyAgainstFrozen(t.index, lists.data() + t.listBegin, t.listEnd - t.listBegin, mode,
+                                           t.epsilon, t.iterations, settings.thickness, scratch, &c.energyChange,
+                                           &c.clamps);
       break;
     case SweepTask::Kind::Freeze:
       bodies[t.index].frozen = true;
-      return;
+      break;
   }
-  if (!s.order.tracking()) {  // run in order: the results go straight to the sums
-    addUpdateCounts(impulseCount, clampCount, energyChange, &s.impulseSum, s.clampsOut, s.energyOut);
-    return;
-  }
-  if (energyChange != 0) s.energyChange[k] = energyChange;
-  if (clampCount != 0) s.clamps[k] = clampCount;
-  if (impulseCount != 0) s.impulses[k] = impulseCount;
+  return c;
 }
 
 template <int d>
-void ContactWorkspace<d>::addTask(IslandSchedule& s, const SweepTask& task, const int* touched, int count) {
-  if (!s.order.tracking()) {
-    // On one thread the task runs as soon as it is recorded: the order is the same, and nothing
-    // the recording decides depends on what the earlier tasks did (see contactSweeps).
-    runTask(s, task, -1, s.scratch);
-    return;
-  }
-  s.tasks.push_back(task);  // its result slots are sized once, by runSchedule
-  addOrdered(s.order, s.frozen, touched, count);
+void ContactWorkspace<d>::addTask(Sequence& s, ImpulseMode mode, const SweepTask& task, const int* touched,
+                                  int count) {
+  tasks_.add(s, task, touched, count, [&](const SweepTask& t) { return runTask(t, mode, s.lists); });
 }
 
 template <int d>
-int ContactWorkspace<d>::runSchedule(IslandSchedule& s) {
-  if (!s.order.tracking()) return s.impulseSum;  // already run, as recorded
-  s.impulses.assign(s.tasks.size(), 0);
-  s.clamps.assign(s.tasks.size(), 0);
-  s.energyChange.assign(s.tasks.size(), 0.0);
-  s.order.run([&](int k) {
-    thread_local std::vector<col::ContactPoint<d>> scratch;  // per worker thread
-    runTask(s, s.tasks[k], k, scratch);
-  });
-  // Diagnostics summed in the sequential order, so they too do not depend on the thread count.
-  int impulses = 0;
-  for (std::size_t k = 0; k < s.tasks.size(); ++k)
-    addUpdateCounts(s.impulses[k], s.clamps[k], s.energyChange[k], &impulses, s.clampsOut, s.energyOut);
-  return impulses;
+int ContactWorkspace<d>::runTasks(Sequence& s, ImpulseMode mode) {
+  return tasks_.run(s, [&](const SweepTask& t) { return runTask(t, mode, s.lists); });
 }
 
 // Stamps that grow along the whole sequence of checks, sweep after sweep: "moved" gets the
@@ -996,7 +921,7 @@ inline long collisionStamp(int sweep, std::size_t pairCount, std::size_t k) {
 }
 
 template <int d>
-int ContactWorkspace<d>::runCollisionTasks(IslandSchedule& s, int island, int sweep, std::size_t from) {
+int ContactWorkspace<d>::runCollisionTasks(Sequence& s, int island, int sweep, std::size_t from) {
   const auto& list = islands.pairs[island];
   for (std::size_t k = from; k < list.size(); ++k) {
     SweepTask t;
@@ -1005,28 +930,28 @@ int ContactWorkspace<d>::runCollisionTasks(IslandSchedule& s, int island, int sw
     t.iterations = settings.collisionPairIterations;
     t.stamp = collisionStamp(sweep, list.size(), k);
     const int touched[2] = {pairs[t.index].a, pairs[t.index].b};
-    addTask(s, t, touched, 2);
+    addTask(s, ImpulseMode::Collision, t, touched, 2);
   }
-  return runSchedule(s);
+  return runTasks(s, ImpulseMode::Collision);
 }
 
 template <int d>
 int ContactWorkspace<d>::collisionSweep(int island, int sweep, double* clampEnergyChange, int* clampsApplied) {
   const auto& list = islands.pairs[island];
   auto stamp = [&](std::size_t k) { return collisionStamp(sweep, list.size(), k); };
-  IslandSchedule& again = schedules_[island];
-  if (sweep > 0 && again.collisionSweepRecorded && again.tasks.size() == list.size()) {
+  Sequence& again = tasks_.sequence(island);
+  if (sweep > 0 && again.reusable && again.tasks.size() == list.size()) {
     // The previous sweep's tasks and dependencies, with this sweep's stamps (recording them
     // again cost about what the second thread saved in a pour's settled pile).
     for (std::size_t k = 0; k < list.size(); ++k) again.tasks[k].stamp = stamp(k);
     again.energyOut = clampEnergyChange;
     again.clampsOut = clampsApplied;
-    return runSchedule(again);
+    return runTasks(again, ImpulseMode::Collision);
   }
   if (sweep == 0 && lastCollisionImpulses == 0 && list.size() >= 64 && tbb::this_task_arena::max_concurrency() > 1)
     return speculativeCollisionSweep(island, clampEnergyChange, clampsApplied);
-  IslandSchedule& s = startSchedule(island, ImpulseMode::Collision, list.size(), clampEnergyChange, clampsApplied);
-  s.collisionSweepRecorded = s.order.tracking();  // later sweeps of the step reuse the tasks
+  Sequence& s = tasks_.start(island, list.size(), taskGrain(), clampEnergyChange, clampsApplied);
+  s.reusable = s.order.tracking();  // later sweeps of the step reuse the tasks
   return runCollisionTasks(s, island, sweep, 0);
 }
 
@@ -1055,11 +980,11 @@ int ContactWorkspace<d>::speculativeCollisionSweep(int island, double* clampEner
     ContactPairState& pair = pairs[list[k]];
     pair = probe.pair;
     markCollisionChecked(pair, bodies[pair.a], bodies[pair.b], stamp(k), false);
-    addUpdateCounts(0, probe.clamps, probe.energyChange, nullptr, clampsApplied, clampEnergyChange);
+    addTaskCounts({0, probe.clamps, probe.energyChange}, nullptr, clampsApplied, clampEnergyChange);
   }
   if (k == n) return 0;
   // 3. The rest as the ordered sweep runs them (recorded afresh; later sweeps record their own).
-  IslandSchedule& s = startSchedule(island, ImpulseMode::Collision, n - k, clampEnergyChange, clampsApplied);
+  Sequence& s = tasks_.start(island, n - k, taskGrain(), clampEnergyChange, clampsApplied);
   return runCollisionTasks(s, island, 0, k);
 }
 
@@ -1073,8 +998,8 @@ int ContactWorkspace<d>::contactSweeps(int island, ImpulseMode mode, bool onlyCo
     pairs[k].stageNormal = 0;
     pairs[k].stageFriction = {0, 0, 0};
   }
-  IslandSchedule& s = startSchedule(island, mode, list.size() * iterations * levelIterations, clampEnergyChange,
-                                    clampsApplied);
+  Sequence& s =
+      tasks_.start(island, list.size() * iterations * levelIterations, taskGrain(), clampEnergyChange, clampsApplied);
   for (int it = 0; it < iterations; ++it) {
     for (std::size_t begin = 0; begin < list.size();) {
       std::size_t end = begin;
@@ -1092,13 +1017,13 @@ int ContactWorkspace<d>::contactSweeps(int island, ImpulseMode mode, bool onlyCo
           t.epsilon = eps;
           t.iterations = settings.contactPairIterations;
           const int touched[2] = {pair.a, pair.b};
-          addTask(s, t, touched, 2);
+          addTask(s, mode, t, touched, 2);
         }
       }
       begin = end;
     }
   }
-  return runSchedule(s);
+  return runTasks(s, mode);
 }
 
 template <int d>
@@ -1106,9 +1031,8 @@ int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyC
                                         int* clampsApplied) {
   const auto& list = islandPairsByLevel[island];
   // At most one task per pair and level iteration, and one freeze per body.
-  IslandSchedule& s = startSchedule(island, mode,
-                                    list.size() * settings.shockLevelIterations + islands.members[island].size(),
-                                    clampEnergyChange, clampsApplied);
+  Sequence& s = tasks_.start(island, list.size() * settings.shockLevelIterations + islands.members[island].size(),
+                             taskGrain(), clampEnergyChange, clampsApplied);
   // Per level, what each of its pairs does in every level iteration (the level's pairs and which
   // bodies are frozen do not change during them): a joint solve of the upper body against its
   // partners of infinite mass, at the first of its pairs with such a partner; nothing, for the
@@ -1137,7 +1061,7 @@ int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyC
       e.upper = levels.levelOf[pair.a] == level ? pair.a : pair.b;
       e.other = e.upper == pair.a ? pair.b : pair.a;
       e.position = static_cast<int>(entries.size());
-      if (infiniteIn(s, e.other) && !infiniteIn(s, e.upper)) byUpper.push_back(e.position);
+      if (tasks_.fixedIn(s, e.other) && !tasks_.fixedIn(s, e.upper)) byUpper.push_back(e.position);
       entries.push_back(e);
     }
     // Each upper body's pairs with a partner of infinite mass, in level order.
@@ -1172,37 +1096,37 @@ int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyC
         if (e.role == Role::Joint) {
           t.kind = SweepTask::Kind::Joint;
           t.index = e.upper;
-          t.listBegin = static_cast<int>(s.jointPairs.size());
+          t.listBegin = static_cast<int>(s.lists.size());
           jointBodies.assign(1, e.upper);
           for (int q = e.ownBegin; q < e.ownEnd; ++q) {
-            s.jointPairs.push_back(entries[own[q]].pair);
+            s.lists.push_back(entries[own[q]].pair);
             jointBodies.push_back(entries[own[q]].other);
           }
-          t.listEnd = static_cast<int>(s.jointPairs.size());
-          addTask(s, t, jointBodies.data(), static_cast<int>(jointBodies.size()));
+          t.listEnd = static_cast<int>(s.lists.size());
+          addTask(s, mode, t, jointBodies.data(), static_cast<int>(jointBodies.size()));
           continue;
         }
         t.kind = SweepTask::Kind::Pair;
         t.index = e.pair;
         const ContactPairState& pair = pairs[e.pair];
         const int touched[2] = {pair.a, pair.b};
-        addTask(s, t, touched, 2);
+        addTask(s, mode, t, touched, 2);
       }
     }
     for (std::size_t k = begin; k < end; ++k) {
       const ContactPairState& p = pairs[list[k]];
       for (int body : {p.a, p.b}) {
-        if (levels.levelOf[body] != level || infiniteIn(s, body)) continue;
+        if (levels.levelOf[body] != level || tasks_.fixedIn(s, body)) continue;
         SweepTask t;
         t.kind = SweepTask::Kind::Freeze;
         t.index = body;
-        addTask(s, t, &body, 1);
-        s.frozen[memberIndex_[body]] = 1;
+        addTask(s, mode, t, &body, 1);
+        tasks_.markFrozen(s, body);
       }
     }
     begin = end;
   }
-  const int impulses = runSchedule(s);
+  const int impulses = runTasks(s, mode);
   for (int m : islands.members[island]) bodies[m].frozen = false;
   return impulses;
 }

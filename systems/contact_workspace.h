@@ -29,6 +29,7 @@
 #include "solvers/contact/manifold_solve_end.h"
 #include "solvers/contact/rigid_math.h"
 #include "solvers/parallel/ordered_tasks.h"
+#include "systems/island_tasks.h"
 
 namespace monolith {
 
@@ -255,21 +256,28 @@ class ContactWorkspace {
   // level's bodies frozen (infinite mass) once its pairs are done; all unfrozen at the end.
   int propagateShock(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange, int* clampsApplied);
 
-  // Ordered tasks over one island's bodies (see the private part below): `startOrder` resets
-  // `order` for the island; `addOrdered` appends a task touching the given bodies, declaring
-  // those of finite mass as written, those frozen (per island member, `frozen`) as read, and
-  // static and kinematic ones, which contact never changes, not at all.
-  // `taskBound`: at most how many tasks will be added (dependencies are recorded only if that
-  // many could be shared).
-  void startOrder(solvers::parallel::OrderedTasks& order, int island, std::size_t taskBound) const;
-  void addOrdered(solvers::parallel::OrderedTasks& order, const std::vector<char>& frozen, const int* touched,
-                  int count) const;
-  int memberIndex(int body) const { return memberIndex_[body]; }
-
-  // Runs f(islandIndex) for every island in parallel (bodies of different islands are disjoint,
-  // so results do not depend on the thread count).
+  // One update of a contact stage as the island/task layer records it (systems/island_tasks.h):
+  // the stages' sweeps record their updates in the thesis's order and run them as ordered tasks.
+  struct SweepTask {
+    enum class Kind : char { Collision, Pair, Joint, Freeze };
+    Kind kind = Kind::Pair;
+    int index = 0;                   // the pair (Collision, Pair) or the body (Joint, Freeze)
+    int listBegin = 0, listEnd = 0;  // Joint: its pairs, in the sequence's lists
+    double epsilon = 0;
+    int iterations = 0;
+    bool shockFriction = false;  // Pair, Joint: in shock propagation (findPairImpulse)
+    long stamp = 0;  // Collision: the stamp of this check (increasing along the sequence)
+  };
+  // The island/task layer: the islands run at once, each island's updates as ordered tasks,
+  // bitwise the one-thread result. Push-out's rounds record their own tasks through it.
+  IslandTasks<SweepTask>& islandTasks() { return tasks_; }
+  const IslandTasks<SweepTask>& islandTasks() const { return tasks_; }
   template <class F>
-  void forEachIsland(F&& f);
+  void forEachIsland(F&& f) {
+    tasks_.forEachIsland(std::forward<F>(f));
+  }
+  // How many consecutive updates the ordered tasks hand out together (see the definition).
+  int taskGrain() const;
 
   // The step energy clamp (ContactSettings::stepEnergyClamp; systems/step_energy_clamp.cpp).
   // At Step II's start: each body's time-n position and kinetic energy, and whether gravity is
@@ -297,47 +305,13 @@ class ContactWorkspace {
   Vec<d> gravity = Vec<d>::Zero();
 
  private:
-  // The sweeps above first record their pair updates, in the thesis's order, as a task
-  // sequence, then run it with OrderedTasks: each update still sees exactly the bodies the
-  // sequential sweep would give it (results are bitwise those of one thread), and updates far
-  // apart in the sequence that share no body run at once -- an island is otherwise serial.
-  struct SweepTask {
-    enum class Kind : char { Collision, Pair, Joint, Freeze };
-    Kind kind = Kind::Pair;
-    int index = 0;                   // the pair (Collision, Pair) or the body (Joint, Freeze)
-    int listBegin = 0, listEnd = 0;  // Joint: its pairs, in IslandSchedule::jointPairs
-    double epsilon = 0;
-    int iterations = 0;
-    bool shockFriction = false;  // Pair, Joint: in shock propagation (findPairImpulse)
-    long stamp = 0;  // Collision: the stamp of this check (increasing along the sequence)
-  };
-  struct IslandSchedule {
-    solvers::parallel::OrderedTasks order;
-    std::vector<SweepTask> tasks;
-    std::vector<int> jointPairs;
-    std::vector<char> frozen;  // per island member: frozen by the Freeze tasks recorded so far
-    std::vector<int> impulses, clamps;
-    std::vector<double> energyChange;
-    ImpulseMode mode = ImpulseMode::Contact;
-    double* energyOut = nullptr;  // the caller's clamp diagnostics, added to in task order
-    int* clampsOut = nullptr;
-    int impulseSum = 0;           // when the tasks run as they are recorded
-    // The recorded tasks are this step's collision sweep of the island: a later sweep has the
-    // same tasks and dependencies (only the stamps differ) and runs them again unrecorded.
-    bool collisionSweepRecorded = false;
-    std::vector<solvers::collision::ContactPoint<d>> scratch;  // narrow phase, when run in order
-  };
-  IslandSchedule& startSchedule(int island, ImpulseMode mode, std::size_t taskBound, double* clampEnergyChange,
-                                int* clampsApplied);
-  // Whether body i has infinite mass at the point of the sequence being recorded.
-  bool infiniteIn(const IslandSchedule& s, int body) const;
-  // Appends a task touching the given bodies (see addOrdered); on one thread it runs at once.
-  void addTask(IslandSchedule& s, const SweepTask& task, const int* touched, int count);
-  // Runs task t; k is its slot for the results when the schedule is run later (tracking).
-  void runTask(IslandSchedule& s, const SweepTask& t, int k, std::vector<solvers::collision::ContactPoint<d>>& scratch);
-  // Runs the recorded tasks (if they did not run as they were recorded) and sums their results
-  // in order. Returns the impulses applied.
-  int runSchedule(IslandSchedule& s);
+  using Sequence = TaskSequence<SweepTask>;
+  // Runs one recorded update of a stage in `mode`; `lists` holds a joint solve's pairs.
+  TaskCounts runTask(const SweepTask& t, ImpulseMode mode, const std::vector<int>& lists);
+  // Adds an update to an island's sequence (it runs at once when the sequence is untracked).
+  void addTask(Sequence& s, ImpulseMode mode, const SweepTask& task, const int* touched, int count);
+  // Runs an island's recorded updates in `mode` (island_tasks.h); returns the impulses applied.
+  int runTasks(Sequence& s, ImpulseMode mode);
   // The first collision sweep of an island when the last step's collision stage applied no
   // impulse (a resting pile): every pair update runs at once without applying anything, on a
   // copy of its pair state; in the sweep's order those that found nothing to apply are taken as
@@ -346,8 +320,8 @@ class ContactWorkspace {
   // Returns the impulses applied.
   int speculativeCollisionSweep(int island, double* clampEnergyChange, int* clampsApplied);
   // Records the island's collision checks from position `from` on as tasks of sweep `sweep`
-  // and runs them (runSchedule). Returns the impulses applied.
-  int runCollisionTasks(IslandSchedule& s, int island, int sweep, std::size_t from);
+  // and runs them (runTasks). Returns the impulses applied.
+  int runCollisionTasks(Sequence& s, int island, int sweep, std::size_t from);
   struct CollisionProbe {  // what one update found, on a copy of its pair's state
     ContactPairState pair;
     int impulses = 0, clamps = 0;
@@ -372,8 +346,7 @@ class ContactWorkspace {
   };
   mutable std::vector<CachedManifold> manifolds_;
   void resetManifolds(std::size_t pairCount);
-  std::vector<IslandSchedule> schedules_;  // per island (islands are recorded and run at once)
-  std::vector<int> memberIndex_;           // per body: its position in its island's members
+  IslandTasks<SweepTask> tasks_;
   int kinematicFrameBody_ = -1;            // the scene's one translating kinematic body, or -1 (pack)
   // rememberStepStart: per body, x^n, its kinetic energy at time n, and whether gravity is the
   // only force on it (no scripted motion either).

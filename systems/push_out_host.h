@@ -1,7 +1,8 @@
 #pragma once
 // The contact workspace as push-out's host (solvers/contact/push_out_rounds.h lists what a host
 // provides): the step's bodies, pairs, islands and levels, and the operations on them that need
-// the workspace (the broad phase, the islands' ordered tasks, a body's world inertia at a pose).
+// the workspace (the broad phase, a body's world inertia at a pose) or its island/task layer
+// (systems/island_tasks.h: the islands at once, each as ordered tasks).
 #include <array>
 #include <vector>
 
@@ -46,18 +47,19 @@ class PushOutHost {
   int growPairs() {
     return ws_.growPairs([](const ContactBody<d>& b) { return std::array<solvers::collision::Pose<d>, 1>{b.candidate}; });
   }
+  // The island/task layer's (systems/island_tasks.h), with the contact stages' block size.
   template <class F>
   void forEachIsland(F&& f) {
-    ws_.forEachIsland(std::forward<F>(f));
+    ws_.islandTasks().forEachIsland(std::forward<F>(f));
   }
   void startOrder(solvers::parallel::OrderedTasks& order, int island, std::size_t taskBound) const {
-    ws_.startOrder(order, island, taskBound);
+    ws_.islandTasks().startOrder(order, island, taskBound, ws_.taskGrain());
   }
   void addOrdered(solvers::parallel::OrderedTasks& order, const std::vector<char>& frozen, const int* touched,
                   int count) const {
-    ws_.addOrdered(order, frozen, touched, count);
+    ws_.islandTasks().addOrdered(order, frozen, touched, count);
   }
-  int memberIndex(int body) const { return ws_.memberIndex(body); }
+  int memberIndex(int body) const { return ws_.islandTasks().memberIndex(body); }
   void escapeOpposedStatics(int central, double fraction, double tolerance,
                             std::vector<solvers::contact::PushOutOuter<d>>& outers, std::vector<int>& outerIndex) const {
     monolith::escapeOpposedStatics<d>(bodies, bodies[central], fraction, tolerance, outers, outerIndex);

@@ -7,6 +7,10 @@
 // checked against every box directly; the scene has a handful of them (ground, walls).
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/geometry/shape/box.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -75,6 +79,25 @@ struct BroadPhase<d>::Impl {
   std::vector<fcl::CollisionObjectd*> registered;
   std::vector<int> registeredIndices;
   fcl::DynamicAABBTreeCollisionManagerd manager;
+  // sortPairs' buckets and its output.
+  std::vector<int> bucketStart, bucketNext;
+  std::vector<std::pair<int, int>> sorted;
+
+  // The pairs (i < j, all below n) sorted as std::sort sorts them (by i, then j): counted into
+  // one bucket per i, each bucket then sorted on its own. A pour's pass finds thousands of
+  // pairs in the tree's order, and sorting them whole took about a third of the pass.
+  void sortPairs(std::vector<std::pair<int, int>>& pairs, int n) {
+    bucketStart.assign(static_cast<std::size_t>(n) + 1, 0);
+    for (const auto& p : pairs) ++bucketStart[p.first + 1];
+    for (int i = 0; i < n; ++i) bucketStart[i + 1] += bucketStart[i];
+    bucketNext.assign(bucketStart.begin(), bucketStart.end() - 1);
+    sorted.resize(pairs.size());
+    for (const auto& p : pairs) sorted[bucketNext[p.first]++] = p;
+    for (int i = 0; i < n; ++i)
+      if (bucketStart[i + 1] - bucketStart[i] > 1)
+        std::sort(sorted.begin() + bucketStart[i], sorted.begin() + bucketStart[i + 1]);
+    pairs.swap(sorted);
+  }
 
   // What the FCL callback needs.
   struct Context {
@@ -167,20 +190,103 @@ struct BroadPhase<d>::Impl {
     return true;
   }
 
-  void dynamicTree(const std::vector<Box>& boxes, const std::vector<char>& flags, std::vector<std::pair<int, int>>& pairs) {
-    if (!refreshTree(boxes)) return;
-    Context context{&boxes, &flags, &pairs};
-    manager.collide(&context, &Impl::onCandidate);
+  // The tree's self-collision split into jobs that share no pair: a node's self-collision is its
+  // children's and the two children against each other; two nodes against each other are the
+  // larger one's children against the smaller (FCL's own rule), dropped when their boxes do not
+  // overlap. Each job runs FCL's recursion into its own list; the lists are concatenated and
+  // sorted afterwards, so the pairs are the same whatever runs where.
+  using Node = fcl::DynamicAABBTreeCollisionManagerd::DynamicAABBNode;
+  struct Job {
+    Node* a;
+    Node* b;  // null: a's self-collision
+  };
+  std::vector<Job> jobs, nextJobs;
+  std::vector<std::vector<std::pair<int, int>>> jobPairs;
+  static constexpr std::size_t kJobs = 32;     // about this many, so that two threads share them evenly
+  static constexpr std::size_t kSplitFrom = 256;  // boxes; below, one FCL pass costs less than the handing over
+
+  static bool useThreads(std::size_t boxes) {
+    return boxes >= kSplitFrom && tbb::this_task_arena::max_concurrency() > 1;
   }
 
-  // The bounded pairs with a box of `subset` in them: one tree query per such box.
+  void splitSelfCollision() {
+    jobs.assign(1, Job{manager.getTree().getRoot(), nullptr});
+    for (int depth = 0; depth < 8 && jobs.size() < kJobs; ++depth) {
+      nextJobs.clear();
+      for (const Job& j : jobs) {
+        if (!j.b) {
+          if (j.a->isLeaf()) continue;
+          nextJobs.push_back({j.a->children[0], nullptr});
+          nextJobs.push_back({j.a->children[1], nullptr});
+          nextJobs.push_back({j.a->children[0], j.a->children[1]});
+        } else if (!j.a->bv.overlap(j.b->bv)) {
+          continue;
+        } else if (j.a->isLeaf() && j.b->isLeaf()) {
+          nextJobs.push_back(j);
+        } else if (j.b->isLeaf() || (!j.a->isLeaf() && j.a->bv.size() > j.b->bv.size())) {
+          nextJobs.push_back({j.a->children[0], j.b});
+          nextJobs.push_back({j.a->children[1], j.b});
+        } else {
+          nextJobs.push_back({j.a, j.b->children[0]});
+          nextJobs.push_back({j.a, j.b->children[1]});
+        }
+      }
+      jobs.swap(nextJobs);
+    }
+  }
+
+  // Runs job(k, context) for k in [0, count) on the arena's threads, each into its own list, and
+  // appends the lists to `pairs` (in job order; the caller sorts).
+  template <class Run>
+  void runJobs(std::size_t count, const std::vector<Box>& boxes, const std::vector<char>& flags,
+               std::vector<std::pair<int, int>>& pairs, Run&& run) {
+    if (jobPairs.size() < count) jobPairs.resize(count);
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, count, 1),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t k = r.begin(); k != r.end(); ++k) {
+            jobPairs[k].clear();
+            Context context{&boxes, &flags, &jobPairs[k]};
+            run(k, context);
+          }
+        },
+        tbb::simple_partitioner());
+    for (std::size_t k = 0; k < count; ++k) pairs.insert(pairs.end(), jobPairs[k].begin(), jobPairs[k].end());
+  }
+
+  void dynamicTree(const std::vector<Box>& boxes, const std::vector<char>& flags, std::vector<std::pair<int, int>>& pairs) {
+    if (!refreshTree(boxes)) return;
+    if (!useThreads(bounded.size())) {
+      Context context{&boxes, &flags, &pairs};
+      manager.collide(&context, &Impl::onCandidate);
+      return;
+    }
+    splitSelfCollision();
+    runJobs(jobs.size(), boxes, flags, pairs, [&](std::size_t k, Context& context) {
+      namespace tree = fcl::detail::dynamic_AABB_tree;
+      if (jobs[k].b) tree::collisionRecurse<double>(jobs[k].a, jobs[k].b, &context, &Impl::onCandidate);
+      else tree::selfCollisionRecurse<double>(jobs[k].a, &context, &Impl::onCandidate);
+    });
+  }
+
+  // The bounded pairs with a box of `subset` in them: one tree query per such box (on the
+  // arena's threads when there are many: each query only reads the tree).
   void dynamicTreeTouching(const std::vector<Box>& boxes, const std::vector<char>& flags,
                            const std::vector<char>& subset, std::vector<std::pair<int, int>>& pairs) {
     if (!refreshTree(boxes)) return;
-    Context context{&boxes, &flags, &pairs};
+    queried.clear();
     for (std::size_t k = 0; k < bounded.size(); ++k)
-      if (subset[bounded[k]]) manager.collide(proxies[k].get(), &context, &Impl::onCandidate);
+      if (subset[bounded[k]]) queried.push_back(static_cast<int>(k));
+    if (!useThreads(queried.size() * 8)) {
+      Context context{&boxes, &flags, &pairs};
+      for (int k : queried) manager.collide(proxies[k].get(), &context, &Impl::onCandidate);
+      return;
+    }
+    runJobs(queried.size(), boxes, flags, pairs, [&](std::size_t k, Context& context) {
+      manager.collide(proxies[queried[k]].get(), &context, &Impl::onCandidate);
+    });
   }
+  std::vector<int> queried;  // dynamicTreeTouching: the proxies of the subset's boxes
 };
 
 template <int d>
@@ -241,7 +347,7 @@ const std::vector<std::pair<int, int>>& BroadPhase<d>::collect(const std::vector
       if (subset && !(*subset)[u] && !(*subset)[j]) continue;
       if (!Impl::bothFlagged(isInfinite, u, j) && touch<d>(boxes[u], boxes[j])) Impl::add(u, j, pairs_);
     }
-  std::sort(pairs_.begin(), pairs_.end());
+  impl.sortPairs(pairs_, n);
   pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
   if (!excluded_.empty())
     pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),

@@ -3,6 +3,7 @@
 #include "solvers/contact/joint_push_out.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <Eigen/Dense>
 #include <cmath>
@@ -93,6 +94,112 @@ TEST(JointPushOut, AChainTooLongForTheExactSolveIsSolvedBySweeps) {
   std::vector<JointMove<2>> moves;
   EXPECT_LT(solveJointPushOut<2>(bodies, points, kSweeps, 1e-15, moves), 1e-9);
   for (int i = 0; i < 100; ++i) EXPECT_NEAR(moves[i].dx.x(), 0.01 * (i + 1), 1e-9) << i;
+}
+
+namespace {
+
+// Gauss-Seidel sweeps over all points in their order, stopped after the first sweep in which no
+// point's separation changes by more than `tolerance`: the sweeps solveJointPushOut runs per
+// connected component, written out over all points at once.
+template <int d>
+std::vector<JointMove<d>> sweepsOverAllPoints(const std::vector<JointBody<d>>& bodies,
+                                              const std::vector<JointPoint<d>>& points, int sweeps, double tolerance) {
+  std::vector<JointMove<d>> moves(bodies.size());
+  std::vector<AngVec<d>> ca(points.size(), AngVec<d>::Zero()), cb(points.size(), AngVec<d>::Zero());
+  std::vector<AngVec<d>> ia(points.size(), AngVec<d>::Zero()), ib(points.size(), AngVec<d>::Zero());
+  std::vector<double> inverseMass(points.size(), 0.0), lambda(points.size(), 0.0);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const JointPoint<d>& p = points[k];
+    double mass = 0;
+    if (p.a >= 0) {
+      ca[k] = cross<d>(p.ra, p.n);
+      ia[k] = bodies[p.a].inverseInertia * ca[k];
+      mass += bodies[p.a].inverseMass + ca[k].dot(ia[k]);
+    }
+    if (p.b >= 0) {
+      cb[k] = cross<d>(p.rb, p.n);
+      ib[k] = bodies[p.b].inverseInertia * cb[k];
+      mass += bodies[p.b].inverseMass + cb[k].dot(ib[k]);
+    }
+    inverseMass[k] = mass > 0 ? 1 / mass : 0;
+  }
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    double largest = 0;
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      if (!(inverseMass[k] > 0)) continue;
+      const JointPoint<d>& p = points[k];
+      double gained = 0;
+      if (p.a >= 0) gained += p.n.dot(moves[p.a].dx) + ca[k].dot(moves[p.a].dtheta);
+      if (p.b >= 0) gained -= p.n.dot(moves[p.b].dx) + cb[k].dot(moves[p.b].dtheta);
+      const double next = std::max(0.0, lambda[k] + (p.depth - gained) * inverseMass[k]);
+      const double change = next - lambda[k];
+      if (change == 0) continue;
+      largest = std::max(largest, std::abs(change) / inverseMass[k]);
+      lambda[k] = next;
+      if (p.a >= 0) {
+        moves[p.a].dx += change * bodies[p.a].inverseMass * p.n;
+        moves[p.a].dtheta += change * ia[k];
+      }
+      if (p.b >= 0) {
+        moves[p.b].dx -= change * bodies[p.b].inverseMass * p.n;
+        moves[p.b].dtheta -= change * ib[k];
+      }
+    }
+    if (largest <= tolerance) break;
+  }
+  return moves;
+}
+
+}  // namespace
+
+TEST(JointPushOut, SeparateJamsSweptAtOnceGiveTheSweepsOverAllPoints) {
+  // Three jams that share no body, their points interleaved (130 points: Gauss-Seidel sweeps):
+  // chains of 70, 45 and 15 bodies against walls, each link 1 cm deep and off the line of the
+  // centres (so the bodies turn), with masses that differ along each chain, so that each jam
+  // would stop after a different number of sweeps on its own. Swept per jam at once, the moves
+  // must be bitwise those of the sweeps over all points, which stop only when every jam is
+  // quiet, on one thread and on two.
+  std::vector<JointBody<3>> bodies;
+  std::vector<std::vector<JointPoint<3>>> chains(3);
+  const int lengths[3] = {70, 45, 15};
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), off(0, 0.1, 0.05);
+  for (int c = 0; c < 3; ++c) {
+    const int first = static_cast<int>(bodies.size());
+    for (int i = 0; i < lengths[c]; ++i) {
+      bodies.push_back(body<3>(1 + (i % 5) * (c + 1), 0.5 + 0.1 * c));
+      const int self = first + i, before = i == 0 ? -1 : self - 1;
+      chains[c].push_back(point<3>(self, before, -0.5 * x + off, 0.5 * x + off, x, 0.01 * (1 + 0.3 * c)));
+    }
+  }
+  std::vector<JointPoint<3>> points;
+  for (std::size_t k = 0; k < 70; ++k)
+    for (int c = 0; c < 3; ++c)
+      if (k < chains[c].size()) points.push_back(chains[c][k]);
+  const double tolerance = 1e-13;
+  const int sweeps = 20000;
+  const std::vector<JointMove<3>> reference = sweepsOverAllPoints<3>(bodies, points, sweeps, tolerance);
+  for (int threads : {1, 2}) {
+    std::vector<JointMove<3>> moves;
+    tbb::task_arena(threads).execute([&] { solveJointPushOut<3>(bodies, points, sweeps, tolerance, moves); });
+    ASSERT_EQ(moves.size(), reference.size());
+    for (std::size_t b = 0; b < moves.size(); ++b) {
+      EXPECT_EQ(moves[b].dx, reference[b].dx) << "body " << b << ", " << threads << " threads";
+      EXPECT_EQ(moves[b].dtheta, reference[b].dtheta) << "body " << b << ", " << threads << " threads";
+    }
+  }
+  // The jams did stop at different sweeps on their own: each one's sweeps over its own points
+  // differ from what the joint stop left it.
+  const std::vector<JointPoint<3>> shortChain(chains[2].begin(), chains[2].end());
+  std::vector<JointBody<3>> shortBodies(bodies.begin() + 115, bodies.end());
+  std::vector<JointPoint<3>> shifted = shortChain;
+  for (auto& p : shifted) {
+    p.a -= 115;
+    if (p.b >= 0) p.b -= 115;
+  }
+  const std::vector<JointMove<3>> alone = sweepsOverAllPoints<3>(shortBodies, shifted, sweeps, tolerance);
+  bool differs = false;
+  for (std::size_t b = 0; b < alone.size(); ++b) differs |= alone[b].dx != reference[115 + b].dx;
+  EXPECT_TRUE(differs) << "the test's jams stop at the same sweep: it does not check the shared stop";
 }
 
 namespace {
