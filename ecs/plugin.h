@@ -16,12 +16,7 @@
 namespace monolith {
 
 // Bump whenever a type crossing the plugin boundary changes layout or meaning.
-inline constexpr std::uint32_t kPluginAbiVersion = 8;  // 2: Stage::Advection inserted; 3, 4: ContactSettings grew;
-                                                       // 5: PoolBase::fieldLayout; 6: ContactSettings grew
-                                                       // and its defaults are the short schedule; 7: the
-                                                       // contact and fluid settings are World resources;
-                                                       // 8: so is the rigid rotation rule (WorldSettings
-                                                       // holds only gravity)
+inline constexpr std::uint32_t kPluginAbiVersion = 8;
 
 struct PluginAbi {
   std::uint32_t abiVersion;
