@@ -58,6 +58,9 @@ std::vector<int> markStructure(FluidDomain<d>& domain, const std::vector<std::ui
     if (fluid) {
       domain.faces[f] = FaceKind::Free;
       domain.structureFace[f] = 1;
+      // A coupling face is whole: the structure covers it and its velocity is the structure's, also
+      // where a cut-cell obstacle covers part of it (a flag's root inside a cut cylinder).
+      if (!domain.openFraction.empty()) domain.openFraction[f] = 1.0;
     } else {
       domain.faces[f] = FaceKind::Inactive;
       interior[f] = 1;
@@ -86,6 +89,7 @@ std::vector<int> markStructure(FluidDomain<d>& domain, const std::vector<std::ui
       if (add[f]) {
         domain.faces[f] = FaceKind::Free;
         domain.structureFace[f] = 1;
+        if (!domain.openFraction.empty()) domain.openFraction[f] = 1.0;
       }
   }
   std::vector<int> faces;

@@ -68,7 +68,9 @@ SparseMatrixR faceNormalRows(const MacLayout<d>& layout, const std::vector<int>&
 // velocity unknowns, and with `viscous` so do the faces inside the structure that are viscous
 // pair neighbours of a free fluid face; every other face touching a structure cell becomes
 // Inactive. Returns the coupling faces (layout face indices, ascending). Faces that a wall, an
-// inflow or a prescribed obstacle already fixes stay prescribed (infinite mass wins).
+// inflow or a prescribed obstacle already fixes stay prescribed (infinite mass wins); a coupling
+// face that a cut-cell obstacle covers in part (domain.openFraction) becomes whole: the structure
+// covers it, and the coupling constraint acts on the whole face.
 // Sets domain.structureFace so that the viscous operator drops the rows between two coupling
 // faces (both move with rigid structure; no fluid shear between them).
 template <int d>
