@@ -8,6 +8,7 @@
 #include <oneapi/tbb/global_control.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <random>
 
 #include "solvers/deformable/bvh.h"
