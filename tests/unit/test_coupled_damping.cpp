@@ -85,7 +85,9 @@ Scene<d> block(dm::Model model, unsigned seed, bool withFixed = true) {
   for (int c = 0; c < 2; ++c) {
     dm::DampingRigid<d> r;
     r.mass = c == 0 ? 0.5 + bodyMass : 2.0;
-    rm::AngMat<d> A = rm::AngMat<d>::Random();
+    rm::AngMat<d> A;
+    for (int a = 0; a < rm::kAngularDim<d>; ++a)
+      for (int b = 0; b < rm::kAngularDim<d>; ++b) A(a, b) = u(rng);
     r.inertia = 0.01 * (A * A.transpose() + rm::AngMat<d>::Identity());
     r.x = c == 0 ? dm::VecD<d>(dm::VecD<d>::Unit(0) * -0.25) : dm::VecD<d>(dm::VecD<d>::Unit(1) * -0.4);
     for (int a = 0; a < d; ++a) r.v(a) = u(rng);
@@ -96,7 +98,9 @@ Scene<d> block(dm::Model model, unsigned seed, bool withFixed = true) {
   for (int i = 0; i < n; ++i) {
     const auto& x = mesh.x[i];
     if (s.role[i] != dm::ParticleRole::Free) continue;
-    dm::VecD<d> normal = dm::VecD<d>::Random().normalized();
+    dm::VecD<d> normal;
+    for (int a = 0; a < d; ++a) normal(a) = u(rng);
+    normal.normalize();
     if (x(1) < -0.06) s.holds.push_back({0, i, normal, 0.1 * u(rng), 1});
     else if (x(1) > 0.06 && x(0) > 0) s.holds.push_back({0, i, normal, 0.1 * u(rng), -1});
     else if (!fixedOne) {
