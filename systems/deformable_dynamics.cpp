@@ -4,12 +4,14 @@
 
 #include "components/cloth.h"
 #include "components/fluid_coupling.h"
+#include "components/forces.h"
+#include "components/sleep.h"
 #include "systems/embedded_binding.h"
 #include "systems/particle_contact.h"
 
+#include "solvers/deformable/coupled_damping.h"
 #include "solvers/deformable/simplex_mesh.h"
 #include "solvers/deformable/stable_step.h"
-#include "solvers/fluid/krylov.h"
 
 namespace monolith {
 
@@ -59,112 +61,41 @@ ImplicitSolveReport implicitDampingSolve(const dm::ForceModel<d>& fm, const Part
                                          std::vector<double>* dampingForce,
                                          const std::vector<dm::MatD<d>>* rotations,
                                          const std::vector<NormalConstraint<d>>* normals) {
-  const int n = static_cast<int>(p.x.size());
-  ImplicitSolveReport report;
-  u.assign(n, 0.0);
-  auto constrained = [&](int i) { return p.fixed[i / d] != 0; };
-  if (fm.dampingRows() == 0) {  // no damping: M u = M v + h f directly
-    for (int i = 0; i < n; ++i) u[i] = constrained(i) ? p.v[i] : p.v[i] + h * f[i] / p.m[i / d];
-    if (dampingForce) dampingForce->assign(n, 0.0);
-    return report;
-  }
-  const std::vector<dm::MatD<d>> computed = rotations ? std::vector<dm::MatD<d>>() : dm::dampingRotations<d>(fm, p.x.data());
-  const std::vector<dm::MatD<d>>& R = rotations ? *rotations : computed;
-  Eigen::VectorXd diag(n), prescribed = Eigen::VectorXd::Zero(n);
-  for (int i = 0; i < n; ++i) {
-    diag(i) = p.m[i / d];
-    if (constrained(i)) prescribed(i) = p.v[i];  // fixed: 0; bound: the body's point velocity
-  }
-  const solvers::LinearOperator A = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
-    std::vector<double> Dv(n, 0.0);
-    dm::addDampingForces<d>(fm, R, p.x.data(), in.data(), Dv.data());
-    for (int i = 0; i < n; ++i) out(i) = diag(i) * in(i) - h * Dv[i];
-  };
-  // Constrained components are prescribed: u = w + prescribed with w zero on them, and
-  // P A P w = P (b - A prescribed), P zeroing the constrained components. P is symmetric, so
-  // P A P stays SPD on the free subspace (Sec. 4.7.3 with the constraint rows of the fixed and
-  // bound particles).
-  std::vector<NormalConstraint<d>> held;
+  const std::vector<dm::MatD<d>> computed =
+      rotations || fm.dampingRows() == 0 ? std::vector<dm::MatD<d>>() : dm::dampingRotations<d>(fm, p.x.data());
+  dm::DampingBody<d> body;
+  body.fm = &fm;
+  body.rotations = rotations ? rotations : &computed;
+  body.x = p.x.data();
+  body.v = p.v.data();
+  body.m = p.m.data();
+  body.f = f.data();
+  body.role.resize(p.count());
+  body.rigid.assign(p.count(), -1);
+  for (int i = 0; i < p.count(); ++i) body.role[i] = p.fixed[i] ? dm::ParticleRole::Prescribed : dm::ParticleRole::Free;
+  std::vector<dm::DampingHold<d>> holds;
   if (normals)
-    for (const NormalConstraint<d>& c : *normals)
-      if (!p.fixed[c.particle]) {
-        held.push_back(c);
-        for (int a = 0; a < d; ++a) prescribed(d * c.particle + a) = c.velocity * c.normal(a);
-      }
-  const solvers::Projector project = [&](Eigen::VectorXd& v) {
-    for (int i = 0; i < n; ++i)
-      if (constrained(i)) v(i) = 0;
-    for (const NormalConstraint<d>& c : held) {
-      Eigen::Map<Vec<d>> vi(v.data() + d * c.particle);
-      vi -= vi.dot(c.normal) * c.normal;
+    for (const NormalConstraint<d>& c : *normals) {
+      if (c.rigid.valid())
+        throw std::invalid_argument("implicitDampingSolve: a hold against a dynamic rigid body needs the coupled solve");
+      holds.push_back({0, c.particle, c.normal, c.velocity, -1});
     }
-  };
-  Eigen::VectorXd b(n), Ap(n), x(n);
-  A(prescribed, Ap);
-  for (int i = 0; i < n; ++i) {
-    b(i) = p.m[i / d] * p.v[i] + h * f[i] - Ap(i);
-    x(i) = p.v[i];
-  }
-  solvers::CgSettings settings;
-  settings.relativeTolerance = 1e-10;
-  settings.maxIterations = 2000;
-  project(x);
-  // CG runs on P A P itself: the product is projected too, so the recursive residual stays in
-  // the free subspace and the stopping test measures the residual of the projected system ("can
-  // be solved with conjugate gradient provided the residual is properly projected at each
-  // iteration", Sec. 4.7.3). Projecting only the preconditioned residual (enough for a null-space
-  // projector, which A p never leaves) would leave in r the constrained components of A p: the
-  // forces that hold the fixed, bound and contact particles, which do not vanish at the
-  // solution. The test would never pass, and CG would run on past convergence on round-off until
-  // it broke down by chance, or diverge: drop_sphere_elastic at t = 1.4376 s (a ball resting on six
-  // held contacts) then takes 2000 iterations in Step I to a residual of 1e50 and blows up.
-  const solvers::LinearOperator projectedA = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
-    A(in, out);
-    project(out);
-  };
-  const solvers::CgReport r =
-      solvers::conjugateGradient(projectedA, solvers::jacobiPreconditioner(diag), project, b, x, settings);
-  report.iterations = r.iterations;
-  report.relativeResidual = r.relativeResidual();
-  report.converged = r.converged;
-  for (int i = 0; i < n; ++i) u[i] = x(i) + prescribed(i);
-  std::vector<double> Du(n, 0.0);
-  dm::addDampingForces<d>(fm, R, p.x.data(), u.data(), Du.data());
-  // The velocity is taken from the forces at the solution, unprojected (Sec. 4.7.2, step 3: a
-  // rather than the projected a-hat): held particles get back their constraint's share, and the
-  // total momentum changes by exactly h sum f (the damping forces are internal; on bound particles
-  // they go to the bodies), not by the solver's residual, which CG leaves at its tolerance.
-  for (int i = 0; i < n; ++i)
-    if (!constrained(i)) u[i] = p.v[i] + h * (f[i] + Du[i]) / p.m[i / d];
-  if (dampingForce) *dampingForce = std::move(Du);
+  dm::CoupledDampingResult<d> r = dm::solveCoupledDamping<d>({std::move(body)}, {}, std::move(holds), h);
+  u = std::move(r.u[0]);
+  if (dampingForce) *dampingForce = std::move(r.Du[0]);
+  ImplicitSolveReport report;
+  report.iterations = r.report.iterations;
+  report.relativeResidual = r.report.relativeResidual;
+  report.converged = r.report.converged;
   return report;
 }
 
 namespace {
 
-template <int d>
-AngularVec<d> armCross(const Vec<d>& r, const Vec<d>& f) {
-  if constexpr (d == 3) return r.cross(f);
-  else return AngularVec<2>(r.x() * f.y() - r.y() * f.x());
-}
-
-template <int d>
-void applyBoundDamping(World<d>& world, const RigidBinding<d>& b, const Particles<d>& p, const std::vector<double>& Du,
-                       double duration) {
-  const auto names = b.bodyNames();
-  std::vector<RigidBody<d>*> bodies;
-  for (const auto& name : names) {
-    const auto e = world.find(name);
-    bodies.push_back(e ? world.template get<RigidBody<d>>(*e) : nullptr);
-  }
-  for (std::size_t k = 0; k < b.particle.size(); ++k) {
-    RigidBody<d>* body = bodies[b.body[k]];
-    if (!body || body->isStatic) continue;
-    const int i = b.particle[k];
-    const Vec<d> j = duration * Vec<d>(Eigen::Map<const Vec<d>>(&Du[d * i]));
-    body->v += j / body->mass;
-    body->L += armCross<d>(Vec<d>(Eigen::Map<const Vec<d>>(&p.x[d * i]) - body->x), j);
-  }
+// Disjoint sets over the bodies of a stage (bodies tied through a rigid unknown are solved together).
+int findRoot(std::vector<int>& parent, int i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
 }
 
 }  // namespace
@@ -214,22 +145,148 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
           if (Body* hb = bodyOf(host))
             for (int a = 0; a < d; ++a) hb->f[d * j + a] += w * b.f[d * i + a];
         });
-  for (Body& b : bodies) {
-    Particles<d>& p = *b.p;
-    std::vector<double> u;
-    RigidBinding<d>* binding = world.template get<RigidBinding<d>>(b.e);
-    const bool embedded = embedding && world.template has<EmbeddedBinding<d>>(b.e);
-    std::vector<NormalConstraint<d>> held;
-    if (contacts_ && b.fm->dampingRows() > 0) held = contacts_->of(world, p, ctx.dt, half ? 0.0 : 0.5);
-    const ImplicitSolveReport r =
-        implicitDampingSolve(*b.fm, p, b.f, h, u, binding || embedded ? &b.Du : nullptr, &b.R, &held);
-    iterations = std::max(iterations, r.iterations);
-    // The damping forces the solve put on bound particles act on their bodies: over this
-    // stage's velocity change, h (Step I) or 2h (Step V's extrapolation) times D u.
-    if (binding) applyBoundDamping(world, *binding, p, b.Du, half ? h : 2 * h);
-    if (half) p.v = u;
-    else
-      for (std::size_t i = 0; i < u.size(); ++i) p.v[i] = 2 * u[i] - p.v[i];
+  // The dynamic rigid bodies tied to a damped body, by a binding or a held contact, are unknowns
+  // of its solve (Sec. 4.7.3); bodies sharing one are solved together. Rigid unknowns are
+  // numbered in order of first use (bodies in pool order, bindings, then holds in particle
+  // order), so the order is the same on any thread count.
+  struct Rigid {
+    Entity e;
+    RigidBody<d>* body;
+  };
+  std::vector<Rigid> rigids;
+  auto rigidIndex = [&](Entity e, RigidBody<d>* body) {
+    for (std::size_t k = 0; k < rigids.size(); ++k)
+      if (rigids[k].e == e) return static_cast<int>(k);
+    rigids.push_back({e, body});
+    return static_cast<int>(rigids.size()) - 1;
+  };
+  auto dynamicBody = [&](Entity e) -> RigidBody<d>* {
+    RigidBody<d>* body = world.template get<RigidBody<d>>(e);
+    return body && !body->isStatic && !world.template has<KinematicMotion<d>>(e) ? body : nullptr;
+  };
+  const int bodyCount = static_cast<int>(bodies.size());
+  std::vector<std::vector<dm::ParticleRole>> roles(bodyCount);
+  std::vector<std::vector<int>> boundTo(bodyCount);
+  std::vector<std::vector<NormalConstraint<d>>> held(bodyCount);
+  std::vector<std::vector<int>> heldRigid(bodyCount);
+  std::vector<int> parent(bodyCount), owner;
+  for (int k = 0; k < bodyCount; ++k) {
+    parent[k] = k;
+    const Body& b = bodies[k];
+    const Particles<d>& p = *b.p;
+    roles[k].resize(p.count());
+    boundTo[k].assign(p.count(), -1);
+    for (int i = 0; i < p.count(); ++i) roles[k][i] = p.fixed[i] ? dm::ParticleRole::Prescribed : dm::ParticleRole::Free;
+    if (b.fm->dampingRows() == 0) continue;  // no damping: the solve is M u = M v + h f, nothing couples
+    std::vector<int> used;
+    if (const RigidBinding<d>* binding = world.template get<RigidBinding<d>>(b.e)) {
+      const auto names = binding->bodyNames();
+      std::vector<int> index(names.size(), -1);
+      for (std::size_t j = 0; j < names.size(); ++j)
+        if (const auto e = world.find(names[j]))
+          if (RigidBody<d>* body = dynamicBody(*e)) index[j] = rigidIndex(*e, body);
+      for (std::size_t j = 0; j < binding->particle.size(); ++j) {
+        const int c = index[binding->body[j]];
+        if (c < 0) continue;  // static or kinematic: the particle's velocity is prescribed
+        roles[k][binding->particle[j]] = dm::ParticleRole::Bound;
+        boundTo[k][binding->particle[j]] = c;
+        used.push_back(c);
+      }
+    }
+    if (contacts_) held[k] = contacts_->of(world, p, ctx.dt, half ? 0.0 : 0.5);
+    for (const NormalConstraint<d>& c : held[k]) {
+      int index = -1;
+      if (c.rigid.valid()) {
+        index = rigidIndex(c.rigid, world.template get<RigidBody<d>>(c.rigid));
+        used.push_back(index);
+      }
+      heldRigid[k].push_back(index);
+    }
+    for (int c : used) {
+      if (static_cast<int>(owner.size()) <= c) owner.resize(c + 1, -1);
+      if (owner[c] < 0) owner[c] = k;
+      else parent[findRoot(parent, k)] = findRoot(parent, owner[c]);
+    }
+  }
+  // The rigid unknowns' twists at the start of the solve. Step I: v^{n+1/2} after the rigid
+  // half kick. Step V solves for the average of v^{n+1/2} and v^{n+1} (backward Euler over dt/4,
+  // then extrapolation), so the body's own kick over dt/4 is taken off again, as its particles'
+  // explicit forces enter over dt/4.
+  const auto* sleeps = world.template findPool<Sleep<d>>();
+  std::vector<dm::DampingRigid<d>> rigidStart(rigids.size());
+  for (std::size_t c = 0; c < rigids.size(); ++c) {
+    const RigidBody<d>& body = *rigids[c].body;
+    Vec<d> v = body.v;
+    AngularVec<d> L = body.L;
+    if (!half)
+      if (const RigidForces<d>* force = world.template get<RigidForces<d>>(rigids[c].e);
+          force && !isAsleep<d>(sleeps, rigids[c].e)) {
+        v -= (0.25 * ctx.dt / body.mass) * force->force;
+        L -= 0.25 * ctx.dt * force->torque;
+      }
+    rigidStart[c].mass = body.mass;
+    rigidStart[c].inertia = body.worldInertia();
+    rigidStart[c].x = body.x;
+    rigidStart[c].v = v;
+    rigidStart[c].omega = body.worldInverseInertia() * L;
+  }
+  for (int root = 0; root < bodyCount; ++root) {
+    if (findRoot(parent, root) != root) continue;
+    std::vector<int> members;  // ascending: the root is the smallest
+    for (int k = root; k < bodyCount; ++k)
+      if (findRoot(parent, k) == root) members.push_back(k);
+    std::vector<int> local(rigids.size(), -1), global;
+    auto localRigid = [&](int c) {
+      if (local[c] < 0) {
+        local[c] = static_cast<int>(global.size());
+        global.push_back(c);
+      }
+      return local[c];
+    };
+    std::vector<dm::DampingBody<d>> solveBodies;
+    std::vector<dm::DampingHold<d>> holds;
+    for (std::size_t m = 0; m < members.size(); ++m) {
+      Body& b = bodies[members[m]];
+      dm::DampingBody<d> sb;
+      sb.fm = b.fm;
+      sb.rotations = &b.R;
+      sb.x = b.p->x.data();
+      sb.v = b.p->v.data();
+      sb.m = b.p->m.data();
+      sb.f = b.f.data();
+      sb.role = roles[members[m]];
+      sb.rigid = boundTo[members[m]];
+      for (int& c : sb.rigid)
+        if (c >= 0) c = localRigid(c);
+      const auto& bodyHeld = held[members[m]];
+      for (std::size_t j = 0; j < bodyHeld.size(); ++j) {
+        const int c = heldRigid[members[m]][j];
+        holds.push_back({static_cast<int>(m), bodyHeld[j].particle, bodyHeld[j].normal, bodyHeld[j].velocity,
+                         c >= 0 ? localRigid(c) : -1});
+      }
+      solveBodies.push_back(std::move(sb));
+    }
+    std::vector<dm::DampingRigid<d>> solveRigids;
+    for (int c : global) solveRigids.push_back(rigidStart[c]);
+    dm::CoupledDampingResult<d> r = dm::solveCoupledDamping<d>(std::move(solveBodies), std::move(solveRigids), std::move(holds), h);
+    iterations = std::max(iterations, r.report.iterations);
+    for (std::size_t m = 0; m < members.size(); ++m) {
+      Body& b = bodies[members[m]];
+      Particles<d>& p = *b.p;
+      const std::vector<double>& u = r.u[m];
+      if (half) p.v = u;
+      else
+        for (std::size_t i = 0; i < u.size(); ++i) p.v[i] = 2 * u[i] - p.v[i];
+      b.Du = std::move(r.Du[m]);
+    }
+    // The damping forces on the bound particles act on their bodies over this stage's velocity
+    // change: h (Step I) or 2h (Step V's extrapolation).
+    const double duration = half ? h : 2 * h;
+    for (std::size_t c = 0; c < global.size(); ++c) {
+      RigidBody<d>& body = *rigids[global[c]].body;
+      body.v += (duration / body.mass) * r.force[c];
+      body.L += duration * r.torque[c];
+    }
   }
   // The damping forces on embedded particles, over the same duration, to their hosts' particles
   // in their weights (after every solve of the stage, as the bound particles' to their bodies).

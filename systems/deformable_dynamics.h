@@ -12,7 +12,9 @@
 // f holds the elastic forces and gravity m g. Without damping Steps I, IV, V are velocity
 // Verlet (symplectic: the energy oscillates but does not drift). Fixed particles are
 // constrained in both solves by the projection P (zeroing their velocity components), applied to
-// the right-hand side and inside CG so that P A P stays symmetric (Sec. 4.7.3).
+// the right-hand side and inside CG so that P^T A P stays symmetric (Sec. 4.7.3). The dynamic
+// rigid bodies that particles are bound to or held against are unknowns of the same solve
+// (solvers/deformable/coupled_damping.h): bodies tied through one rigid body are solved together.
 #include <cstdint>
 #include <memory>
 #include <unordered_map>
@@ -52,23 +54,29 @@ struct ImplicitSolveReport {
 };
 
 // A particle in contact held along one direction during the damping solve (Sec. 4.7.1, 4.7.3:
-// contact as a temporary constraint projected inside CG): u . normal = velocity.
+// contact as a temporary normal joint projected inside CG). Against a static or kinematic body
+// (`rigid` invalid): u . normal = velocity. Against a dynamic rigid body `rigid`, which then is
+// an unknown of the solve: (u - v_c - w_c x r) . normal = velocity, r from the body's centre of
+// mass to the particle.
 template <int d>
 struct NormalConstraint {
   int particle = 0;
   Vec<d> normal = Vec<d>::Zero();  // unit
   double velocity = 0;
+  Entity rigid;
 };
 
-// Solves (M - h D(x)) u = M v + h f with the fixed and bound particles' u prescribed (their
-// current v) and projected out of the solve; u returned in `u`, and D u in `dampingForce` if given.
+// One body alone (solvers/deformable/coupled_damping.h without rigid unknowns): solves
+// (M - h D(x)) u = M v + h f with the fixed and bound particles' u prescribed (their current v)
+// and projected out of the solve; u returned in `u`, and D u in `dampingForce` if given.
 // `rotations`: the damping rotations at the current positions if already known (explicitForces).
 // `normals`: particles whose normal velocity is prescribed inside the solve (P = 1 - n n^T on
-// them, symmetric in the mass inner product); the constraint only steers the damping force: the
-// free particles' returned u is v + h M^{-1} (f + D u), the projection undone (Sec. 4.7.2, notes
-// 2.4 step 3), so that contact and friction act afterwards as a post-process that passes momentum
-// both ways (without holds this is the solution itself up to CG's tolerance, and makes the
-// momentum change exactly h sum f).
+// them, symmetric in the mass inner product; their `rigid` must be invalid); the constraint only
+// steers the damping force: the free particles' returned u is v + h M^{-1} (f + D u), the
+// projection undone (Sec. 4.7.2, notes 2.4 step 3), so that contact and friction act afterwards
+// as a post-process that passes momentum both ways (without holds this is the solution itself up
+// to CG's tolerance, and makes the momentum change exactly h sum f). The stage systems solve the
+// bodies tied to dynamic rigid bodies together with those bodies' twists as unknowns.
 template <int d>
 ImplicitSolveReport implicitDampingSolve(const solvers::deformable::ForceModel<d>& fm, const Particles<d>& p,
                                          const std::vector<double>& f, double h, std::vector<double>& u,
@@ -94,7 +102,8 @@ class AdvanceDeformableVelocity final : public System<d> {
   Stage stage() const override { return stage_; }
   std::vector<std::string> reads() const override {
     return {SimplexMesh<d>::kName, Elasticity::kName,         Shape<d>::kName,
-            Collider<d>::kName,    KinematicMotion<d>::kName, EmbeddedBinding<d>::kName};
+            Collider<d>::kName,    KinematicMotion<d>::kName, EmbeddedBinding<d>::kName,
+            RigidBinding<d>::kName, "rigid_forces"};
   }
   std::vector<std::string> writes() const override {
     return {Particles<d>::kName, RigidBody<d>::kName, "diagnostics"};  // bodies: damping on bound particles

@@ -108,6 +108,7 @@ void DeformableSelfCollision<d>::run(World<d>& world, StepContext& ctx) {
   out.max("self_collision_impulses", c.collisions);
   out.max("self_collision_passes", c.passes);
   out.max("self_collision_remaining", c.remaining);
+  out.max("self_collision_impact_zones", c.impactZones);
   if (stage_ == Stage::Collisions) *afterCollisions_ = v;
   particles.writeVelocities();
 }

@@ -126,10 +126,14 @@ class ParticlePenetration final : public System<d> {
 
 // The damping solves of Steps I and V (Sec. 4.7.1, 4.7.3): the particles of one deformable body
 // that touch a rigid body at the candidate positions x + dt v (within twice the contact thickness,
-// where resting contacts hover) and do not separate from it, each held along the contact normal
-// to the body point's normal velocity plus `keep` times the relative approach. Step V keeps half
+// where resting contacts hover) and do not separate from it, each held along the contact normal:
+// its normal velocity relative to the body point's (a dynamic body, then an unknown of the solve)
+// or its normal velocity (a static or kinematic body: the point's normal velocity added) set to
+// `keep` times the relative approach. Step V keeps half
 // (notes 2.6, trapezoid rule: the extrapolated v^{n+1} = 2u - v^{n+1/2} then just stops the
-// approach); Step I, a backward Euler step to v^{n+1/2}, keeps none. The damping forces then
+// approach; a particle beyond the thickness from a dynamic body, which the post-process does not
+// stop, keeps its own relative normal velocity); Step I, a backward Euler step to v^{n+1/2},
+// keeps none. The damping forces then
 // see the particles moving with the body; contact itself follows as the post-process. The thesis
 // holds contacts in Step V only; without Step I's (measured on density_ratio_heavy_box at dt =
 // 1e-4, beta = 0.01) the damping of the light top particles, free in the solve, lets the energy

@@ -2,6 +2,7 @@
 
 #include "solvers/deformable/parallel_indices.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -461,6 +462,126 @@ ProximityReport repelProximities(const CollisionSurface<d>& s, const std::vector
   return report;
 }
 
+namespace {
+
+int zoneRoot(std::vector<int>& parent, int i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+
+// The rigid velocity field v_c + w x (x - x_c) of a set of particles with weights m: their centre
+// of mass, linear and angular momentum kept (w = I^{-1} L about the centre; a singular inertia,
+// collinear particles, is inverted on its range).
+template <int d>
+void rigidVelocity(const std::vector<int>& members, const std::vector<double>& weight, const std::vector<double>& x,
+                   const std::vector<double>& v, VecD<d>& centre, VecD<d>& linear, Eigen::Vector3d& omega) {
+  double mass = 0;
+  centre.setZero();
+  linear.setZero();
+  for (int i : members) {
+    mass += weight[i];
+    centre += weight[i] * at<d>(x, i);
+    linear += weight[i] * at<d>(v, i);
+  }
+  centre /= mass;
+  linear /= mass;
+  Eigen::Vector3d L = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
+  for (int i : members) {
+    Eigen::Vector3d r = Eigen::Vector3d::Zero(), u = Eigen::Vector3d::Zero();
+    r.template head<d>() = at<d>(x, i) - centre;
+    u.template head<d>() = at<d>(v, i) - linear;
+    L += weight[i] * r.cross(u);
+    I += weight[i] * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+  }
+  omega.setZero();
+  if constexpr (d == 2) {
+    if (I(2, 2) > 0) omega.z() = L.z() / I(2, 2);
+  } else {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(I);
+    const double largest = eig.eigenvalues().maxCoeff();
+    for (int k = 0; k < 3; ++k) {
+      const double lambda = eig.eigenvalues()(k);
+      if (lambda > 1e-12 * largest)
+        omega += eig.eigenvectors().col(k) * (eig.eigenvectors().col(k).dot(L) / lambda);
+    }
+  }
+}
+
+}  // namespace
+
+// Rigid impact zones (Bridson, Fedkiw, Anderson 2002, Sec. 7.4; Provot 1997), the fail-safe when
+// the collision passes leave collisions: the particles of every colliding pair are merged into
+// zones (a pair joining two zones merges them), and each zone's particles are given the rigid
+// velocity of the zone that keeps its linear and angular momentum. A rigid velocity moves the
+// zone's points by the invertible affine map 1 + t dt [w]x over the step, so no pair within a
+// zone changes the sign of its coplanarity function: only pairs between zones can still collide,
+// and they merge the zones at the next detection, until none is found (or every colliding pair
+// lies within one zone). A zone with particles of infinite mass (fixed or bound) moves with their
+// rigid velocity (equal weights on them; its free particles take it).
+template <int d>
+ProximityReport resolveImpactZones(const CollisionSurface<d>& s, const std::vector<double>& x, std::vector<double>& v,
+                                   const std::vector<double>& inverseMass, double dt) {
+  ProximityReport report;
+  std::vector<double> pad(s.thickness.size());
+  for (std::size_t i = 0; i < pad.size(); ++i) pad[i] = 1e-3 * s.thickness[i];
+  const int n = static_cast<int>(inverseMass.size());
+  std::vector<int> parent(n);
+  for (int i = 0; i < n; ++i) parent[i] = i;
+  std::vector<char> zoned(n, 0);
+  std::vector<double> mass(n), pinned(n);
+  for (int i = 0; i < n; ++i) {
+    mass[i] = inverseMass[i] > 0 ? 1 / inverseMass[i] : 0.0;
+    pinned[i] = inverseMass[i] > 0 ? 0.0 : 1.0;
+  }
+  for (int round = 0; round < n; ++round) {
+    // A pair within one zone moves rigidly (it may touch, not cross): only pairs spanning zones
+    // count, and each merges its zones.
+    int hits = 0;
+    for (const Pair& pair : candidatePairs<d>(s, x, v, dt, pad)) {
+      auto pos = [&](int i) { return at<d>(x, i); };
+      const Stencil<d> st = stencilOf<d>(s, pair, pos);
+      bool spans = false;
+      for (int k = 1; k < st.n; ++k) spans = spans || zoneRoot(parent, st.idx[k]) != zoneRoot(parent, st.idx[0]);
+      if (!spans) continue;
+      const double tolerance = std::max(pad[pair.edges ? s.edges[2 * pair.a] : pair.a],
+                                        pad[pair.edges ? s.edges[2 * pair.b] : s.faces[d * pair.b]]);
+      if (firstContactTime<d>(s, pair, x, v, dt, std::max(tolerance, 1e-12)) < 0) continue;
+      ++hits;
+      for (int k = 0; k < st.n; ++k) {
+        zoned[st.idx[k]] = 1;
+        const int a = zoneRoot(parent, st.idx[0]), b = zoneRoot(parent, st.idx[k]);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      }
+    }
+    report.remaining = hits;
+    if (hits == 0) break;
+    ++report.impactZoneRounds;
+    // Members of each zone in particle order, zones in order of their smallest particle.
+    std::vector<std::vector<int>> zones(n);
+    for (int i = 0; i < n; ++i)
+      if (zoned[i]) zones[zoneRoot(parent, i)].push_back(i);
+    report.impactZones = 0;
+    for (const std::vector<int>& members : zones) {
+      if (members.size() < 2) continue;
+      ++report.impactZones;
+      bool anyPinned = false;
+      for (int i : members) anyPinned = anyPinned || pinned[i] > 0;
+      VecD<d> centre, linear;
+      Eigen::Vector3d omega;
+      rigidVelocity<d>(members, anyPinned ? pinned : mass, x, v, centre, linear, omega);
+      for (int i : members) {
+        if (inverseMass[i] == 0) continue;
+        Eigen::Vector3d r = Eigen::Vector3d::Zero();
+        r.template head<d>() = at<d>(x, i) - centre;
+        const VecD<d> vi = linear + omega.cross(r).template head<d>();
+        for (int a = 0; a < d; ++a) v[d * i + a] = vi(a);
+      }
+    }
+  }
+  return report;
+}
+
 template <int d>
 ProximityReport resolveCollisions(const CollisionSurface<d>& s, const std::vector<double>& x, std::vector<double>& v,
                                   const std::vector<double>& inverseMass, double dt, const ProximitySettings& settings) {
@@ -486,6 +607,12 @@ ProximityReport resolveCollisions(const CollisionSurface<d>& s, const std::vecto
     report.remaining = hits;
     if (hits == 0) break;
   }
+  if (report.remaining > 0 && settings.impactZones) {
+    const ProximityReport zones = resolveImpactZones<d>(s, x, v, inverseMass, dt);
+    report.remaining = zones.remaining;
+    report.impactZones = zones.impactZones;
+    report.impactZoneRounds = zones.impactZoneRounds;
+  }
   return report;
 }
 
@@ -508,6 +635,8 @@ int countCollisions(const CollisionSurface<d>& s, const std::vector<double>& x, 
   template ProximityReport resolveCollisions<D>(const CollisionSurface<D>&, const std::vector<double>&,          \
                                                 std::vector<double>&, const std::vector<double>&, double,        \
                                                 const ProximitySettings&);                                       \
+  template ProximityReport resolveImpactZones<D>(const CollisionSurface<D>&, const std::vector<double>&,         \
+                                                 std::vector<double>&, const std::vector<double>&, double);      \
   template int countCollisions<D>(const CollisionSurface<D>&, const std::vector<double>&, const std::vector<double>&, \
                                   double);
 MONOLITH_INSTANTIATE(2)

@@ -14,8 +14,10 @@
 //     triangle, or the two edges, are coplanar, from the cubic of [27] Sec. 6.3; in 2-D the
 //     point and segment collinear, a quadratic) with a proximity check at each such time; a hit
 //     gets the impulse that makes the pair separate slightly along the normal at that time.
-//     Repeated until a pass finds no collision or the pass limit is reached (the rigid impact
-//     zones of [27] Sec. 7.4 are not built: `remaining` reports what is left).
+//     Repeated until a pass finds no collision or the pass limit is reached;
+//  3. rigid impact zones ([27] Sec. 7.4) when collisions are left after the passes: the particles
+//     of colliding pairs merged into zones, each moving with its rigid velocity (linear and
+//     angular momentum kept), until no collision is found between zones (`remaining` then 0).
 // Every impulse acts on the pair's particles with the weights of the closest points (the point
 // +1, the face's vertices -b_i with b the barycentric coordinates; an edge's ends 1-s, s) and
 // their inverse masses: the weights sum to zero, so linear momentum is conserved to round-off.
@@ -48,13 +50,16 @@ struct ProximitySettings {
   double repulsion = 0.1;   // fraction of the thickness overlap removed per step by repulsion
   int collisionPasses = 32;
   double separation = 1e-3;  // a collision leaves the pair separating by this fraction of the thickness per step
+  bool impactZones = true;   // rigid impact zones when the passes leave collisions ([27] Sec. 7.4)
 };
 
 struct ProximityReport {
   int repulsions = 0;   // pairs given a proximity impulse
   int collisions = 0;   // collision impulses over all passes
   int passes = 0;       // collision passes run
-  int remaining = 0;    // collisions found by the last pass when the limit was reached
+  int remaining = 0;    // collisions left: found by the last pass, or after the impact zones
+  int impactZones = 0;       // rigid impact zones of two or more particles (0 when the passes sufficed)
+  int impactZoneRounds = 0;  // detections that merged zones
   double closest = 0;   // smallest pair distance at x (infinite without close pairs)
 };
 
@@ -76,6 +81,16 @@ ProximityReport repelProximities(const CollisionSurface<d>& s, const std::vector
 template <int d>
 ProximityReport resolveCollisions(const CollisionSurface<d>& s, const std::vector<double>& x, std::vector<double>& v,
                                   const std::vector<double>& inverseMass, double dt, const ProximitySettings& settings);
+
+// Rigid impact zones ([27] Sec. 7.4; Provot 1997), the fail-safe resolveCollisions runs when its
+// passes leave collisions: the particles of colliding pairs are merged into zones, each given the
+// rigid velocity that keeps its linear and angular momentum (a zone holding fixed or bound
+// particles, of infinite mass, takes their rigid velocity), and the detection repeated until no
+// pair between zones collides. A rigid velocity moves a zone's points by an invertible affine
+// map over the step, so pairs within a zone cannot cross.
+template <int d>
+ProximityReport resolveImpactZones(const CollisionSurface<d>& s, const std::vector<double>& x, std::vector<double>& v,
+                                   const std::vector<double>& inverseMass, double dt);
 
 // The number of point–face and edge–edge pairs that cross over [x, x + dt v]: their
 // coplanarity function changes sign at a time in (0, 1] where they meet (what resolveCollisions

@@ -52,7 +52,7 @@ BallState restingBall(bool withFixed) {
       s.p.v.push_back(0.2 * u(rng));
     }
     if (mesh.x[i].y() < ymin + 0.05) {
-      s.held.push_back({i, Eigen::Vector3d::UnitY(), 0.01 * u(rng)});
+      s.held.push_back({i, Eigen::Vector3d::UnitY(), 0.01 * u(rng), Entity{}});
     } else if (withFixed && mesh.x[i].y() > -ymin - 0.05) {
       s.p.fixed[i] = 1;
       for (int a = 0; a < 3; ++a) s.p.v[3 * i + a] = 0;

@@ -1,0 +1,339 @@
+#include "solvers/deformable/coupled_damping.h"
+
+#include <Eigen/Dense>
+#include <stdexcept>
+
+#include "solvers/fluid/krylov.h"
+
+namespace monolith::solvers::deformable {
+
+namespace {
+
+template <int d>
+constexpr int kTwist = d + rm::kAngularDim<d>;
+
+template <int d>
+using Twist = Eigen::Matrix<double, kTwist<d>, 1>;
+
+// g = (n, r x n): the constraint's row on the rigid twist (the body point's normal velocity g . xi).
+template <int d>
+Twist<d> jointRow(const VecD<d>& n, const VecD<d>& r) {
+  Twist<d> g;
+  g.template head<d>() = n;
+  g.template tail<rm::kAngularDim<d>>() = rm::cross<d>(r, n);
+  return g;
+}
+
+}  // namespace
+
+template <int d>
+CoupledDampingSystem<d>::CoupledDampingSystem(std::vector<DampingBody<d>> bodies, std::vector<DampingRigid<d>> rigids,
+                                              std::vector<DampingHold<d>> holds, double h)
+    : bodies_(std::move(bodies)), rigids_(std::move(rigids)), h_(h) {
+  int n = 0;
+  for (const DampingBody<d>& b : bodies_) {
+    offset_.push_back(n);
+    n += d * static_cast<int>(b.role.size());
+  }
+  rigidStart_ = n;
+  size_ = n + kTwist<d> * static_cast<int>(rigids_.size());
+  // A hold on a particle that is not free is dropped (its velocity is not an unknown), as is a
+  // second hold on the same particle (one contact per particle).
+  std::vector<std::vector<char>> taken(bodies_.size());
+  for (std::size_t k = 0; k < bodies_.size(); ++k) taken[k].assign(bodies_[k].role.size(), 0);
+  holdsOfRigid_.resize(rigids_.size());
+  for (const DampingHold<d>& c : holds) {
+    const DampingBody<d>& b = bodies_[c.body];
+    if (b.role[c.particle] != ParticleRole::Free || taken[c.body][c.particle]) continue;
+    taken[c.body][c.particle] = 1;
+    const int k = static_cast<int>(holds_.size());
+    holds_.push_back(c);
+    if (c.rigid >= 0) holdsOfRigid_[c.rigid].push_back(k);
+    else staticHolds_.push_back(k);
+  }
+  for (std::size_t c = 0; c < rigids_.size(); ++c) {
+    const DampingRigid<d>& r = rigids_[c];
+    inverseInertia_.push_back(r.inertia.inverse());
+    Eigen::Matrix<double, kTwist<d>, kTwist<d>> K = Eigen::Matrix<double, kTwist<d>, kTwist<d>>::Zero();
+    K.template topLeftCorner<d, d>() = r.mass * MatD<d>::Identity();
+    K.template bottomRightCorner<rm::kAngularDim<d>, rm::kAngularDim<d>>() = r.inertia;
+    for (int k : holdsOfRigid_[c]) {
+      const DampingHold<d>& o = holds_[k];
+      const Twist<d> g = jointRow<d>(o.normal, arm(o.body, o.particle, static_cast<int>(c)));
+      K += bodies_[o.body].m[o.particle] * g * g.transpose();
+    }
+    Eigen::Matrix<double, kTwist<d>, kTwist<d>> Kinv = K.ldlt().solve(Eigen::Matrix<double, kTwist<d>, kTwist<d>>::Identity());
+    centralInverse_.push_back(0.5 * (Kinv + Kinv.transpose()));  // exactly symmetric
+  }
+}
+
+template <int d>
+VecD<d> CoupledDampingSystem<d>::arm(int body, int particle, int c) const {
+  return VecD<d>(Eigen::Map<const VecD<d>>(bodies_[body].x + d * particle)) - rigids_[c].x;
+}
+
+template <int d>
+void CoupledDampingSystem<d>::expand(const Eigen::VectorXd& in, std::vector<std::vector<double>>& w) const {
+  w.resize(bodies_.size());
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    const DampingBody<d>& b = bodies_[k];
+    const int count = static_cast<int>(b.role.size());
+    w[k].assign(d * count, 0.0);
+    const int o = offset_[k];
+    for (int i = 0; i < count; ++i) {
+      if (b.role[i] == ParticleRole::Bound) {
+        const int c = b.rigid[i];
+        const int ro = rigidOffset(c);
+        const VecD<d> v = in.template segment<d>(ro);
+        const rm::AngVec<d> omega = in.template segment<rm::kAngularDim<d>>(ro + d);
+        const VecD<d> vi = v + rm::angularCross<d>(omega, arm(static_cast<int>(k), i, c));
+        for (int a = 0; a < d; ++a) w[k][d * i + a] = vi(a);
+      } else {
+        for (int a = 0; a < d; ++a) w[k][d * i + a] = in(o + d * i + a);
+      }
+    }
+  }
+}
+
+template <int d>
+void CoupledDampingSystem<d>::dampingForces(const std::vector<std::vector<double>>& w,
+                                            std::vector<std::vector<double>>& Dw) const {
+  Dw.resize(bodies_.size());
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    const DampingBody<d>& b = bodies_[k];
+    Dw[k].assign(w[k].size(), 0.0);
+    if (b.fm->dampingRows() > 0) addDampingForces<d>(*b.fm, *b.rotations, b.x, w[k].data(), Dw[k].data());
+  }
+}
+
+template <int d>
+void CoupledDampingSystem<d>::apply(const Eigen::VectorXd& in, Eigen::VectorXd& out) const {
+  std::vector<std::vector<double>> w, Dw;
+  expand(in, w);
+  dampingForces(w, Dw);
+  out.setZero(size_);
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    const DampingBody<d>& b = bodies_[k];
+    const int o = offset_[k];
+    for (int i = 0; i < static_cast<int>(b.role.size()); ++i) {
+      if (b.role[i] == ParticleRole::Bound) {
+        // J_i^T: the damping force on a bound particle acts on its body.
+        const int c = b.rigid[i];
+        const int ro = rigidOffset(c);
+        const VecD<d> f = Eigen::Map<const VecD<d>>(&Dw[k][d * i]);
+        out.template segment<d>(ro) -= h_ * f;
+        out.template segment<rm::kAngularDim<d>>(ro + d) -= h_ * rm::cross<d>(arm(static_cast<int>(k), i, c), f);
+      } else {
+        for (int a = 0; a < d; ++a) out(o + d * i + a) = b.m[i] * in(o + d * i + a) - h_ * Dw[k][d * i + a];
+      }
+    }
+  }
+  for (std::size_t c = 0; c < rigids_.size(); ++c) {
+    const int ro = rigidOffset(static_cast<int>(c));
+    out.template segment<d>(ro) += rigids_[c].mass * in.template segment<d>(ro);
+    out.template segment<rm::kAngularDim<d>>(ro + d) += rigids_[c].inertia * in.template segment<rm::kAngularDim<d>>(ro + d);
+  }
+}
+
+template <int d>
+void CoupledDampingSystem<d>::applyMass(const Eigen::VectorXd& in, Eigen::VectorXd& out) const {
+  out.setZero(size_);
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    for (int i = 0; i < static_cast<int>(bodies_[k].role.size()); ++i)
+      for (int a = 0; a < d; ++a) out(offset_[k] + d * i + a) = bodies_[k].m[i] * in(offset_[k] + d * i + a);
+  for (std::size_t c = 0; c < rigids_.size(); ++c) {
+    const int ro = rigidOffset(static_cast<int>(c));
+    out.template segment<d>(ro) = rigids_[c].mass * in.template segment<d>(ro);
+    out.template segment<rm::kAngularDim<d>>(ro + d) = rigids_[c].inertia * in.template segment<rm::kAngularDim<d>>(ro + d);
+  }
+}
+
+template <int d>
+void CoupledDampingSystem<d>::applyInverseMass(const Eigen::VectorXd& in, Eigen::VectorXd& out) const {
+  out.setZero(size_);
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    for (int i = 0; i < static_cast<int>(bodies_[k].role.size()); ++i)
+      for (int a = 0; a < d; ++a) out(offset_[k] + d * i + a) = in(offset_[k] + d * i + a) / bodies_[k].m[i];
+  for (std::size_t c = 0; c < rigids_.size(); ++c) {
+    const int ro = rigidOffset(static_cast<int>(c));
+    out.template segment<d>(ro) = in.template segment<d>(ro) / rigids_[c].mass;
+    out.template segment<rm::kAngularDim<d>>(ro + d) = inverseInertia_[c] * in.template segment<rm::kAngularDim<d>>(ro + d);
+  }
+}
+
+template <int d>
+void CoupledDampingSystem<d>::projectRigidHolds(int c, Eigen::VectorXd& y, bool forceSide) const {
+  const std::vector<int>& held = holdsOfRigid_[c];
+  if (held.empty()) return;
+  const int ro = rigidOffset(c);
+  // Velocities: y itself; forces: y = M^{-1} r on the blocks involved, and P^T r = M P M^{-1} r.
+  Twist<d> xi = y.template segment<kTwist<d>>(ro);
+  if (forceSide) {
+    xi.template head<d>() /= rigids_[c].mass;
+    xi.template tail<rm::kAngularDim<d>>() = inverseInertia_[c] * xi.template tail<rm::kAngularDim<d>>();
+  }
+  Twist<d> rhs = Twist<d>::Zero();
+  std::vector<Twist<d>> g(held.size());
+  std::vector<double> un(held.size());
+  for (std::size_t k = 0; k < held.size(); ++k) {
+    const DampingHold<d>& o = holds_[held[k]];
+    const double m = bodies_[o.body].m[o.particle];
+    g[k] = jointRow<d>(o.normal, arm(o.body, o.particle, c));
+    const VecD<d> uo = y.template segment<d>(offset_[o.body] + d * o.particle);
+    un[k] = o.normal.dot(uo) / (forceSide ? m : 1.0);
+    rhs += m * (un[k] - g[k].dot(xi)) * g[k];
+  }
+  const Twist<d> dxi = centralInverse_[c] * rhs;
+  for (std::size_t k = 0; k < held.size(); ++k) {
+    const DampingHold<d>& o = holds_[held[k]];
+    const double m = bodies_[o.body].m[o.particle];
+    const double lambda = m * (g[k].dot(xi + dxi) - un[k]);
+    // Velocities: u_o += lambda n / m; forces: r_o += m (lambda n / m).
+    y.template segment<d>(offset_[o.body] + d * o.particle) += (forceSide ? lambda : lambda / m) * o.normal;
+  }
+  if (forceSide) {
+    y.template segment<d>(ro) += rigids_[c].mass * dxi.template head<d>();
+    y.template segment<rm::kAngularDim<d>>(ro + d) += rigids_[c].inertia * dxi.template tail<rm::kAngularDim<d>>();
+  } else {
+    y.template segment<kTwist<d>>(ro) += dxi;
+  }
+}
+
+template <int d>
+void CoupledDampingSystem<d>::projectVelocity(Eigen::VectorXd& y) const {
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    for (int i = 0; i < static_cast<int>(bodies_[k].role.size()); ++i)
+      if (bodies_[k].role[i] != ParticleRole::Free) y.template segment<d>(offset_[k] + d * i).setZero();
+  for (int k : staticHolds_) {
+    const DampingHold<d>& c = holds_[k];
+    auto yi = y.template segment<d>(offset_[c.body] + d * c.particle);
+    yi -= yi.dot(c.normal) * c.normal;
+  }
+  for (int c = 0; c < static_cast<int>(rigids_.size()); ++c) projectRigidHolds(c, y, false);
+}
+
+template <int d>
+void CoupledDampingSystem<d>::projectForce(Eigen::VectorXd& r) const {
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    for (int i = 0; i < static_cast<int>(bodies_[k].role.size()); ++i)
+      if (bodies_[k].role[i] != ParticleRole::Free) r.template segment<d>(offset_[k] + d * i).setZero();
+  for (int k : staticHolds_) {
+    const DampingHold<d>& c = holds_[k];
+    auto ri = r.template segment<d>(offset_[c.body] + d * c.particle);
+    ri -= ri.dot(c.normal) * c.normal;
+  }
+  for (int c = 0; c < static_cast<int>(rigids_.size()); ++c) projectRigidHolds(c, r, true);
+}
+
+template <int d>
+void CoupledDampingSystem<d>::applyProjected(const Eigen::VectorXd& in, Eigen::VectorXd& out) const {
+  Eigen::VectorXd y = in;
+  projectVelocity(y);
+  apply(y, out);
+  projectForce(out);
+}
+
+template <int d>
+std::vector<double> CoupledDampingSystem<d>::constraintResiduals(const Eigen::VectorXd& y) const {
+  std::vector<double> out;
+  for (const DampingHold<d>& c : holds_) {
+    double rel = c.normal.dot(VecD<d>(y.template segment<d>(offset_[c.body] + d * c.particle)));
+    if (c.rigid >= 0)
+      rel -= jointRow<d>(c.normal, arm(c.body, c.particle, c.rigid)).dot(y.template segment<kTwist<d>>(rigidOffset(c.rigid)));
+    out.push_back(rel - c.target);
+  }
+  return out;
+}
+
+template <int d>
+CoupledDampingResult<d> CoupledDampingSystem<d>::solve() const {
+  CoupledDampingResult<d> result;
+  const int n = size_;
+  // y0: the velocities at the start of the stage; yp: the prescribed values and held targets.
+  Eigen::VectorXd y0 = Eigen::VectorXd::Zero(n), yp = Eigen::VectorXd::Zero(n), hf = Eigen::VectorXd::Zero(n);
+  bool damped = false;
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    const DampingBody<d>& b = bodies_[k];
+    damped = damped || b.fm->dampingRows() > 0;
+    for (int i = 0; i < static_cast<int>(b.role.size()); ++i)
+      for (int a = 0; a < d; ++a) {
+        const int j = offset_[k] + d * i + a;
+        if (b.role[i] == ParticleRole::Bound) continue;
+        y0(j) = b.v[d * i + a];
+        if (b.role[i] == ParticleRole::Prescribed) yp(j) = b.v[d * i + a];
+        else hf(j) = h_ * b.f[d * i + a];
+      }
+  }
+  for (std::size_t c = 0; c < rigids_.size(); ++c) {
+    const int ro = rigidOffset(static_cast<int>(c));
+    y0.template segment<d>(ro) = rigids_[c].v;
+    y0.template segment<rm::kAngularDim<d>>(ro + d) = rigids_[c].omega;
+  }
+  for (const DampingHold<d>& c : holds_)
+    yp.template segment<d>(offset_[c.body] + d * c.particle) = c.target * c.normal;
+
+  Eigen::VectorXd y = y0;
+  if (damped) {
+    Eigen::VectorXd b(n), Ayp(n), My0(n);
+    applyMass(y0, My0);
+    apply(yp, Ayp);
+    b = My0 + hf - Ayp;
+    projectForce(b);
+    Eigen::VectorXd x = y0 - yp;
+    projectVelocity(x);
+    solvers::CgSettings settings;
+    settings.relativeTolerance = 1e-10;
+    settings.maxIterations = 2000;
+    const solvers::LinearOperator op = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) { applyProjected(in, out); };
+    // P M^{-1} P^T: symmetric, and it keeps the search directions in the range of P.
+    const solvers::LinearOperator precondition = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+      Eigen::VectorXd rp = r;
+      projectForce(rp);
+      applyInverseMass(rp, z);
+      projectVelocity(z);
+    };
+    const solvers::CgReport r = solvers::conjugateGradient(op, precondition, nullptr, b, x, settings);
+    result.report.iterations = r.iterations;
+    result.report.relativeResidual = r.relativeResidual();
+    result.report.converged = r.converged;
+    y = x + yp;
+  }
+  std::vector<std::vector<double>> w;
+  expand(y, w);
+  dampingForces(w, result.Du);
+  result.u.resize(bodies_.size());
+  result.force.assign(rigids_.size(), VecD<d>::Zero());
+  result.torque.assign(rigids_.size(), rm::AngVec<d>::Zero());
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    const DampingBody<d>& b = bodies_[k];
+    std::vector<double>& u = result.u[k];
+    u.assign(b.v, b.v + d * b.role.size());
+    for (int i = 0; i < static_cast<int>(b.role.size()); ++i) {
+      const VecD<d> Dw = Eigen::Map<const VecD<d>>(&result.Du[k][d * i]);
+      if (b.role[i] == ParticleRole::Bound) {
+        const int c = b.rigid[i];
+        result.force[c] += Dw;
+        result.torque[c] += rm::cross<d>(arm(static_cast<int>(k), i, c), Dw);
+      } else if (b.role[i] == ParticleRole::Free) {
+        // Unprojected (Sec. 4.7.2, step 3): held particles get back their constraint's share.
+        for (int a = 0; a < d; ++a) u[d * i + a] = b.v[d * i + a] + h_ * (b.f[d * i + a] + Dw(a)) / b.m[i];
+      }
+    }
+  }
+  return result;
+}
+
+template <int d>
+CoupledDampingResult<d> solveCoupledDamping(std::vector<DampingBody<d>> bodies, std::vector<DampingRigid<d>> rigids,
+                                            std::vector<DampingHold<d>> holds, double h) {
+  return CoupledDampingSystem<d>(std::move(bodies), std::move(rigids), std::move(holds), h).solve();
+}
+
+template class CoupledDampingSystem<2>;
+template class CoupledDampingSystem<3>;
+template CoupledDampingResult<2> solveCoupledDamping<2>(std::vector<DampingBody<2>>, std::vector<DampingRigid<2>>,
+                                                        std::vector<DampingHold<2>>, double);
+template CoupledDampingResult<3> solveCoupledDamping<3>(std::vector<DampingBody<3>>, std::vector<DampingRigid<3>>,
+                                                        std::vector<DampingHold<3>>, double);
+
+}  // namespace monolith::solvers::deformable

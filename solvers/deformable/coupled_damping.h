@@ -1,0 +1,161 @@
+#pragma once
+// The implicit damping solve of Steps I and V with rigid bodies among its unknowns (thesis
+// Sec. 4.7.1, 4.7.3; notes 2.5, 2.6), entity-free.
+//
+// Unknowns y: the velocities of the particles of one or more deformable bodies and the twists
+// xi = (v, w) of the dynamic rigid bodies they are tied to. A particle is
+//  * free: its velocity is an unknown;
+//  * prescribed: its velocity is given (fixed particles, particles bound to static or kinematic
+//    bodies, embedded particles);
+//  * bound to rigid unknown c: its velocity is J_i xi_c = v_c + w_c x r_i (r_i = x_i - x_c), so
+//    it is not an unknown itself: the damping force on it acts on the body through J_i^T
+//    (force and torque r_i x f). Its mass is the body's already (added at scene setup).
+// The system is the backward Euler step of the damping alone,
+//   (M - h J^T D J) y = M y0 + h J^T f,
+// with M = diag(m_i, m_c, I_c) (the rigid bodies' world inertia) and J the map from the
+// unknowns to every particle's velocity; J^T D J is symmetric negative semidefinite, so the
+// matrix is SPD. The rigid bodies' own forces are applied by the rigid stages, so their f is 0
+// here (y0 carries their current twist).
+//
+// Contacts enter as temporary normal joints C^T y = t (Sec. 4.7.3, "contact as temporary
+// constraints"): a particle held against a static or kinematic body has its normal velocity
+// prescribed (P = 1 - n n^T on it); a particle held against a rigid unknown c has its normal
+// velocity relative to the body's point prescribed, n . (u_o - J_o xi_c) = t_o. The constraint
+// projection is P = delta - M^{-1} C (C^T M^{-1} C)^{-1} C^T, for one body and all the particles
+// held against it the central-body solve of eq. (4.3)-(4.4): with g_o = (n_o, r_o x n_o),
+//   (M_c + sum_o m_o g_o g_o^T) dxi = sum_o m_o g_o (n_o . u_o - g_o . xi),
+//   lambda_o = m_o (g_o . (xi + dxi) - n_o . u_o),  u_o += lambda_o n_o / m_o,  xi += dxi,
+// the exact M-orthogonal projection onto that body's constraints. Each particle is held against
+// one body at most, so the projections of different bodies touch disjoint unknowns and commute:
+// one pass is the exact projection onto all constraints (the forward and backward sweeps of
+// Sec. 4.7.3 are needed only when projections share unknowns). P is symmetric in the mass inner
+// product (M P = P^T M), so CG runs on
+//   P^T A P w = P^T (b - A y_p),   y = y_p + w,
+// with y_p any velocity meeting the constraints (the prescribed values, t_o n_o on held
+// particles, zero elsewhere), the preconditioner P M^{-1} P^T, and the product projected, so the
+// residual stays in the range of P^T and the stopping test sees the projected system.
+//
+// After the solve the velocities are rebuilt from the forces at the solution, unprojected
+// (Sec. 4.7.2, step 3): u_i = v_i + h (f_i + (D J y)_i) / m_i on free and held particles, and each
+// rigid unknown receives the damping force of its bound particles, J_c^T D J y, returned as a
+// force and torque for the caller to apply over the stage's duration. The constraints only steer
+// the velocity at which the damping forces are evaluated; contact and friction follow as the
+// post-process that passes momentum both ways. Since the damping forces are internal, the total
+// linear momentum changes by exactly h sum f whatever CG's tolerance leaves, and with
+// torque-free dampers (springs) the angular momentum is kept too.
+#include <vector>
+
+#include "solvers/contact/rigid_math.h"
+#include "solvers/deformable/elasticity.h"
+
+namespace monolith::solvers::deformable {
+
+namespace rm = solvers::contact;
+
+enum class ParticleRole : char { Free = 0, Prescribed = 1, Bound = 2 };
+
+// One deformable body in the solve. Arrays hold d numbers per particle (m: one).
+template <int d>
+struct DampingBody {
+  const ForceModel<d>* fm = nullptr;
+  const std::vector<MatD<d>>* rotations = nullptr;  // damping rotations at x (dampingRotations)
+  const double* x = nullptr;
+  const double* v = nullptr;  // velocity at the start of the stage (prescribed particles: their value)
+  const double* m = nullptr;
+  const double* f = nullptr;  // explicit forces (ignored on prescribed and bound particles)
+  std::vector<ParticleRole> role;  // per particle
+  std::vector<int> rigid;          // per particle: the rigid unknown of a bound particle, else -1
+};
+
+// A dynamic rigid body as an unknown: mass, world inertia, centre of mass, and its twist at the
+// start of the solve.
+template <int d>
+struct DampingRigid {
+  double mass = 1;
+  rm::AngMat<d> inertia = rm::AngMat<d>::Identity();
+  VecD<d> x = VecD<d>::Zero();
+  VecD<d> v = VecD<d>::Zero();
+  rm::AngVec<d> omega = rm::AngVec<d>::Zero();
+};
+
+// A particle held along a normal: n . u = target (rigid < 0: a static or kinematic body, target
+// its point's normal velocity plus what the stage keeps of the approach), or
+// n . (u - v_c - w_c x r) = target (rigid >= 0: relative to that rigid unknown's point,
+// r = x_particle - x_c).
+template <int d>
+struct DampingHold {
+  int body = 0;
+  int particle = 0;
+  VecD<d> normal = VecD<d>::Zero();
+  double target = 0;
+  int rigid = -1;
+};
+
+struct CoupledDampingReport {
+  int iterations = 0;
+  double relativeResidual = 0;
+  bool converged = true;
+};
+
+template <int d>
+struct CoupledDampingResult {
+  std::vector<std::vector<double>> u;   // per body: the rebuilt velocities (prescribed and bound: v)
+  std::vector<std::vector<double>> Du;  // per body: the damping forces at the solution
+  std::vector<VecD<d>> force;           // per rigid unknown: sum of the damping forces on its bound particles
+  std::vector<rm::AngVec<d>> torque;    // ... and their torque about its centre of mass
+  CoupledDampingReport report;
+};
+
+// The system above, assembled once; the operator and projections are exposed for tests.
+template <int d>
+class CoupledDampingSystem {
+ public:
+  CoupledDampingSystem(std::vector<DampingBody<d>> bodies, std::vector<DampingRigid<d>> rigids,
+                       std::vector<DampingHold<d>> holds, double h);
+
+  int size() const { return size_; }
+  // A y = M y - h J^T D J y (bound components of the output zero; the input's ignored).
+  void apply(const Eigen::VectorXd& in, Eigen::VectorXd& out) const;
+  // The operator CG sees: P^T A P.
+  void applyProjected(const Eigen::VectorXd& in, Eigen::VectorXd& out) const;
+  // y <- P y (velocities) and r <- P^T r (forces).
+  void projectVelocity(Eigen::VectorXd& y) const;
+  void projectForce(Eigen::VectorXd& r) const;
+  // The mass matrix M (for the tests' inner products) and its inverse.
+  void applyMass(const Eigen::VectorXd& in, Eigen::VectorXd& out) const;
+  void applyInverseMass(const Eigen::VectorXd& in, Eigen::VectorXd& out) const;
+  // Constraint residuals C^T y - t (one per hold), for tests.
+  std::vector<double> constraintResiduals(const Eigen::VectorXd& y) const;
+
+  CoupledDampingResult<d> solve() const;
+
+ private:
+  int particleOffset(int body) const { return offset_[body]; }
+  int rigidOffset(int c) const { return rigidStart_ + c * (d + rm::kAngularDim<d>); }
+  // Expands the unknowns to every particle's velocity (bound particles from their rigid body).
+  void expand(const Eigen::VectorXd& in, std::vector<std::vector<double>>& w) const;
+  // The damping forces on every particle at the expanded velocities w.
+  void dampingForces(const std::vector<std::vector<double>>& w, std::vector<std::vector<double>>& Dw) const;
+  VecD<d> arm(int body, int particle, int c) const;
+  // The central-body projection of rigid unknown c and its held particles: P on velocities y,
+  // or P^T = M P M^{-1} on forces.
+  void projectRigidHolds(int c, Eigen::VectorXd& y, bool forceSide) const;
+
+  std::vector<DampingBody<d>> bodies_;
+  std::vector<DampingRigid<d>> rigids_;
+  std::vector<DampingHold<d>> holds_;
+  double h_;
+  std::vector<int> offset_;
+  int rigidStart_ = 0, size_ = 0;
+  std::vector<std::vector<int>> holdsOfRigid_;  // per rigid unknown, indices into holds_
+  std::vector<int> staticHolds_;
+  // Per rigid unknown: the factorized (M_c + sum m_o g_o g_o^T) and the inverse world inertia.
+  std::vector<Eigen::Matrix<double, d + rm::kAngularDim<d>, d + rm::kAngularDim<d>>> centralInverse_;
+  std::vector<rm::AngMat<d>> inverseInertia_;
+};
+
+template <int d>
+CoupledDampingResult<d> solveCoupledDamping(std::vector<DampingBody<d>> bodies, std::vector<DampingRigid<d>> rigids,
+                                            std::vector<DampingHold<d>> holds, double h);
+
+}  // namespace monolith::solvers::deformable
