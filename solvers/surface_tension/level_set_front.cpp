@@ -87,7 +87,7 @@ int mergeSlivers(Front2& front, double minLength) {
 }
 
 Front2 frontFromLevelSet(const MacLayout<2>& layout, const std::vector<double>& phi, CrossingOrder order,
-                         double sliverFraction) {
+                         double sliverFraction, double nodeSnap) {
   const int nx = layout.cells[0], ny = layout.cells[1];
   if (static_cast<int>(phi.size()) != nx * ny) throw std::invalid_argument("frontFromLevelSet: phi has the wrong size");
   const double dx = layout.dx;
@@ -117,6 +117,16 @@ Front2 frontFromLevelSet(const MacLayout<2>& layout, const std::vector<double>& 
   auto origin = [&](int i, int j) { return Eigen::Vector2d(layout.origin + dx * Eigen::Vector2d(i, j)); };
 
   Front2 front;
+  // A crossing next to a node whose value is within nodeSnap dx of zero is the node itself: one point
+  // shared by every edge that meets there.
+  std::map<long, int> nodePoint;
+  auto nodeId = [&](int i, int j) -> int {
+    const long key = static_cast<long>(j) * (nx + 1) + i;
+    const auto found = nodePoint.find(key);
+    if (found != nodePoint.end()) return found->second;
+    front.points.push_back(origin(i, j));
+    return nodePoint[key] = front.pointCount() - 1;
+  };
   // Edge ids: vertical edge (i, j) from node (i, j) to (i, j+1); horizontal from (i, j) to (i+1, j).
   std::map<long, int> crossingOf;
   auto edgeCrossing = [&](bool vertical, int i, int j) -> int {
@@ -134,6 +144,8 @@ Front2 frontFromLevelSet(const MacLayout<2>& layout, const std::vector<double>& 
       if (order == CrossingOrder::Third) t = {0, 0.5, 1}, v = {a, yFace(i, j), b};
       else t = {-0.5, 0, 1, 1.5}, v = {yFace(i - 1, j), a, b, yFace(i + 1, j)};
     }
+    if (std::abs(a) < nodeSnap * dx) return crossingOf[key] = nodeId(i, j);
+    if (std::abs(b) < nodeSnap * dx) return crossingOf[key] = vertical ? nodeId(i, j + 1) : nodeId(i + 1, j);
     const double theta = crossingParameter(t, v);
     const Eigen::Vector2d x = origin(i, j) + theta * dx * (vertical ? Eigen::Vector2d(0, 1) : Eigen::Vector2d(1, 0));
     front.points.push_back(x);
@@ -164,6 +176,7 @@ Front2 frontFromLevelSet(const MacLayout<2>& layout, const std::vector<double>& 
       // Orient: the outward normal R t = (t_y, -t_x) points up the bilinear gradient.
       const Eigen::Vector2d gradient((c10 - c00 + c11 - c01) / 2, (c01 - c00 + c11 - c10) / 2);
       for (auto p : pairs) {
+        if (p[0] == p[1]) continue;  // both ends on one snapped node
         const Eigen::Vector2d t = front.points[p[1]] - front.points[p[0]];
         if (Eigen::Vector2d(t.y(), -t.x()).dot(gradient) < 0) std::swap(p[0], p[1]);
         front.elements.push_back(p);

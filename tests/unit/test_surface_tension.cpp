@@ -309,6 +309,33 @@ TEST(SurfaceTensionStaticCircle, LevelSetCurrentsFallUnderRefinement) {
   EXPECT_GT(two.linf, 3 * runs[1].linf);
 }
 
+TEST(SurfaceTensionStaticCircle, TwoPhaseLevelSetCurrentsDoNotGrow) {
+  // Two phases, the level-set-tracked front at 1/dx = 40 to t = 1.25. The circle passes within 1e-6
+  // of eight grid nodes ((0.5 +- 0.15, 0.5 +- 0.2) and transposed) and touches four more; the corner
+  // cells there are cut into tiny parts, and the current then grows steadily (measured without the
+  // node snap: L1 5.80e-8 at t = 0.625, 1.105e-7 at 1.25, 2.24e-7 at 2.5, and L-inf 8.3e-5 at t = 5).
+  // With the crossings put on those nodes (TwoPhaseSettings::levelSetNodeSnap, 1e-4 dx): 5.18e-8 and
+  // 6.56e-8 (L-inf 1.34e-5 at t = 5, the thesis's 3.33e-5).
+  auto growth = [](double snap) {
+    LevelSetFrontOptions options;
+    options.nodeSnap = snap;
+    double half = 0;
+    const StaticCircleResult r = runStaticCircle(40, false, true, 1.25, true, 0, false, 1e4, options,
+                                                 [&](const TwoPhaseState& s, const TwoPhaseStepReport&) {
+                                                   if (s.step == 125) half = velocityNorms(s.u).first;
+                                                 });
+    EXPECT_TRUE(r.stable);
+    EXPECT_NEAR(r.pressureJump, 4.0, 0.04);
+    return std::make_pair(r.l1 / half, r.l1);
+  };
+  const auto [snapped, snappedL1] = growth(1e-4);
+  EXPECT_LT(snapped, 1.45);
+  EXPECT_LT(snappedL1, 8e-8);
+  const auto [unsnapped, unsnappedL1] = growth(0);
+  EXPECT_GT(unsnapped, 1.7);  // the growth this test is there to catch
+  EXPECT_GT(unsnappedL1, 1e-7);
+}
+
 TEST(SurfaceTensionFront, ShapeMeasuresOfASquare) {
   // The unit square about (2, 3): area 1, length 4, centroid (2, 3), top 3.5 and bottom 2.5 on the
   // line x = 2, circularity 2 sqrt(pi) / 4.
