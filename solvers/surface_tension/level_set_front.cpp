@@ -58,8 +58,16 @@ int mergeSlivers(Front2& front, double minLength) {
       const double lengthDrop0 = before >= 0 ? (front.points[e[1]] - front.points[front.elements[before][0]]).norm() : 1e300;
       const double lengthDrop1 = after >= 0 ? (front.points[front.elements[after][1]] - front.points[e[0]]).norm() : 1e300;
       if (before < 0 && after < 0) continue;  // an isolated segment: leave it
+      // A merged segment whose two ends lie on one grid line would lie on that line (a cap over the
+      // line whose tip is deleted), and the inside of that line's faces would be undecided; such a
+      // merge is taken only when the other one has the same fault.
+      auto onOneLine = [&](int a, int b) {
+        return front.points[a].x() == front.points[b].x() || front.points[a].y() == front.points[b].y();
+      };
+      const bool bad0 = before >= 0 && onOneLine(front.elements[before][0], e[1]);
+      const bool bad1 = after >= 0 && onOneLine(e[0], front.elements[after][1]);
       std::vector<std::array<int, 2>> elements;
-      if (lengthDrop0 <= lengthDrop1) {
+      if (bad0 != bad1 ? bad1 : lengthDrop0 <= lengthDrop1) {
         for (int q = 0; q < front.elementCount(); ++q)
           if (q == before) elements.push_back({front.elements[before][0], e[1]});
           else if (q != s) elements.push_back(front.elements[q]);

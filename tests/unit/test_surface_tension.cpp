@@ -336,6 +336,30 @@ TEST(SurfaceTensionStaticCircle, TwoPhaseLevelSetCurrentsDoNotGrow) {
   EXPECT_GT(unsnappedL1, 1e-7);
 }
 
+TEST(SurfaceTensionFront, LevelSetMeshDoesNotLayASegmentOnAGridLine) {
+  // A circle whose top lies 3e-6 above the grid line y = 0.75, over the node (0.5, 0.75): the mesh
+  // has a cap over the line, two crossings 1.2e-3 (0.05 dx) either side of the node and its tip on
+  // the vertical edge above it. Merging those slivers by deleting the tip laid the merged segment on
+  // the line, where its cells' faces cannot be told inside from outside; in the two-phase static
+  // circle that kicked the current from 3e-6 to 1e-4 (1/dx = 40, t = 3.9). The merge deletes a
+  // crossing instead, and the tip stays.
+  const MacLayout<2> layout(Eigen::Vector2i(40, 40), 1.0 / 40);
+  const Eigen::Vector2d centre(0.5, 0.5 + 3e-6);
+  std::vector<double> phi(layout.cellCount());
+  for (int c = 0; c < layout.cellCount(); ++c) phi[c] = (layout.cellCenter(layout.cellCoord(c)) - centre).norm() - 0.25;
+  const Front2 front = frontFromLevelSet(layout, phi, CrossingOrder::Fourth);
+  bool tip = false;
+  for (const auto& x : front.points) tip = tip || (x.y() > 0.75 && std::abs(x.x() - 0.5) < 1e-12);
+  EXPECT_TRUE(tip);
+  for (const auto& e : front.elements) {
+    const Eigen::Vector2d a = front.points[e[0]], b = front.points[e[1]];
+    const bool onLine = (a.y() == b.y() && std::abs(a.y() * 40 - std::round(a.y() * 40)) < 1e-9) ||
+                        (a.x() == b.x() && std::abs(a.x() * 40 - std::round(a.x() * 40)) < 1e-9);
+    EXPECT_FALSE(onLine) << a.transpose() << " -> " << b.transpose();
+  }
+  EXPECT_NEAR(enclosedArea(front), M_PI * 0.0625, 1e-3);
+}
+
 TEST(SurfaceTensionFront, ShapeMeasuresOfASquare) {
   // The unit square about (2, 3): area 1, length 4, centroid (2, 3), top 3.5 and bottom 2.5 on the
   // line x = 2, circularity 2 sqrt(pi) / 4.
