@@ -30,7 +30,9 @@ Front2 frontFromLevelSet(const MacLayout<2>& layout, const std::vector<double>& 
                          double sliverFraction = 0.1, double nodeSnap = 0);
 
 // Removes every segment shorter than minLength by deleting one of its endpoints (an interior point of
-// its polyline; the one whose removal leaves the shorter merged segment). Returns the count removed.
+// its polyline; the one whose removal leaves the shorter merged segment, unless that merged segment
+// would lie on a grid line: a cap over a line, tip deleted, whose faces could not be told inside from
+// outside). Returns the count removed.
 int mergeSlivers(Front2& front, double minLength);
 
 // Root in [0, 1] of the polynomial through the samples (t_i, v_i) (3 or 4 of them), with v(0) and
