@@ -90,8 +90,7 @@ struct TwoPhaseSettings {
   // Two phases only, in dx: the rebuilt mesh puts the crossings next to a grid node whose level-set
   // value is within this of zero on the node itself (frontFromLevelSet's nodeSnap). A front passing
   // a node at a tiny distance cuts the corner cells into tiny parts; in two phases that made the
-  // static circle's currents grow at 1/dx = 40 (L1 linearly from the start, and L-inf from 3e-6 to
-  // 1e-4 when the circle's top and bottom crossed their tangent grid nodes at t ~ 3.7). In one phase
+  // static circle's current grow steadily at 1/dx = 40 (L1 linearly from the start). In one phase
   // the snapped configuration (a front through a node) measured worse, so it is not used there
   // (docs/benchmarks_surface_tension.md). 0 turns it off.
   double levelSetNodeSnap = 1e-4;
