@@ -313,9 +313,9 @@ TEST(SurfaceTensionStaticCircle, TwoPhaseLevelSetCurrentsDoNotGrow) {
   // Two phases, the level-set-tracked front at 1/dx = 40 to t = 1.25. The circle passes within 1e-6
   // of eight grid nodes ((0.5 +- 0.15, 0.5 +- 0.2) and transposed) and touches four more; the corner
   // cells there are cut into tiny parts, and the current then grows steadily (measured without the
-  // node snap: L1 5.80e-8 at t = 0.625, 1.105e-7 at 1.25, 2.24e-7 at 2.5, and L-inf 8.3e-5 at t = 5).
-  // With the crossings put on those nodes (TwoPhaseSettings::levelSetNodeSnap, 1e-4 dx): 5.18e-8 and
-  // 6.56e-8 (L-inf 1.34e-5 at t = 5, the thesis's 3.33e-5).
+  // node snap: L1 5.80e-8 at t = 0.625, 1.105e-7 at 1.25, 2.27e-7 at 2.5). With the crossings put on
+  // those nodes (TwoPhaseSettings::levelSetNodeSnap, 1e-4 dx): 5.18e-8 and 6.56e-8 (and at t = 5
+  // L1 3.13e-7, L-inf 3.13e-6; the thesis's 7.56e-6 / 3.33e-5).
   auto growth = [](double snap) {
     LevelSetFrontOptions options;
     options.nodeSnap = snap;
