@@ -58,8 +58,16 @@ int mergeSlivers(Front2& front, double minLength) {
       const double lengthDrop0 = before >= 0 ? (front.points[e[1]] - front.points[front.elements[before][0]]).norm() : 1e300;
       const double lengthDrop1 = after >= 0 ? (front.points[front.elements[after][1]] - front.points[e[0]]).norm() : 1e300;
       if (before < 0 && after < 0) continue;  // an isolated segment: leave it
+      // A merged segment whose two ends lie on one grid line would lie on that line (a cap over the
+      // line whose tip is deleted), and the inside of that line's faces would be undecided; such a
+      // merge is taken only when the other one has the same fault.
+      auto onOneLine = [&](int a, int b) {
+        return front.points[a].x() == front.points[b].x() || front.points[a].y() == front.points[b].y();
+      };
+      const bool bad0 = before >= 0 && onOneLine(front.elements[before][0], e[1]);
+      const bool bad1 = after >= 0 && onOneLine(e[0], front.elements[after][1]);
       std::vector<std::array<int, 2>> elements;
-      if (lengthDrop0 <= lengthDrop1) {
+      if (bad0 != bad1 ? bad1 : lengthDrop0 <= lengthDrop1) {
         for (int q = 0; q < front.elementCount(); ++q)
           if (q == before) elements.push_back({front.elements[before][0], e[1]});
           else if (q != s) elements.push_back(front.elements[q]);
@@ -87,7 +95,7 @@ int mergeSlivers(Front2& front, double minLength) {
 }
 
 Front2 frontFromLevelSet(const MacLayout<2>& layout, const std::vector<double>& phi, CrossingOrder order,
-                         double sliverFraction) {
+                         double sliverFraction, double nodeSnap) {
   const int nx = layout.cells[0], ny = layout.cells[1];
   if (static_cast<int>(phi.size()) != nx * ny) throw std::invalid_argument("frontFromLevelSet: phi has the wrong size");
   const double dx = layout.dx;
@@ -117,6 +125,16 @@ Front2 frontFromLevelSet(const MacLayout<2>& layout, const std::vector<double>& 
   auto origin = [&](int i, int j) { return Eigen::Vector2d(layout.origin + dx * Eigen::Vector2d(i, j)); };
 
   Front2 front;
+  // A crossing next to a node whose value is within nodeSnap dx of zero is the node itself: one point
+  // shared by every edge that meets there.
+  std::map<long, int> nodePoint;
+  auto nodeId = [&](int i, int j) -> int {
+    const long key = static_cast<long>(j) * (nx + 1) + i;
+    const auto found = nodePoint.find(key);
+    if (found != nodePoint.end()) return found->second;
+    front.points.push_back(origin(i, j));
+    return nodePoint[key] = front.pointCount() - 1;
+  };
   // Edge ids: vertical edge (i, j) from node (i, j) to (i, j+1); horizontal from (i, j) to (i+1, j).
   std::map<long, int> crossingOf;
   auto edgeCrossing = [&](bool vertical, int i, int j) -> int {
@@ -134,6 +152,8 @@ Front2 frontFromLevelSet(const MacLayout<2>& layout, const std::vector<double>& 
       if (order == CrossingOrder::Third) t = {0, 0.5, 1}, v = {a, yFace(i, j), b};
       else t = {-0.5, 0, 1, 1.5}, v = {yFace(i - 1, j), a, b, yFace(i + 1, j)};
     }
+    if (std::abs(a) < nodeSnap * dx) return crossingOf[key] = nodeId(i, j);
+    if (std::abs(b) < nodeSnap * dx) return crossingOf[key] = vertical ? nodeId(i, j + 1) : nodeId(i + 1, j);
     const double theta = crossingParameter(t, v);
     const Eigen::Vector2d x = origin(i, j) + theta * dx * (vertical ? Eigen::Vector2d(0, 1) : Eigen::Vector2d(1, 0));
     front.points.push_back(x);
@@ -164,6 +184,7 @@ Front2 frontFromLevelSet(const MacLayout<2>& layout, const std::vector<double>& 
       // Orient: the outward normal R t = (t_y, -t_x) points up the bilinear gradient.
       const Eigen::Vector2d gradient((c10 - c00 + c11 - c01) / 2, (c01 - c00 + c11 - c10) / 2);
       for (auto p : pairs) {
+        if (p[0] == p[1]) continue;  // both ends on one snapped node
         const Eigen::Vector2d t = front.points[p[1]] - front.points[p[0]];
         if (Eigen::Vector2d(t.y(), -t.x()).dot(gradient) < 0) std::swap(p[0], p[1]);
         front.elements.push_back(p);

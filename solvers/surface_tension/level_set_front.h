@@ -21,11 +21,18 @@ enum class CrossingOrder { Third = 3, Fourth = 4 };
 
 // phi: one value per cell of `layout` (x fastest). Stencils reaching outside the grid clamp to the
 // nearest cell. Points closer than 0.1 dx are merged (sliverLength = 0 keeps every segment).
+// nodeSnap > 0: the crossings on the edges of a node whose value lies within nodeSnap dx of zero are
+// put on the node (one shared point). That moves them by at most about nodeSnap dx normal to the
+// front, so Table 6.1 is measured without it; the two-phase flow uses it (TwoPhaseSettings::
+// levelSetNodeSnap) because a front passing a node at a roundoff-to-tiny distance makes crossings
+// that flip between the node's edges from step to step (docs/benchmarks_surface_tension.md).
 Front2 frontFromLevelSet(const MacLayout<2>& layout, const std::vector<double>& phi, CrossingOrder order,
-                         double sliverFraction = 0.1);
+                         double sliverFraction = 0.1, double nodeSnap = 0);
 
 // Removes every segment shorter than minLength by deleting one of its endpoints (an interior point of
-// its polyline; the one whose removal leaves the shorter merged segment). Returns the count removed.
+// its polyline; the one whose removal leaves the shorter merged segment, unless that merged segment
+// would lie on a grid line: a cap over a line, tip deleted, whose faces could not be told inside from
+// outside). Returns the count removed.
 int mergeSlivers(Front2& front, double minLength);
 
 // Root in [0, 1] of the polynomial through the samples (t_i, v_i) (3 or 4 of them), with v(0) and

@@ -95,6 +95,7 @@ void applyLevelSetOptions(TwoPhaseSettings& settings, const LevelSetFrontOptions
   settings.levelSetRedistancing = options.redistancing;
   settings.levelSetKeep = options.keep;
   settings.particleLevelSet = options.particles;
+  settings.levelSetNodeSnap = options.nodeSnap;
 }
 // Steps a static circle until the end or a blow-up (advance returns true), then takes the
 // parasitic-current norms over all faces.
@@ -111,7 +112,8 @@ StaticCircleResult stepStaticCircle(State& state, int steps, Advance advance) {
 }  // namespace
 
 StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double endTime, bool levelSet, int points,
-                                   bool remesh, double densityOutside, const LevelSetFrontOptions& levelSetOptions) {
+                                   bool remesh, double densityOutside, const LevelSetFrontOptions& levelSetOptions,
+                                   const StaticCircleObserver& observer) {
   const double dx = 1.0 / n, dt = 0.2 * dx;
   if (points <= 0) points = staticCircleFrontPoints(n);
   TwoPhaseState state = makeTwoPhaseState(MacLayout<2>(Eigen::Vector2i(n, n), dx),
@@ -132,6 +134,7 @@ StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double e
   StaticCircleResult r = stepStaticCircle(state, static_cast<int>(std::lround(endTime / dt)), [&](TwoPhaseState& s) {
     last = advanceTwoPhase(s, settings, dt);
     if (levelSet && levelSetOptions.frozen) s.phi = exactPhi;
+    if (observer) observer(s, last);
     return last.blewUp;
   });
   r.pressureJump = last.pressureJump;

@@ -2,6 +2,7 @@
 // The experiments of thesis Sec. 6.4 set up on the solvers of this directory (used by the tests
 // and by tests/bench/bench_surface_tension.cpp). Parameters follow the thesis; choices it leaves
 // open are stated with each function.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -46,11 +47,15 @@ struct LevelSetFrontOptions {
   double keep = 3;
   bool particles = false;
   bool frozen = false;
+  double nodeSnap = 1e-4;  // TwoPhaseSettings::levelSetNodeSnap
 };
+// Called after every step of a static circle (the bench's trace of the currents over time).
+using StaticCircleObserver = std::function<void(const TwoPhaseState&, const TwoPhaseStepReport&)>;
 // levelSet: the level-set-tracked front (level_set_tracking.h) from the circle's exact signed distance.
 StaticCircleResult runStaticCircle(int n, bool onePhase, bool implicit, double endTime, bool levelSet = false,
                                    int points = 0, bool remesh = false, double densityOutside = 1e4,
-                                   const LevelSetFrontOptions& levelSetOptions = {});
+                                   const LevelSetFrontOptions& levelSetOptions = {},
+                                   const StaticCircleObserver& observer = {});
 // The point count of the original driver's front at 1/dx = n: the power of two nearest 8 pi r n.
 int staticCircleFrontPoints(int n);
 // The same circle with the pressure jump scheme (pressure_jump.h: one phase, explicit, phi the exact

@@ -400,7 +400,8 @@ void reportBlowUp(TwoPhaseStepReport& report, const TwoPhaseSettings& settings, 
 bool rebuildFront(TwoPhaseState& state, const MacLayout<2>& layout, const TwoPhaseSettings& settings,
                   TwoPhaseStepReport& report) {
   try {
-    state.front = frontFromLevelSet(layout, state.phi, CrossingOrder::Fourth);
+    state.front = frontFromLevelSet(layout, state.phi, CrossingOrder::Fourth, 0.1,
+                                    settings.onePhase ? 0.0 : settings.levelSetNodeSnap);
     return true;
   } catch (const std::invalid_argument&) {
     reportBlowUp(report, settings, [&](std::ostream& why) {

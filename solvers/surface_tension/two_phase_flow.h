@@ -87,6 +87,13 @@ struct TwoPhaseSettings {
   // that varies from point to point: O(1) curvature noise, parasitic currents that do not converge
   // (docs/benchmarks_surface_tension.md). 3 keeps every value the stencils read.
   double levelSetKeep = 3;
+  // Two phases only, in dx: the rebuilt mesh puts the crossings next to a grid node whose level-set
+  // value is within this of zero on the node itself (frontFromLevelSet's nodeSnap). A front passing
+  // a node at a tiny distance cuts the corner cells into tiny parts; in two phases that made the
+  // static circle's current grow steadily at 1/dx = 40 (L1 linearly from the start). In one phase
+  // the snapped configuration (a front through a node) measured worse, so it is not used there
+  // (docs/benchmarks_surface_tension.md). 0 turns it off.
+  double levelSetNodeSnap = 1e-4;
   // The particle level set [47] (particle_level_set.h) corrects the advected phi before and after
   // redistancing; its particles live in TwoPhaseState::levelSetParticles (seeded on the first step).
   bool particleLevelSet = false;

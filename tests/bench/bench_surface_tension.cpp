@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "solvers/surface_tension/front_metrics.h"
 #include "solvers/surface_tension/scenarios.h"
 
 using namespace monolith::solvers;
@@ -44,7 +45,10 @@ int main(int argc, char** argv) {
     }
   } else if (mode == "static") {
     // Options among the sizes: points=P (front points; default the original driver's 2^k at about
-    // dx / 4; one_per_dx: one point per dx of arc), remesh, rho_out=R, t_end=T (default the thesis's 5).
+    // dx / 4; one_per_dx: one point per dx of arc), remesh, rho_out=R, t_end=T (default the thesis's 5),
+    // trace=K (every K steps, and at every step whose front has a new point count: the currents, where
+    // the largest is, the front's area error, centroid and points), snap=S (level sets: crossings
+    // within S dx of a node put on it; default 1e-4, 0 off).
     const bool one = argc > 2 && (std::string(argv[2]) == "one" || std::string(argv[2]) == "one_ls");
     const bool ls = argc > 2 && std::string(argv[2]).find("_ls") != std::string::npos;
     int points = 0;
@@ -52,6 +56,7 @@ int main(int argc, char** argv) {
     double rhoOut = 1e4, endTime = 5.0;
     LevelSetFrontOptions lsOptions;
     bool keepGiven = false;  // the pressure jump scheme keeps 2 cells unless told
+    int traceEvery = 0;      // trace=K: every K steps, the currents and the front's area, centroid, points
     std::vector<int> ns;
     for (int i = 3; i < argc; ++i) {
       const std::string a = argv[i];
@@ -65,15 +70,17 @@ int main(int argc, char** argv) {
       else if (a.rfind("keep=", 0) == 0) lsOptions.keep = std::atof(a.c_str() + 5), keepGiven = true;
       else if (a == "particles") lsOptions.particles = true;
       else if (a == "frozen") lsOptions.frozen = true;
+      else if (a.rfind("snap=", 0) == 0) lsOptions.nodeSnap = std::atof(a.c_str() + 5);
+      else if (a.rfind("trace=", 0) == 0) traceEvery = std::atoi(a.c_str() + 6);
       else ns.push_back(std::atoi(a.c_str()));
     }
     if (ns.empty()) ns = {20, 40, 80};
     if (ls)
-      std::printf("level set: redistancing %s, keep %g dx%s%s\n",
+      std::printf("level set: redistancing %s, keep %g dx, node snap %g dx%s%s\n",
                   lsOptions.redistancing == LevelSetRedistancing::ToMesh       ? "to the mesh"
                   : lsOptions.redistancing == LevelSetRedistancing::FastMarching ? "fast marching"
                                                                                  : "none",
-                  lsOptions.keep, lsOptions.particles ? ", particle level set" : "", lsOptions.frozen ? ", frozen" : "");
+                  lsOptions.keep, lsOptions.nodeSnap, lsOptions.particles ? ", particle level set" : "", lsOptions.frozen ? ", frozen" : "");
     std::printf("static circle, %s phase, %s, implicit, t = %g, dt = 0.2 dx, front points %s%s, rho_out %g\n"
                 "| 1/dx | L1(u) | Linf(u) | pressure jump | jump error | steps | CG its (last) | wall s |\n|---|---|---|---|---|---|---|---|\n",
                 one ? "one" : "two", ls ? "level-set front" : "front tracking", endTime,
@@ -88,7 +95,25 @@ int main(int argc, char** argv) {
         continue;
       }
       const int p = points >= 0 ? points : static_cast<int>(std::lround(2 * M_PI * 0.25 * n));
-      const StaticCircleResult r = runStaticCircle(n, one, true, endTime, ls, p, remesh, rhoOut, lsOptions);
+      StaticCircleObserver trace;
+      int lastPoints = -1;
+      if (traceEvery > 0)
+        trace = [&](const TwoPhaseState& state, const TwoPhaseStepReport& report) {
+          const bool changed = lastPoints >= 0 && state.front.pointCount() != lastPoints;  // the mesh's topology moved
+          lastPoints = state.front.pointCount();
+          if (state.step % traceEvery != 0 && !changed) return;
+          const auto [l1, linf] = velocityNorms(state.u);
+          const FrontShape shape = measureFront(state.front);
+          Eigen::Index worst = 0;
+          state.u.cwiseAbs().maxCoeff(&worst);
+          const auto [axis, face] = state.layout.faceCoord(static_cast<int>(worst));
+          const Eigen::Vector2d at = state.layout.faceCenter(axis, face);
+          std::printf("  t %.3f  L1 %.3e  Linf %.3e at (%.4f, %.4f) axis %d  area-pi r^2 %+.3e  centroid %+.3e %+.3e  points %d  cut cells %d  CG %d\n",
+                      state.time, l1, linf, at.x(), at.y(), axis, shape.area - M_PI * 0.0625, shape.centroid.x() - 0.5,
+                      shape.centroid.y() - 0.5, state.front.pointCount(), report.cutCells, report.solve.iterations);
+          std::fflush(stdout);
+        };
+      const StaticCircleResult r = runStaticCircle(n, one, true, endTime, ls, p, remesh, rhoOut, lsOptions, trace);
       std::printf("| %d | %.3e | %.3e | %.5f | %.2e | %d | %d | %.1f |\n", n, r.l1, r.linf, r.pressureJump,
                   std::abs(r.pressureJump - 4.0) / 4.0, r.steps, r.lastIterations, seconds(start));
       std::fflush(stdout);
