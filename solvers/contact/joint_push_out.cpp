@@ -23,6 +23,29 @@ struct Row {
   double inverseMass = 0;
 };
 
+// The separation the moves give point k along its normal ((dtheta x r).n = dtheta.(r x n)).
+template <int d>
+inline double separationGained(const JointPoint<d>& p, const Row<d>& row, const std::vector<JointMove<d>>& moves) {
+  double s = 0;
+  if (p.a >= 0) s += p.n.dot(moves[p.a].dx) + row.ca.dot(moves[p.a].dtheta);
+  if (p.b >= 0) s -= p.n.dot(moves[p.b].dx) + row.cb.dot(moves[p.b].dtheta);
+  return s;
+}
+
+// A change of point k's multiplier, moved into the bodies (dx = M^{-1} J^T dlambda).
+template <int d>
+inline void moveBodies(const std::vector<JointBody<d>>& bodies, const JointPoint<d>& p, const Row<d>& row, double change,
+                       std::vector<JointMove<d>>& moves) {
+  if (p.a >= 0) {
+    moves[p.a].dx += change * bodies[p.a].inverseMass * p.n;
+    moves[p.a].dtheta += change * row.inertiaCa;
+  }
+  if (p.b >= 0) {
+    moves[p.b].dx -= change * bodies[p.b].inverseMass * p.n;
+    moves[p.b].dtheta -= change * row.inertiaCb;
+  }
+}
+
 // Up to this many points the multipliers come from the exact active-set solve below; beyond, from
 // Gauss-Seidel sweeps (whose convergence slows with the mass ratio: 1e6 gives ~1e6 sweeps).
 constexpr int kDenseJointPoints = 96;
@@ -185,8 +208,7 @@ bool sweepComponents(std::size_t bodyCount, const std::vector<JointPoint<d>>& po
   }
 }
 
-// solveJointPushOut's sweeps per component (sweepComponents), on its rows and multipliers: the
-// point's separation gained and a multiplier's change moved into the bodies as there. Kept out
+// solveJointPushOut's sweeps per component (sweepComponents), on its rows and multipliers. Kept out
 // of solveJointPushOut's own loop (not inlined): with this path inlined there, the one-component
 // loop took 17 % more instructions (callgrind, pour_spheres_1000).
 template <int d>
@@ -199,22 +221,12 @@ template <int d>
       const std::size_t k = static_cast<std::size_t>(list[i]);
       if (!(rows[k].inverseMass > 0)) continue;
       const JointPoint<d>& p = points[k];
-      double gained = 0;
-      if (p.a >= 0) gained += p.n.dot(moves[p.a].dx) + rows[k].ca.dot(moves[p.a].dtheta);
-      if (p.b >= 0) gained -= p.n.dot(moves[p.b].dx) + rows[k].cb.dot(moves[p.b].dtheta);
-      const double next = std::max(0.0, lambda[k] + (p.depth - gained) * rows[k].inverseMass);
+      const double next = std::max(0.0, lambda[k] + (p.depth - separationGained<d>(p, rows[k], moves)) * rows[k].inverseMass);
       const double change = next - lambda[k];
       if (change == 0) continue;
       largest = std::max(largest, std::abs(change) / rows[k].inverseMass);
       lambda[k] = next;
-      if (p.a >= 0) {
-        moves[p.a].dx += change * bodies[p.a].inverseMass * p.n;
-        moves[p.a].dtheta += change * rows[k].inertiaCa;
-      }
-      if (p.b >= 0) {
-        moves[p.b].dx -= change * bodies[p.b].inverseMass * p.n;
-        moves[p.b].dtheta -= change * rows[k].inertiaCb;
-      }
+      moveBodies<d>(bodies, p, rows[k], change, moves);
     }
     return largest;
   };
@@ -244,26 +256,8 @@ double solveJointPushOut(const std::vector<JointBody<d>>& bodies, const std::vec
     }
     r.inverseMass = mass > 0 ? 1 / mass : 0;
   }
-  // The separation the moves give along n at point k ((dtheta x r).n = dtheta.(r x n)).
-  auto gained = [&](std::size_t k) {
-    const JointPoint<d>& p = points[k];
-    double s = 0;
-    if (p.a >= 0) s += p.n.dot(moves[p.a].dx) + rows[k].ca.dot(moves[p.a].dtheta);
-    if (p.b >= 0) s -= p.n.dot(moves[p.b].dx) + rows[k].cb.dot(moves[p.b].dtheta);
-    return s;
-  };
-  // A change of point k's multiplier, moved into the bodies (dx = M^{-1} J^T dlambda).
-  auto apply = [&](std::size_t k, double change) {
-    const JointPoint<d>& p = points[k];
-    if (p.a >= 0) {
-      moves[p.a].dx += change * bodies[p.a].inverseMass * p.n;
-      moves[p.a].dtheta += change * rows[k].inertiaCa;
-    }
-    if (p.b >= 0) {
-      moves[p.b].dx -= change * bodies[p.b].inverseMass * p.n;
-      moves[p.b].dtheta -= change * rows[k].inertiaCb;
-    }
-  };
+  auto gained = [&](std::size_t k) { return separationGained<d>(points[k], rows[k], moves); };
+  auto apply = [&](std::size_t k, double change) { moveBodies<d>(bodies, points[k], rows[k], change, moves); };
   std::vector<double> lambda(points.size(), 0.0);
   if (points.size() <= static_cast<std::size_t>(kDenseJointPoints)) {
     solveDense<d>(bodies, points, rows, lambda);
