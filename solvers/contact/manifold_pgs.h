@@ -72,7 +72,8 @@ struct PgsPoint {
   TangentVec offsetT;
   // What prepareRows leaves for prepareSweeps.
   double inverseMasses_;
-  bool rotatesA_, rotatesB_;
+  // Initialised: a growing vector copies its points, and copying an unset bool is undefined.
+  bool rotatesA_ = false, rotatesB_ = false;
 
   // inverseMasses: m_a^{-1} + m_b^{-1}; Ia, Ib: the inverse inertias the impulses are applied
   // with (zero for a body of infinite mass). K's blocks come from the Jacobian rows:
