@@ -200,29 +200,16 @@ void CoupledDampingSystem<d>::projectRigidHolds(int c, Eigen::VectorXd& y, bool 
 }
 
 template <int d>
-void CoupledDampingSystem<d>::projectVelocity(Eigen::VectorXd& y) const {
+void CoupledDampingSystem<d>::project(Eigen::VectorXd& v, bool force) const {
   for (std::size_t k = 0; k < bodies_.size(); ++k)
     for (int i = 0; i < static_cast<int>(bodies_[k].role.size()); ++i)
-      if (bodies_[k].role[i] != ParticleRole::Free) y.template segment<d>(offset_[k] + d * i).setZero();
+      if (bodies_[k].role[i] != ParticleRole::Free) v.template segment<d>(offset_[k] + d * i).setZero();
   for (int k : staticHolds_) {
     const DampingHold<d>& c = holds_[k];
-    auto yi = y.template segment<d>(offset_[c.body] + d * c.particle);
-    yi -= yi.dot(c.normal) * c.normal;
+    auto vi = v.template segment<d>(offset_[c.body] + d * c.particle);
+    vi -= vi.dot(c.normal) * c.normal;
   }
-  for (int c = 0; c < static_cast<int>(rigids_.size()); ++c) projectRigidHolds(c, y, false);
-}
-
-template <int d>
-void CoupledDampingSystem<d>::projectForce(Eigen::VectorXd& r) const {
-  for (std::size_t k = 0; k < bodies_.size(); ++k)
-    for (int i = 0; i < static_cast<int>(bodies_[k].role.size()); ++i)
-      if (bodies_[k].role[i] != ParticleRole::Free) r.template segment<d>(offset_[k] + d * i).setZero();
-  for (int k : staticHolds_) {
-    const DampingHold<d>& c = holds_[k];
-    auto ri = r.template segment<d>(offset_[c.body] + d * c.particle);
-    ri -= ri.dot(c.normal) * c.normal;
-  }
-  for (int c = 0; c < static_cast<int>(rigids_.size()); ++c) projectRigidHolds(c, r, true);
+  for (int c = 0; c < static_cast<int>(rigids_.size()); ++c) projectRigidHolds(c, v, force);
 }
 
 template <int d>

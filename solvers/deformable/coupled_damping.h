@@ -118,9 +118,11 @@ class CoupledDampingSystem {
   void apply(const Eigen::VectorXd& in, Eigen::VectorXd& out) const;
   // The operator CG sees: P^T A P.
   void applyProjected(const Eigen::VectorXd& in, Eigen::VectorXd& out) const;
-  // y <- P y (velocities) and r <- P^T r (forces).
-  void projectVelocity(Eigen::VectorXd& y) const;
-  void projectForce(Eigen::VectorXd& r) const;
+  // The projection P on a velocity (force = false) or its transpose on a force (force = true):
+  // they differ only in the rigid holds' central-body solve.
+  void project(Eigen::VectorXd& v, bool force) const;
+  void projectVelocity(Eigen::VectorXd& y) const { project(y, false); }
+  void projectForce(Eigen::VectorXd& r) const { project(r, true); }
   // The mass matrix M (for the tests' inner products) and its inverse.
   void applyMass(const Eigen::VectorXd& in, Eigen::VectorXd& out) const;
   void applyInverseMass(const Eigen::VectorXd& in, Eigen::VectorXd& out) const;
