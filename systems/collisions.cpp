@@ -12,15 +12,17 @@ void Collisions<d>::run(World<d>& world, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (!ws.pack(world, ctx.dt, /*subtractKick=*/true)) return;
   ws.findPairs();
-  const int woken = ws.wakeTouchedSleepers(world);  // sleeping on (systems/sleep.h), else 0
+  const int woken = ws.wakeTouchedSleepers(world, ctx.dt);  // sleeping on (systems/sleep.h), else 0
   if (ws.settings.stepEnergyClamp) ws.rememberStepStart(world);
   const auto energyBefore = ws.readEnergy();
 
+  // The candidates move with v^n plus the Step I increment (pack recovered v^n).
+  const CandidateStep step{ctx.dt, /*kick=*/true};
   std::vector<int> impulses(ws.islands.members.size(), 0), clamps(ws.islands.members.size(), 0);
   std::vector<double> clampChange(ws.islands.members.size(), 0.0);
   ws.forEachIsland([&](int island) {
     for (int sweep = 0; sweep < ws.settings.collisionIterations; ++sweep) {
-      const int n = ws.collisionSweep(island, sweep, &clampChange[island], &clamps[island]);
+      const int n = ws.collisionSweep(island, sweep, step, &clampChange[island], &clamps[island]);
       impulses[island] += n;
       if (n == 0) break;
     }
@@ -31,15 +33,14 @@ void Collisions<d>::run(World<d>& world, StepContext& ctx) {
     b.vCollided = b.v;
     b.LCollided = b.L;
   }
-  const int pairsAdded = ws.computeLevels();
+  const int pairsAdded = ws.computeLevels(ctx.dt);
   // Step II item 3: \hat v^{n+1/2} = \hat v^n + (\tilde v^{n+1/2} - v^n).
   for (auto& b : ws.bodies) {
     if (b.infinite()) continue;
     b.v += b.dv;
     b.L += b.dL;
   }
-  ws.unpack(false);
-  ws.kick = false;  // from here on the working velocity already is the n+1/2 one
+  ws.unpack(false);  // from here on the working velocity is the n+1/2 one: no kick
 
   int processed = 0, swept = 0, impulseCount = 0, clampCount = 0;
   for (const auto& p : ws.pairs) {

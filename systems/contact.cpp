@@ -19,10 +19,11 @@ void Contact<d>::run(World<d>& world, StepContext& ctx) {
   if (ws.bodies.empty()) return;
   // Joint post-stabilization (Step II.2) and PD (Step III.2) ran since collisions unpacked.
   if (world.template count<ArticulationJoint<d>>() > 0) ws.reloadVelocities();
-  ws.updateAllCandidates();
+  const CandidateStep step{ctx.dt, /*kick=*/false};  // the working velocity is v^{n+1/2}
+  ws.updateAllCandidates(step);
   std::vector<int> impulses(ws.islands.members.size(), 0);
   ws.forEachIsland(
-      [&](int island) { impulses[island] = ws.contactSweeps(island, ImpulseMode::Contact, false, nullptr, nullptr); });
+      [&](int island) { impulses[island] = ws.contactSweeps(island, ImpulseMode::Contact, step, false, nullptr, nullptr); });
   ws.unpack(false);
   // Joints (systems/articulation.h): rounds of pre-stabilization, then contact again, so that
   // contact has the last word and the joints close on what it leaves (Sec. 4.5).
@@ -30,7 +31,7 @@ void Contact<d>::run(World<d>& world, StepContext& ctx) {
   for (int round = 0, rounds = jointContactRounds(world); round < rounds; ++round) {
     preStabilizeJointVelocities(world, ctx);
     ws.reloadVelocities();
-    ws.updateAllCandidates();
+    ws.updateAllCandidates(step);
     // The rounds' sweeps go on with Step III's stage: its sums (ContactPairState::stageNormal)
     // keep the first sweeps' impulses, which carry the bodies' weight, so that shock
     // propagation's friction leans on them (contactSweeps starts the sums anew). Leaning on
@@ -40,7 +41,7 @@ void Contact<d>::run(World<d>& world, StepContext& ctx) {
     for (std::size_t k = 0; k < ws.pairs.size(); ++k)
       stageSums[k] = {ws.pairs[k].stageNormal, ws.pairs[k].stageFriction};
     ws.forEachIsland([&](int island) {
-      impulses[island] += ws.contactSweeps(island, ImpulseMode::Contact, false, nullptr, nullptr);
+      impulses[island] += ws.contactSweeps(island, ImpulseMode::Contact, step, false, nullptr, nullptr);
     });
     for (std::size_t k = 0; k < ws.pairs.size(); ++k) {
       ws.pairs[k].stageNormal += stageSums[k].first;
@@ -60,16 +61,18 @@ template <int d>
 void ShockPropagation<d>::run(World<d>& world, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (ws.bodies.empty()) return;
+  const CandidateStep step{ctx.dt, /*kick=*/false};
   std::vector<int> impulses(ws.islands.members.size(), 0);
-  ws.forEachIsland(
-      [&](int island) { impulses[island] = ws.propagateShock(island, ImpulseMode::Contact, false, nullptr, nullptr); });
+  ws.forEachIsland([&](int island) {
+    impulses[island] = ws.propagateShock(island, ImpulseMode::Contact, step, false, nullptr, nullptr);
+  });
   ws.unpack(false);
   // Joints (systems/articulation.h): the jointed bodies' velocities onto their joints and
   // contacts together, where the scene asks for it.
   if (world.template count<ArticulationJoint<d>>() > 0 && articulationSettings(world).stepThreeContactSolve) {
     preStabilizeWithContacts(world, ws, ctx);
     ws.reloadVelocities();
-    ws.updateAllCandidates();
+    ws.updateAllCandidates(step);
   }
   int total = 0;
   for (int n : impulses) total += n;

@@ -187,10 +187,9 @@ void ContactWorkspace<d>::ensureGeometry(World<d>& world) {
 }
 
 template <int d>
-bool ContactWorkspace<d>::pack(World<d>& world, double stepDt, bool subtractKick) {
+bool ContactWorkspace<d>::pack(World<d>& world, double dt, bool subtractKick) {
   ensureGeometry(world);
-  dt = stepDt;
-  kick = subtractKick;
+  const CandidateStep step{dt, subtractKick};  // the candidates of the stage that packs
   settings = world.template resource<ContactSettings>();
   gravity = world.settings().gravity;
   bodies.resize(entities_.size());
@@ -241,7 +240,7 @@ bool ContactWorkspace<d>::pack(World<d>& world, double stepDt, bool subtractKick
         b.turnFree = b.geometry->geometry().type == col::GeometryType::Sphere && I.isDiagonal(0) &&
                      I(0, 0) == I(1, 1) && I(1, 1) == I(2, 2);
       }
-      updateCandidate(b);
+      updateCandidate(b, step);
     }
   };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, entities_.size(), 256), packRange);
@@ -317,14 +316,14 @@ void ContactWorkspace<d>::reportEnergyChange(DiagnosticsSink& out, const std::st
 }
 
 template <int d>
-void ContactWorkspace<d>::updateCandidate(ContactBody<d>& b) const {
+void ContactWorkspace<d>::updateCandidate(ContactBody<d>& b, const CandidateStep& step) {
   if (b.still()) {
     b.candidate.x = b.x0;
     b.candidate.R = b.R0;
     b.inverseInertiaCandidate = b.inverseInertia0;
     return;
   }
-  const double k = kick ? 1.0 : 0.0;
+  const double dt = step.dt, k = step.kick ? 1.0 : 0.0;
   b.candidate.x = b.x0 + dt * (b.v + k * b.dv);
   if (b.turnFree) {
     b.candidate.R = b.R0;
@@ -338,22 +337,22 @@ void ContactWorkspace<d>::updateCandidate(ContactBody<d>& b) const {
 }
 
 template <int d>
-col::StepMotion<d> ContactWorkspace<d>::stepMotion(const ContactBody<d>& b) const {
+col::StepMotion<d> ContactWorkspace<d>::stepMotion(const ContactBody<d>& b, const CandidateStep& step) {
   col::StepMotion<d> m;
   m.start.x = b.x0;
   m.start.R = b.R0;
   if (b.still()) return m;
-  const double k = kick ? 1.0 : 0.0;
+  const double k = step.kick ? 1.0 : 0.0;
   m.translation = b.candidate.x - b.x0;
   const con::AngVec<d> w = b.inverseInertia0 * (b.L + k * b.dL);  // as updateCandidate turns it
-  m.rotation = dt * w;
+  m.rotation = step.dt * w;
   return m;
 }
 
 template <int d>
-void ContactWorkspace<d>::updateAllCandidates() {
+void ContactWorkspace<d>::updateAllCandidates(const CandidateStep& step) {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bodies.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) updateCandidate(bodies[i]);
+    for (std::size_t i = r.begin(); i != r.end(); ++i) updateCandidate(bodies[i], step);
   });
 }
 
@@ -402,7 +401,7 @@ void ContactWorkspace<d>::findPairs() {
 }
 
 template <int d>
-col::Pose<d> ContactWorkspace<d>::reAdvanced(const ContactBody<d>& b, double k) const {
+col::Pose<d> ContactWorkspace<d>::reAdvanced(const ContactBody<d>& b, double dt, double k) {
   col::Pose<d> p;
   if (b.still()) {
     p.x = b.x0;
@@ -583,7 +582,7 @@ void ContactWorkspace<d>::sortIslandPairsByLevel() {
 }
 
 template <int d>
-int ContactWorkspace<d>::computeLevels() {
+int ContactWorkspace<d>::computeLevels(double dt) {
   // "a below b" when b, re-advanced with its new velocity (with the Step I kick), overlaps a
   // advanced with its old one (notes 1.6). Bodies of infinite mass are never re-advanced, so
   // they end up at the bottom.
@@ -593,7 +592,7 @@ int ContactWorkspace<d>::computeLevels() {
   std::vector<std::array<col::Pose<d>, 2>>& poses = reAdvancedPoses_;
   poses.resize(bodies.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bodies.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) poses[i] = {reAdvanced(bodies[i], 0.0), reAdvanced(bodies[i], 1.0)};
+    for (std::size_t i = r.begin(); i != r.end(); ++i) poses[i] = {reAdvanced(bodies[i], dt, 0.0), reAdvanced(bodies[i], dt, 1.0)};
   });
   const int added = growPairs([&](const ContactBody<d>& b) -> const std::array<col::Pose<d>, 2>& { return poses[&b - bodies.data()]; });
   // The same test also completes the processed list (notes 1.4, "contact pairs" gathered on the
@@ -629,8 +628,8 @@ int ContactWorkspace<d>::computeLevels() {
 
 template <int d>
 typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
-    ContactPairState& pair, const ContactBody<d>& A, const ContactBody<d>& B, ImpulseMode mode, double epsilon,
-    int iterations, double margin, std::vector<col::ContactPoint<d>>& scratch, double* clampEnergyChange,
+    ContactPairState& pair, const ContactBody<d>& A, const ContactBody<d>& B, ImpulseMode mode,
+    const CandidateStep& step, double epsilon, int iterations, double margin, std::vector<col::ContactPoint<d>>& scratch, double* clampEnergyChange,
     int* clampsApplied, bool shockFriction) const {
   if (A.infinite() && B.infinite()) return {};
   const bool collision = mode == ImpulseMode::Collision;
@@ -653,7 +652,7 @@ typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
   scratch.clear();
   bool swept = false;
   if (collision && settings.sweptCollisions) {
-    const col::StepMotion<d> ma = stepMotion(A), mb = stepMotion(B);
+    const col::StepMotion<d> ma = stepMotion(A, step), mb = stepMotion(B, step);
     const double size = std::min(col::tunnelingSize(*A.geometry), col::tunnelingSize(*B.geometry));
     swept = col::relativeTravel(*A.geometry, ma, *B.geometry, mb) > 0.5 * size;
     if (swept) {
@@ -702,7 +701,7 @@ typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
   // one the candidates moved with, and a body they stop above a gap falls through it in contact.
   con::ManifoldProblem<d>& problem = threadProblem<d>();
   problem.start(con::ManifoldProblem<d>::Shape::Pair, state,
-                targetsOf(settings, dt, impulse.restitution, settings.closeGaps && !collision));
+                targetsOf(settings, step.dt, impulse.restitution, settings.closeGaps && !collision));
   for (const auto& c : scratch) {
     if (c.depth < -query.margin) continue;
     problem.add(VecD(c.point - poseA.x), VecD(c.point - poseB.x), c.normal, VecD::Zero(), c.depth, impulse.friction,
@@ -744,23 +743,25 @@ typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
 
 template <int d>
 void ContactWorkspace<d>::applyPairImpulse(ContactPairState& pair, ContactBody<d>& A, ContactBody<d>& B,
-                                           const PairImpulse& r, ImpulseMode mode) const {
+                                           const PairImpulse& r, ImpulseMode mode,
+                                           const CandidateStep& step) const {
   if (!A.infinite()) {
     A.v += r.scale * A.inverseMass() * r.J;
     A.L += r.scale * r.tau;
-    updateCandidate(A);
+    updateCandidate(A, step);
   }
   if (!B.infinite()) {
     B.v -= r.scale * B.inverseMass() * r.J;
     B.L -= r.scale * (r.tau + con::cross<d>(r.fromB, r.J));
-    updateCandidate(B);
+    updateCandidate(B, step);
   }
   if (mode != ImpulseMode::Collision) pair.contacted = true;
 }
 
 template <int d>
 int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int count, ImpulseMode mode,
-                                                 double epsilon, int iterations, double margin,
+                                                 const CandidateStep& step, double epsilon, int iterations,
+                                                 double margin,
                                                  std::vector<col::ContactPoint<d>>& scratch,
                                                  double* clampEnergyChange, int* clampsApplied) {
   // Shock propagation with a body resting on several bodies of lower levels (a pyramid box on
@@ -778,7 +779,7 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
   state.movesA = true;
   con::ManifoldProblem<d>& problem = threadProblem<d>();
   problem.start(con::ManifoldProblem<d>::Shape::AgainstFrozen, state,
-                targetsOf(settings, dt, -1.0 + epsilon, settings.closeGaps));
+                targetsOf(settings, step.dt, -1.0 + epsilon, settings.closeGaps));
   VecD frameVelocity = VecD::Zero();
   bool frameSet = false, frameKinematic = false;
   // Each pair's points, [pointsEnd[q-1], pointsEnd[q]): their friction leans on what that pair
@@ -843,7 +844,7 @@ int ContactWorkspace<d>::updateBodyAgainstFrozen(int c, const int* pairList, int
   }
   C.v += scale * C.inverseMass() * J;
   C.L += scale * tau;
-  updateCandidate(C);
+  updateCandidate(C, step);
   return active;
 }
 
@@ -871,7 +872,8 @@ void markCollisionChecked(ContactPairState& pair, ContactBody<d>& A, ContactBody
 }
 
 template <int d>
-TaskCounts ContactWorkspace<d>::runTask(const SweepTask& t, ImpulseMode mode, const std::vector<int>& lists) {
+TaskCounts ContactWorkspace<d>::runTask(const SweepTask& t, ImpulseMode mode, const CandidateStep& step,
+                                        const std::vector<int>& lists) {
   thread_local std::vector<col::ContactPoint<d>> scratch;  // per worker thread
   TaskCounts c;
   switch (t.kind) {
@@ -881,18 +883,18 @@ TaskCounts ContactWorkspace<d>::runTask(const SweepTask& t, ImpulseMode mode, co
       ContactBody<d>& B = bodies[pair.b];
       // Checked after both bodies last moved: nothing new to find (notes 1.4).
       if (pair.checkedStamp > std::max(A.movedStamp, B.movedStamp)) return c;
-      c.impulses = updatePair(pair, ImpulseMode::Collision, 0.0, t.iterations, 0.0, scratch, &c.energyChange,
+      c.impulses = updatePair(pair, ImpulseMode::Collision, step, 0.0, t.iterations, 0.0, scratch, &c.energyChange,
                               &c.clamps);
       markCollisionChecked(pair, A, B, t.stamp, c.impulses > 0);
       break;
     }
     case SweepTask::Kind::Pair:
-      c.impulses = updatePair(pairs[t.index], mode, t.epsilon, t.iterations, settings.thickness, scratch,
+      c.impulses = updatePair(pairs[t.index], mode, step, t.epsilon, t.iterations, settings.thickness, scratch,
                               &c.energyChange, &c.clamps, t.shockFriction);
       break;
     case SweepTask::Kind::Joint:
       c.impulses = updateBodyAgainstFrozen(t.index, lists.data() + t.listBegin, t.listEnd - t.listBegin, mode,
-                                           t.epsilon, t.iterations, settings.thickness, scratch, &c.energyChange,
+                                           step, t.epsilon, t.iterations, settings.thickness, scratch, &c.energyChange,
                                            &c.clamps);
       break;
     case SweepTask::Kind::Freeze:
@@ -903,14 +905,14 @@ TaskCounts ContactWorkspace<d>::runTask(const SweepTask& t, ImpulseMode mode, co
 }
 
 template <int d>
-void ContactWorkspace<d>::addTask(Sequence& s, ImpulseMode mode, const SweepTask& task, const int* touched,
-                                  int count) {
-  tasks_.add(s, task, touched, count, [&](const SweepTask& t) { return runTask(t, mode, s.lists); });
+void ContactWorkspace<d>::addTask(Sequence& s, ImpulseMode mode, const CandidateStep& step, const SweepTask& task,
+                                  const int* touched, int count) {
+  tasks_.add(s, task, touched, count, [&](const SweepTask& t) { return runTask(t, mode, step, s.lists); });
 }
 
 template <int d>
-int ContactWorkspace<d>::runTasks(Sequence& s, ImpulseMode mode) {
-  return tasks_.run(s, [&](const SweepTask& t) { return runTask(t, mode, s.lists); });
+int ContactWorkspace<d>::runTasks(Sequence& s, ImpulseMode mode, const CandidateStep& step) {
+  return tasks_.run(s, [&](const SweepTask& t) { return runTask(t, mode, step, s.lists); });
 }
 
 // Stamps that grow along the whole sequence of checks, sweep after sweep: "moved" gets the
@@ -921,7 +923,8 @@ inline long collisionStamp(int sweep, std::size_t pairCount, std::size_t k) {
 }
 
 template <int d>
-int ContactWorkspace<d>::runCollisionTasks(Sequence& s, int island, int sweep, std::size_t from) {
+int ContactWorkspace<d>::runCollisionTasks(Sequence& s, int island, int sweep, const CandidateStep& step,
+                                           std::size_t from) {
   const auto& list = islands.pairs[island];
   for (std::size_t k = from; k < list.size(); ++k) {
     SweepTask t;
@@ -930,13 +933,14 @@ int ContactWorkspace<d>::runCollisionTasks(Sequence& s, int island, int sweep, s
     t.iterations = settings.collisionPairIterations;
     t.stamp = collisionStamp(sweep, list.size(), k);
     const int touched[2] = {pairs[t.index].a, pairs[t.index].b};
-    addTask(s, ImpulseMode::Collision, t, touched, 2);
+    addTask(s, ImpulseMode::Collision, step, t, touched, 2);
   }
-  return runTasks(s, ImpulseMode::Collision);
+  return runTasks(s, ImpulseMode::Collision, step);
 }
 
 template <int d>
-int ContactWorkspace<d>::collisionSweep(int island, int sweep, double* clampEnergyChange, int* clampsApplied) {
+int ContactWorkspace<d>::collisionSweep(int island, int sweep, const CandidateStep& step, double* clampEnergyChange,
+                                        int* clampsApplied) {
   const auto& list = islands.pairs[island];
   auto stamp = [&](std::size_t k) { return collisionStamp(sweep, list.size(), k); };
   Sequence& again = tasks_.sequence(island);
@@ -946,17 +950,18 @@ int ContactWorkspace<d>::collisionSweep(int island, int sweep, double* clampEner
     for (std::size_t k = 0; k < list.size(); ++k) again.tasks[k].stamp = stamp(k);
     again.energyOut = clampEnergyChange;
     again.clampsOut = clampsApplied;
-    return runTasks(again, ImpulseMode::Collision);
+    return runTasks(again, ImpulseMode::Collision, step);
   }
   if (sweep == 0 && lastCollisionImpulses == 0 && list.size() >= 64 && tbb::this_task_arena::max_concurrency() > 1)
-    return speculativeCollisionSweep(island, clampEnergyChange, clampsApplied);
+    return speculativeCollisionSweep(island, step, clampEnergyChange, clampsApplied);
   Sequence& s = tasks_.start(island, list.size(), taskGrain(), clampEnergyChange, clampsApplied);
   s.reusable = s.order.tracking();  // later sweeps of the step reuse the tasks
-  return runCollisionTasks(s, island, sweep, 0);
+  return runCollisionTasks(s, island, sweep, step, 0);
 }
 
 template <int d>
-int ContactWorkspace<d>::speculativeCollisionSweep(int island, double* clampEnergyChange, int* clampsApplied) {
+int ContactWorkspace<d>::speculativeCollisionSweep(int island, const CandidateStep& step, double* clampEnergyChange,
+                                                   int* clampsApplied) {
   const auto& list = islands.pairs[island];
   const std::size_t n = list.size();
   auto stamp = [n](std::size_t k) { return collisionStamp(0, n, k); };
@@ -968,7 +973,7 @@ int ContactWorkspace<d>::speculativeCollisionSweep(int island, double* clampEner
       CollisionProbe& probe = probes_[k];
       probe.pair = pairs[list[k]];
       probe.impulses = findPairImpulse(probe.pair, bodies[probe.pair.a], bodies[probe.pair.b], ImpulseMode::Collision,
-                                       0.0, settings.collisionPairIterations, 0.0, scratch, &probe.energyChange,
+                                       step, 0.0, settings.collisionPairIterations, 0.0, scratch, &probe.energyChange,
                                        &probe.clamps)
                            .active;
     }
@@ -985,12 +990,12 @@ int ContactWorkspace<d>::speculativeCollisionSweep(int island, double* clampEner
   if (k == n) return 0;
   // 3. The rest as the ordered sweep runs them (recorded afresh; later sweeps record their own).
   Sequence& s = tasks_.start(island, n - k, taskGrain(), clampEnergyChange, clampsApplied);
-  return runCollisionTasks(s, island, 0, k);
+  return runCollisionTasks(s, island, 0, step, k);
 }
 
 template <int d>
-int ContactWorkspace<d>::contactSweeps(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange,
-                                       int* clampsApplied) {
+int ContactWorkspace<d>::contactSweeps(int island, ImpulseMode mode, const CandidateStep& step, bool onlyContacted,
+                                       double* clampEnergyChange, int* clampsApplied) {
   const auto& list = islandPairsByLevel[island];
   const int iterations = settings.contactIterations, levelIterations = settings.contactLevelIterations;
   // A new stage (Step III's contact, or Step V's): its impulses are summed from here on.
@@ -1017,18 +1022,18 @@ int ContactWorkspace<d>::contactSweeps(int island, ImpulseMode mode, bool onlyCo
           t.epsilon = eps;
           t.iterations = settings.contactPairIterations;
           const int touched[2] = {pair.a, pair.b};
-          addTask(s, mode, t, touched, 2);
+          addTask(s, mode, step, t, touched, 2);
         }
       }
       begin = end;
     }
   }
-  return runTasks(s, mode);
+  return runTasks(s, mode, step);
 }
 
 template <int d>
-int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange,
-                                        int* clampsApplied) {
+int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, const CandidateStep& step, bool onlyContacted,
+                                        double* clampEnergyChange, int* clampsApplied) {
   const auto& list = islandPairsByLevel[island];
   // At most one task per pair and level iteration, and one freeze per body.
   Sequence& s = tasks_.start(island, list.size() * settings.shockLevelIterations + islands.members[island].size(),
@@ -1103,14 +1108,14 @@ int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyC
             jointBodies.push_back(entries[own[q]].other);
           }
           t.listEnd = static_cast<int>(s.lists.size());
-          addTask(s, mode, t, jointBodies.data(), static_cast<int>(jointBodies.size()));
+          addTask(s, mode, step, t, jointBodies.data(), static_cast<int>(jointBodies.size()));
           continue;
         }
         t.kind = SweepTask::Kind::Pair;
         t.index = e.pair;
         const ContactPairState& pair = pairs[e.pair];
         const int touched[2] = {pair.a, pair.b};
-        addTask(s, mode, t, touched, 2);
+        addTask(s, mode, step, t, touched, 2);
       }
     }
     for (std::size_t k = begin; k < end; ++k) {
@@ -1120,13 +1125,13 @@ int ContactWorkspace<d>::propagateShock(int island, ImpulseMode mode, bool onlyC
         SweepTask t;
         t.kind = SweepTask::Kind::Freeze;
         t.index = body;
-        addTask(s, mode, t, &body, 1);
+        addTask(s, mode, step, t, &body, 1);
         tasks_.markFrozen(s, body);
       }
     }
     begin = end;
   }
-  const int impulses = runTasks(s, mode);
+  const int impulses = runTasks(s, mode, step);
   for (int m : islands.members[island]) bodies[m].frozen = false;
   return impulses;
 }

@@ -119,6 +119,15 @@ struct ContactPairState {
   int manifold = -1;
 };
 
+// How a stage moves a body to its candidate pose (GBF 2003): x^0 + dt (v + dv), turned by
+// dt I^{-1}(L + dL), with the Step I increment (dv, dL) while the working velocity is v^n (Step
+// II's collision sweeps: `kick`), without it once the working velocity is v^{n+1/2} (every later
+// stage). Each stage passes its own (its step size is the step context's).
+struct CandidateStep {
+  double dt = 0;
+  bool kick = false;
+};
+
 // How one pair update treats the impulse (notes 1.4-1.6, Sec. 2.3.2).
 enum class ImpulseMode {
   Collision,        // restitution e, friction clamp, energy clamp against the base state, split lever arms
@@ -132,7 +141,8 @@ class ContactWorkspace {
   using VecD = Eigen::Matrix<double, d, 1>;
 
   // Packs the colliding bodies. `subtractKick`: the bodies carry v^{n+1/2} and the Step I
-  // increment dt/2 F/m is taken off to recover v^n (Step II). Returns false if nothing collides.
+  // increment dt/2 F/m is taken off to recover v^n (Step II). Their candidate poses are those of
+  // CandidateStep{dt, subtractKick}. Returns false if nothing collides.
   bool pack(World<d>& world, double dt, bool subtractKick);
   // Writes the working velocities (and positions, if `positions`) back to the components.
   void unpack(bool positions);
@@ -157,13 +167,13 @@ class ContactWorkspace {
 
   // Candidate pose x0 + dt (v + kick*dv), rotated by dt * I^{-1}(L + kick*dL) (first order:
   // candidates only decide which pairs touch).
-  void updateCandidate(ContactBody<d>& b) const;
+  static void updateCandidate(ContactBody<d>& b, const CandidateStep& step);
   // The velocity of the frame in which an impulse against `partner`, a body of infinite mass,
   // is energy-clamped (r: the contact point from the partner's centre).
   VecD clampFrameVelocity(const ContactBody<d>& partner, const VecD& r) const;
   // The motion from the base pose to the candidate pose (swept collisions).
-  solvers::collision::StepMotion<d> stepMotion(const ContactBody<d>& b) const;
-  void updateAllCandidates();
+  static solvers::collision::StepMotion<d> stepMotion(const ContactBody<d>& b, const CandidateStep& step);
+  void updateAllCandidates(const CandidateStep& step);
 
   // Broad phase at the candidate poses, then islands; resets pair flags.
   void findPairs();
@@ -171,13 +181,13 @@ class ContactWorkspace {
   // findPairs joins to an awake dynamic body, and those whose box a moving kinematic body's
   // reaches, each with the bodies it fell asleep with; gives them the Step I kick they missed,
   // packs again and finds the pairs again, until nothing more wakes. Returns the bodies woken.
-  int wakeTouchedSleepers(World<d>& world);
+  int wakeTouchedSleepers(World<d>& world, double dt);
   // The entity of bodies[i].
   Entity entityOf(std::size_t i) const { return entities_[i]; }
   // Contact-graph levels from the processed pairs (Step III item 1, notes 1.6). First grows the
   // pair list to where the collision impulses sent the bodies (growPairs); returns the pairs
-  // that added.
-  int computeLevels();
+  // that added. `dt`: the step (the bodies re-advanced over it).
+  int computeLevels(double dt);
   // Grows each body's broad-phase box to cover `poses(body)` too (a list of poses). If any box
   // grew, the broad phase runs again: its pairs are a superset of the known ones, which keep
   // their state; new ones start unprocessed. Islands and the per-island level lists follow.
@@ -188,7 +198,7 @@ class ContactWorkspace {
   template <typename PosesOf>
   int growPairs(PosesOf&& poses);
   // The pose at x^n + dt (v + k dv): k = 1 re-advances with the Step I kick (notes 1.6).
-  solvers::collision::Pose<d> reAdvanced(const ContactBody<d>& b, double k) const;
+  static solvers::collision::Pose<d> reAdvanced(const ContactBody<d>& b, double dt, double k);
 
   // What one pair's manifold solve asks for: the net impulse J on A (-J on B), A's angular
   // impulse tau about its centre, the energy clamp's scale, and how many points carry impulse
@@ -202,14 +212,14 @@ class ContactWorkspace {
   };
   // One pair update: the pair's manifold at the candidate poses, its impulses solved together
   // (at most `iterations` sweeps) and applied. Returns how many points carry impulse.
-  int updatePair(ContactPairState& pair, ImpulseMode mode, double epsilon, int iterations, double margin,
-                 std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
+  int updatePair(ContactPairState& pair, ImpulseMode mode, const CandidateStep& step, double epsilon, int iterations,
+                 double margin, std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
                  int* clampsApplied, bool shockFriction = false) {
     ContactBody<d>& A = bodies[pair.a];
     ContactBody<d>& B = bodies[pair.b];
-    const PairImpulse r = findPairImpulse(pair, A, B, mode, epsilon, iterations, margin, scratch, clampEnergyChange,
-                                          clampsApplied, shockFriction);
-    if (r.active > 0) applyPairImpulse(pair, A, B, r, mode);
+    const PairImpulse r = findPairImpulse(pair, A, B, mode, step, epsilon, iterations, margin, scratch,
+                                          clampEnergyChange, clampsApplied, shockFriction);
+    if (r.active > 0) applyPairImpulse(pair, A, B, r, mode, step);
     return r.active;
   }
   // The update's first half: finds the impulse, only reading the bodies (the speculative sweep
@@ -221,22 +231,23 @@ class ContactWorkspace {
   // shock propagation's updates carry no normal impulse and cannot stop the slip those sweeps
   // leave (an off-centre box on a box walked at millimetres per second).
   PairImpulse findPairImpulse(ContactPairState& pair, const ContactBody<d>& A, const ContactBody<d>& B,
-                              ImpulseMode mode, double epsilon, int iterations, double margin,
+                              ImpulseMode mode, const CandidateStep& step, double epsilon, int iterations, double margin,
                               std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
                               int* clampsApplied, bool shockFriction = false) const;
   // The second half: the impulse on both bodies (those of finite mass), their candidates
   // re-advanced; a contact impulse marks the pair contacted (Step V's list).
   void applyPairImpulse(ContactPairState& pair, ContactBody<d>& A, ContactBody<d>& B, const PairImpulse& r,
-                        ImpulseMode mode) const;
+                        ImpulseMode mode, const CandidateStep& step) const;
 
   // One Gauss-Seidel collision sweep (Step II, notes 1.4) over one island's pairs; `sweep` counts
   // from 0. A pair is skipped when it was checked after both its bodies last moved. Returns the
   // number of impulses applied.
-  int collisionSweep(int island, int sweep, double* clampEnergyChange, int* clampsApplied);
+  int collisionSweep(int island, int sweep, const CandidateStep& step, double* clampEnergyChange, int* clampsApplied);
 
   // The epsilon-scaled contact sweeps of notes 1.6 over one island: contact iterations, each
   // level from the bottom, level iterations, eps = (it+1)(li+1)/(iterations*level iterations).
-  int contactSweeps(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange, int* clampsApplied);
+  int contactSweeps(int island, ImpulseMode mode, const CandidateStep& step, bool onlyContacted,
+                    double* clampEnergyChange, int* clampsApplied);
 
   // The contact manifold of a pair for the contact stages (Steps III and V) at the bodies'
   // candidate poses, with `first` (the pair's a, or its b when `firstIsB`) as findContacts's A:
@@ -248,13 +259,14 @@ class ContactWorkspace {
                    std::vector<solvers::collision::ContactPoint<d>>& out) const;
 
   // Joint contact solve of body c against the bodies of infinite mass among `count` pairs.
-  int updateBodyAgainstFrozen(int c, const int* pairList, int count, ImpulseMode mode, double epsilon, int iterations,
-                              double margin, std::vector<solvers::collision::ContactPoint<d>>& scratch,
+  int updateBodyAgainstFrozen(int c, const int* pairList, int count, ImpulseMode mode, const CandidateStep& step,
+                              double epsilon, int iterations, double margin, std::vector<solvers::collision::ContactPoint<d>>& scratch,
                               double* clampEnergyChange, int* clampsApplied);
 
   // Shock propagation over one island (GBF 2003; notes 1.6): bottom-up through the levels, each
   // level's bodies frozen (infinite mass) once its pairs are done; all unfrozen at the end.
-  int propagateShock(int island, ImpulseMode mode, bool onlyContacted, double* clampEnergyChange, int* clampsApplied);
+  int propagateShock(int island, ImpulseMode mode, const CandidateStep& step, bool onlyContacted,
+                     double* clampEnergyChange, int* clampsApplied);
 
   // One update of a contact stage as the island/task layer records it (systems/island_tasks.h):
   // the stages' sweeps record their updates in the thesis's order and run them as ordered tasks.
@@ -296,8 +308,6 @@ class ContactWorkspace {
   std::vector<std::pair<int, int>> graphEdges;  // (below, above): the edges `levels` came from
   // Per island: pair indices sorted by (level, index).
   std::vector<std::vector<int>> islandPairsByLevel;
-  double dt = 0;
-  bool kick = false;
   // Impulses the last collision stage applied; -1 before the first. A resting island's first
   // collision sweep is speculative on several threads only after none (see below).
   int lastCollisionImpulses = -1;
@@ -307,21 +317,22 @@ class ContactWorkspace {
  private:
   using Sequence = TaskSequence<SweepTask>;
   // Runs one recorded update of a stage in `mode`; `lists` holds a joint solve's pairs.
-  TaskCounts runTask(const SweepTask& t, ImpulseMode mode, const std::vector<int>& lists);
+  TaskCounts runTask(const SweepTask& t, ImpulseMode mode, const CandidateStep& step, const std::vector<int>& lists);
   // Adds an update to an island's sequence (it runs at once when the sequence is untracked).
-  void addTask(Sequence& s, ImpulseMode mode, const SweepTask& task, const int* touched, int count);
+  void addTask(Sequence& s, ImpulseMode mode, const CandidateStep& step, const SweepTask& task, const int* touched,
+               int count);
   // Runs an island's recorded updates in `mode` (island_tasks.h); returns the impulses applied.
-  int runTasks(Sequence& s, ImpulseMode mode);
+  int runTasks(Sequence& s, ImpulseMode mode, const CandidateStep& step);
   // The first collision sweep of an island when the last step's collision stage applied no
   // impulse (a resting pile): every pair update runs at once without applying anything, on a
   // copy of its pair state; in the sweep's order those that found nothing to apply are taken as
   // they are, and from the first that did, the rest run as ordered tasks. Until then no body has
   // changed, so each taken update saw what the sequential sweep gives it: the same result.
   // Returns the impulses applied.
-  int speculativeCollisionSweep(int island, double* clampEnergyChange, int* clampsApplied);
+  int speculativeCollisionSweep(int island, const CandidateStep& step, double* clampEnergyChange, int* clampsApplied);
   // Records the island's collision checks from position `from` on as tasks of sweep `sweep`
   // and runs them (runTasks). Returns the impulses applied.
-  int runCollisionTasks(Sequence& s, int island, int sweep, std::size_t from);
+  int runCollisionTasks(Sequence& s, int island, int sweep, const CandidateStep& step, std::size_t from);
   struct CollisionProbe {  // what one update found, on a copy of its pair's state
     ContactPairState pair;
     int impulses = 0, clamps = 0;

@@ -46,7 +46,7 @@ int rootOf(std::vector<int>& parent, int i) {
 }  // namespace
 
 template <int d>
-int ContactWorkspace<d>::wakeTouchedSleepers(World<d>& world) {
+int ContactWorkspace<d>::wakeTouchedSleepers(World<d>& world, double dt) {
   if (world.template count<Sleep<d>>() == 0) return 0;
   auto& sleeps = world.template pool<Sleep<d>>();
   const auto* forces = world.template findPool<RigidForces<d>>();
@@ -123,7 +123,7 @@ int ContactWorkspace<d>::wakeTouchedSleepers(World<d>& world) {
     groups.clear();
     // The woken bodies move from here on: pack them as such and find their pairs (with each
     // other, and with sleepers they touch, which the next pass wakes).
-    pack(world, dt, kick);
+    pack(world, dt, /*subtractKick=*/true);
     findPairs();
   }
 }
@@ -251,8 +251,8 @@ void FallAsleep<d>::run(World<d>& world, StepContext& ctx) {
 
 template void enableSleeping<2>(World<2>&);
 template void enableSleeping<3>(World<3>&);
-template int ContactWorkspace<2>::wakeTouchedSleepers(World<2>&);
-template int ContactWorkspace<3>::wakeTouchedSleepers(World<3>&);
+template int ContactWorkspace<2>::wakeTouchedSleepers(World<2>&, double);
+template int ContactWorkspace<3>::wakeTouchedSleepers(World<3>&, double);
 template class FallAsleep<2>;
 template class FallAsleep<3>;
 

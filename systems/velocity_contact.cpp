@@ -19,6 +19,7 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
   if (!ws.pack(world, ctx.dt, /*subtractKick=*/false)) return;
   ws.pairs = std::move(pairs);
   const ContactSettings& s = ws.settings;
+  const CandidateStep step{ctx.dt, /*kick=*/false};  // from x^{n+1} with v^{n+1}
   const auto energyBefore = ws.readEnergy();
   // Joints (systems/articulation.h): the jointed bodies' velocities first projected onto their
   // joints and contacts together (with friction, while the contacts still carry the weight).
@@ -30,13 +31,13 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
   std::vector<double> change(ws.islands.members.size(), 0.0);
   ws.forEachIsland([&](int island) {
     impulses[island] =
-        ws.contactSweeps(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
+        ws.contactSweeps(island, ImpulseMode::ClampedContact, step, true, &change[island], &clamps[island]);
     // Shock propagation here too (not in the thesis's Step V): the sweeps end with the top
     // levels, whose last impulses push the lower bodies down, so a resting stack would keep a
     // downward velocity of the order of dt g / levels. A bottom-up pass with each level frozen
     // leaves it at rest; its impulses are clamped like the others.
     if (s.shockPropagation)
-      impulses[island] += ws.propagateShock(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
+      impulses[island] += ws.propagateShock(island, ImpulseMode::ClampedContact, step, true, &change[island], &clamps[island]);
   });
   // Then rounds of post-stabilization and contact again, so that neither leaves the other a
   // velocity to undo; post_stabilize_velocities closes the joints last.
@@ -44,13 +45,13 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
     ws.unpack(false);
     postStabilizeJointVelocities(world, ctx);
     ws.reloadVelocities();
-    ws.updateAllCandidates();
+    ws.updateAllCandidates(step);
     ws.forEachIsland([&](int island) {
       impulses[island] +=
-          ws.contactSweeps(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
+          ws.contactSweeps(island, ImpulseMode::ClampedContact, step, true, &change[island], &clamps[island]);
       if (s.shockPropagation)
         impulses[island] +=
-            ws.propagateShock(island, ImpulseMode::ClampedContact, true, &change[island], &clamps[island]);
+            ws.propagateShock(island, ImpulseMode::ClampedContact, step, true, &change[island], &clamps[island]);
     });
   }
   const auto energyAfter = ws.readEnergy();
