@@ -130,8 +130,9 @@ class ManifoldProblem {
   // beyond their own if the plain solve leaves them slipping (shock propagation): `allowance`,
   // shared evenly (PgsPoint::frictionPreload).
   void setLeaning(std::size_t begin, double allowance) {
+    // The plain law: nothing to store (entries not set are 0 when read, solveAgainLeaningOnStage).
+    if (!(allowance > 0)) return;
     preloads_.resize(points_.size(), 0.0);
-    if (!(allowance > 0)) return;  // (the plain law: the new entries are 0)
     for (std::size_t k = begin; k < points_.size(); ++k) preloads_[k] = allowance / double(points_.size() - begin);
   }
 
@@ -161,7 +162,8 @@ class ManifoldProblem {
       for (Point& p : points_) p.prepareForSolve(state_.exactFinish, inverseMasses, Ia, Ib, rotatesA, rotatesB);
     }
     const double tolerance = 1e-7 * speedScale_ + 1e-12;
-    const PgsBodies<d> before = state_;
+    // The state before the solve, for the solve again leaning on the stage (only with a slip).
+    if (anySliding_) before_ = state_;
     if (!anyApproaching_) {
       // Only a slip (shock propagation): the plain law has no normal impulse to stop it with.
     } else if (closedForm) {
@@ -186,7 +188,7 @@ class ManifoldProblem {
     }
     if (anySliding_) {
       const double slipBound = std::max(tolerance + targets_.approachTolerance, kLeanSlip * speedScale_);
-      solveAgainLeaningOnStage(before, slipBound, inverseMasses, Ia, Ib, iterations, tolerance);
+      solveAgainLeaningOnStage(before_, slipBound, inverseMasses, Ia, Ib, iterations, tolerance);
     }
   }
 
@@ -280,7 +282,7 @@ class ManifoldProblem {
   }
 
   Shape shape_ = Shape::Pair;
-  PgsBodies<d> state_;
+  PgsBodies<d> state_, before_;
   ManifoldTargets targets_;
   std::vector<Point> points_;
   std::vector<double> preloads_;  // per point (setLeaning); empty: none
