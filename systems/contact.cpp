@@ -22,8 +22,9 @@ void Contact<d>::run(World<d>& world, StepContext& ctx) {
   const CandidateStep step{ctx.dt, /*kick=*/false};  // the working velocity is v^{n+1/2}
   ws.updateAllCandidates(step);
   std::vector<int> impulses(ws.islands.members.size(), 0);
-  ws.forEachIsland(
-      [&](int island) { impulses[island] = ws.contactSweeps(island, ImpulseMode::Contact, step, false, nullptr, nullptr); });
+  ws.forEachIsland([&](int island) {
+    impulses[island] = ws.contactSweeps(island, ImpulseMode::Contact, step, false, nullptr, nullptr);
+  });
   ws.unpack(false);
   // Joints (systems/articulation.h): rounds of pre-stabilization, then contact again, so that
   // contact has the last word and the joints close on what it leaves (Sec. 4.5).

@@ -592,7 +592,8 @@ int ContactWorkspace<d>::computeLevels(double dt) {
   std::vector<std::array<col::Pose<d>, 2>>& poses = reAdvancedPoses_;
   poses.resize(bodies.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bodies.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) poses[i] = {reAdvanced(bodies[i], dt, 0.0), reAdvanced(bodies[i], dt, 1.0)};
+    for (std::size_t i = r.begin(); i != r.end(); ++i)
+      poses[i] = {reAdvanced(bodies[i], dt, 0.0), reAdvanced(bodies[i], dt, 1.0)};
   });
   const int added = growPairs([&](const ContactBody<d>& b) -> const std::array<col::Pose<d>, 2>& { return poses[&b - bodies.data()]; });
   // The same test also completes the processed list (notes 1.4, "contact pairs" gathered on the
@@ -629,8 +630,9 @@ int ContactWorkspace<d>::computeLevels(double dt) {
 template <int d>
 typename ContactWorkspace<d>::PairImpulse ContactWorkspace<d>::findPairImpulse(
     ContactPairState& pair, const ContactBody<d>& A, const ContactBody<d>& B, ImpulseMode mode,
-    const CandidateStep& step, double epsilon, int iterations, double margin, std::vector<col::ContactPoint<d>>& scratch, double* clampEnergyChange,
-    int* clampsApplied, bool shockFriction) const {
+    const CandidateStep& step, double epsilon, int iterations, double margin,
+    std::vector<col::ContactPoint<d>>& scratch, double* clampEnergyChange, int* clampsApplied,
+    bool shockFriction) const {
   if (A.infinite() && B.infinite()) return {};
   const bool collision = mode == ImpulseMode::Collision;
   con::ImpulseSettings impulse;

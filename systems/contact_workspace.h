@@ -231,9 +231,9 @@ class ContactWorkspace {
   // shock propagation's updates carry no normal impulse and cannot stop the slip those sweeps
   // leave (an off-centre box on a box walked at millimetres per second).
   PairImpulse findPairImpulse(ContactPairState& pair, const ContactBody<d>& A, const ContactBody<d>& B,
-                              ImpulseMode mode, const CandidateStep& step, double epsilon, int iterations, double margin,
-                              std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
-                              int* clampsApplied, bool shockFriction = false) const;
+                              ImpulseMode mode, const CandidateStep& step, double epsilon, int iterations,
+                              double margin, std::vector<solvers::collision::ContactPoint<d>>& scratch,
+                              double* clampEnergyChange, int* clampsApplied, bool shockFriction = false) const;
   // The second half: the impulse on both bodies (those of finite mass), their candidates
   // re-advanced; a contact impulse marks the pair contacted (Step V's list).
   void applyPairImpulse(ContactPairState& pair, ContactBody<d>& A, ContactBody<d>& B, const PairImpulse& r,
@@ -260,8 +260,9 @@ class ContactWorkspace {
 
   // Joint contact solve of body c against the bodies of infinite mass among `count` pairs.
   int updateBodyAgainstFrozen(int c, const int* pairList, int count, ImpulseMode mode, const CandidateStep& step,
-                              double epsilon, int iterations, double margin, std::vector<solvers::collision::ContactPoint<d>>& scratch,
-                              double* clampEnergyChange, int* clampsApplied);
+                              double epsilon, int iterations, double margin,
+                              std::vector<solvers::collision::ContactPoint<d>>& scratch, double* clampEnergyChange,
+                              int* clampsApplied);
 
   // Shock propagation over one island (GBF 2003; notes 1.6): bottom-up through the levels, each
   // level's bodies frozen (infinite mass) once its pairs are done; all unfrozen at the end.

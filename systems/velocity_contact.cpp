@@ -37,7 +37,8 @@ void VelocityContact<d>::run(World<d>& world, StepContext& ctx) {
     // downward velocity of the order of dt g / levels. A bottom-up pass with each level frozen
     // leaves it at rest; its impulses are clamped like the others.
     if (s.shockPropagation)
-      impulses[island] += ws.propagateShock(island, ImpulseMode::ClampedContact, step, true, &change[island], &clamps[island]);
+      impulses[island] +=
+          ws.propagateShock(island, ImpulseMode::ClampedContact, step, true, &change[island], &clamps[island]);
   });
   // Then rounds of post-stabilization and contact again, so that neither leaves the other a
   // velocity to undo; post_stabilize_velocities closes the joints last.
