@@ -228,8 +228,8 @@ TEST(Articulation, ContactStartsFromTheJointStagesVelocities) {
 }
 
 // The first ragdolls of ragdoll_pile, so many of its entities (the ground first), without the
-// scene's rest mechanisms (its "solver" entity's rolling resistance and sleeping): the tests add
-// what they measure.
+// scene's rest mechanisms (its "solver" entity's rolling resistance and Step III's
+// joint-and-contact projection, and sleeping): the tests add what they measure.
 nlohmann::json ragdollPile(int ragdolls, double end) {
   std::ifstream in(kScenes + "ragdoll_pile.json");
   std::string line, text;
@@ -281,8 +281,9 @@ TEST(Articulation, ContactRoundsKeepARestingRagdollOutOfThePushOutCycle) {
 }
 
 // Four ragdolls of ragdoll_pile (40 bodies, 36 joints) dropped on each other at dt = 1/30 come
-// to rest with their joints closed, with ragdoll_pile's rest mechanisms: rolling resistance of
-// 2 mm at the jointed bodies' contacts in Step V's solve and sleeping. Without rolling resistance
+// to rest with their joints closed, with two of ragdoll_pile's rest mechanisms: rolling
+// resistance of 2 mm at the jointed bodies' contacts in Step V's solve and sleeping (not Step
+// III's joint-and-contact projection, RagdollOnASlopeDoesNotCreepWithStepThreesProjection). Without rolling resistance
 // one head rolls without slipping on the ground round its ball joint (3 mm/s, 1 cm over the last
 // second: no Coulomb friction stops it), so the island never sleeps; with it and without
 // sleeping the velocities die (kinetic energy ~1e-21 J) but push-out and the joint closing still
