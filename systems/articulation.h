@@ -119,10 +119,12 @@ template <int d>
 void postStabilizeWithContacts(World<d>& world, const ContactWorkspace<d>& ws, StepContext& ctx);
 
 // Step III, after shock propagation, with `step_three_contact_solve` (called from
-// systems/contact.cpp): the same projection of the jointed bodies' velocities onto their joints
-// and contacts as Step V's, at the time-n poses, a gap allowed to close within the step; so
-// that the poses Step IV reaches open neither the joints nor the contacts by what contact's
-// last sweeps and shock propagation left.
+// systems/contact.cpp): the jointed bodies' velocities as Step III's contact started
+// (ContactWorkspace::stepThreeStartV) projected onto their joints and contacts as in Step V, at
+// the time-n poses, the points as far apart as the bodies reach in the step; so that Step IV
+// advances with velocities that keep the joints closed and the contacts sticking, instead of
+// those contact's last sweeps and shock propagation left (which open the joints; the jointed
+// position solve then closed them by displacements no friction held: a creep at rest).
 template <int d>
 void preStabilizeWithContacts(World<d>& world, const ContactWorkspace<d>& ws, StepContext& ctx);
 

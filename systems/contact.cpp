@@ -18,7 +18,16 @@ void Contact<d>::run(World<d>& world, StepContext& ctx) {
   ContactWorkspace<d>& ws = *this->ws_;
   if (ws.bodies.empty()) return;
   // Joint post-stabilization (Step II.2) and PD (Step III.2) ran since collisions unpacked.
-  if (world.template count<ArticulationJoint<d>>() > 0) ws.reloadVelocities();
+  if (world.template count<ArticulationJoint<d>>() > 0) {
+    ws.reloadVelocities();
+    // Where Step III's joint-and-contact projection after shock propagation starts from.
+    if (articulationSettings(world).stepThreeContactSolve) {
+      ws.stepThreeStartV.resize(ws.bodies.size());
+      ws.stepThreeStartL.resize(ws.bodies.size());
+      for (std::size_t i = 0; i < ws.bodies.size(); ++i)
+        ws.stepThreeStartV[i] = ws.bodies[i].v, ws.stepThreeStartL[i] = ws.bodies[i].L;
+    }
+  }
   const CandidateStep step{ctx.dt, /*kick=*/false};  // the working velocity is v^{n+1/2}
   ws.updateAllCandidates(step);
   std::vector<int> impulses(ws.islands.members.size(), 0);

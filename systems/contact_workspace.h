@@ -314,6 +314,11 @@ class ContactWorkspace {
   int lastCollisionImpulses = -1;
   ContactSettings settings;
   Vec<d> gravity = Vec<d>::Zero();
+  // The bodies' velocities as Step III's contact started (after the joint stages of Steps II.2
+  // and III.2), kept only in a scene whose joints ask for Step III's joint-and-contact
+  // projection (systems/articulation.h, preStabilizeWithContacts), which starts from them.
+  std::vector<VecD> stepThreeStartV;
+  std::vector<solvers::contact::AngVec<d>> stepThreeStartL;
 
  private:
   using Sequence = TaskSequence<SweepTask>;

@@ -228,8 +228,8 @@ TEST(Articulation, ContactStartsFromTheJointStagesVelocities) {
 }
 
 // The first ragdolls of ragdoll_pile, so many of its entities (the ground first), without the
-// scene's rest mechanisms (its "solver" entity's rolling resistance and sleeping): the tests add
-// what they measure.
+// scene's rest mechanisms (its "solver" entity's rolling resistance and Step III's
+// joint-and-contact projection, and sleeping): the tests add what they measure.
 nlohmann::json ragdollPile(int ragdolls, double end) {
   std::ifstream in(kScenes + "ragdoll_pile.json");
   std::string line, text;
@@ -281,8 +281,9 @@ TEST(Articulation, ContactRoundsKeepARestingRagdollOutOfThePushOutCycle) {
 }
 
 // Four ragdolls of ragdoll_pile (40 bodies, 36 joints) dropped on each other at dt = 1/30 come
-// to rest with their joints closed, with ragdoll_pile's rest mechanisms: rolling resistance of
-// 2 mm at the jointed bodies' contacts in Step V's solve and sleeping. Without rolling resistance
+// to rest with their joints closed, with two of ragdoll_pile's rest mechanisms: rolling
+// resistance of 2 mm at the jointed bodies' contacts in Step V's solve and sleeping (not Step
+// III's joint-and-contact projection, RagdollOnASlopeDoesNotCreepWithStepThreesProjection). Without rolling resistance
 // one head rolls without slipping on the ground round its ball joint (3 mm/s, 1 cm over the last
 // second: no Coulomb friction stops it), so the island never sleeps; with it and without
 // sleeping the velocities die (kinetic energy ~1e-21 J) but push-out and the joint closing still
@@ -328,6 +329,51 @@ TEST(Articulation, ReducedRagdollPileComesToRestWithJointsClosedOnAnyThreadCount
   EXPECT_LT(worstEnergy, 1e-9);
   EXPECT_LT(moved, 1e-3);
   EXPECT_EQ(fewestAsleep, 40);
+}
+
+// One ragdoll of ragdoll_pile dropped on a 10-degree slope (friction 0.6, tan 10° = 0.18: it must
+// stick), with the pile's rolling resistance and without sleeping. Step III's contact and shock
+// propagation have the last word over its rounds of pre-stabilization, so the velocities Step
+// IV advances with open the joints, and the jointed position solve closes them by displacements
+// that no friction holds: the forearms creep down the slope at zero end-of-step velocity
+// (measured 14 mm over [3, 4] s). Step III's joint-and-contact projection from the velocities
+// before contact (step_three_contact_solve) carries the weight on its contact rows, so friction
+// and rolling resistance hold every point and the advance itself keeps the joints closed:
+// measured 3e-11 m, on 1 and 2 threads bitwise alike.
+TEST(Articulation, RagdollOnASlopeDoesNotCreepWithStepThreesProjection) {
+  const Registry registry = builtins();
+  nlohmann::json base = ragdollPile(1, 4.0);
+  const double tilt = 10 * kPi / 180;
+  for (auto& e : base["entities"])
+    if (e["name"] == "ground") e["shape"]["normal"] = {std::sin(tilt), std::cos(tilt), 0.0};
+  std::uint64_t hash = 0;
+  auto creep = [&](bool stepThree, int threads) {
+    nlohmann::json s = base;
+    s["entities"].push_back({{"name", "solver"},
+                             {"articulation", {{"rolling_resistance", 0.002}, {"step_three_contact_solve", stepThree}}}});
+    Simulation<3> sim(parseScene(s.dump(), "ragdoll_on_a_slope.json"), registry, threads);
+    std::vector<Eigen::Vector3d> before;
+    double joint = 0;
+    while (!sim.finished()) {
+      joint = std::max(joint, sim.step().at("joint_error_max"));
+      if (before.empty() && sim.time() > 3.0 - 1e-9)
+        for (const auto& b : sim.world().pool<RigidBody<3>>().components()) before.push_back(b.x);
+    }
+    double moved = 0;
+    std::size_t i = 0;
+    for (const auto& b : sim.world().pool<RigidBody<3>>().components()) moved = std::max(moved, (b.x - before[i++]).norm());
+    std::cout << "[measured] one ragdoll on a 10-degree slope, step_three_contact_solve " << stepThree << ", "
+              << threads << " thread(s): largest centre motion over [3, 4] s " << moved << " m, joint_error_max "
+              << joint << " m\n";
+    EXPECT_LT(joint, 1e-6);
+    hash = stateHash(sim.world());
+    return moved;
+  };
+  EXPECT_GT(creep(false, 1), 5e-3);  // measured 1.4e-2 m
+  EXPECT_LT(creep(true, 2), 1e-6);   // measured 2.8e-11 m
+  const std::uint64_t twoThreads = hash;
+  creep(true, 1);
+  EXPECT_EQ(hash, twoThreads);
 }
 
 // Sleeping with joints (systems/sleep.h): two boxes on the ground, joined by a ball joint where
