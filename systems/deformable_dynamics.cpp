@@ -169,7 +169,8 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
   std::vector<std::vector<int>> boundTo(bodyCount);
   std::vector<std::vector<NormalConstraint<d>>> held(bodyCount);
   std::vector<std::vector<int>> heldRigid(bodyCount);
-  std::vector<int> parent(bodyCount), owner;
+  std::vector<int> parent(bodyCount);
+  std::vector<std::pair<int, int>> uses;  // (deformable body, rigid unknown)
   for (int k = 0; k < bodyCount; ++k) {
     parent[k] = k;
     const Body& b = bodies[k];
@@ -202,12 +203,39 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
       }
       heldRigid[k].push_back(index);
     }
-    for (int c : used) {
-      if (static_cast<int>(owner.size()) <= c) owner.resize(c + 1, -1);
-      if (owner[c] < 0) owner[c] = k;
-      else parent[findRoot(parent, k)] = findRoot(parent, owner[c]);
+    for (int c : used) uses.push_back({k, c});
+  }
+  // The rigid unknowns' own contacts and joints (rows on their twists); dynamic bodies they reach
+  // join the unknowns.
+  std::vector<dm::DampingRigidRow<d>> allRows;
+  if (!rigids.empty()) {
+    std::vector<Entity> unknowns;
+    for (const Rigid& r : rigids) unknowns.push_back(r.e);
+    const std::vector<RigidConstraintRow<d>> found = contacts_->rigidRows(world, unknowns, ctx.dt, half ? 0.0 : 0.5);
+    for (std::size_t k = rigids.size(); k < unknowns.size(); ++k)
+      rigidIndex(unknowns[k], world.template get<RigidBody<d>>(unknowns[k]));
+    for (const RigidConstraintRow<d>& r : found) {
+      dm::DampingRigidRow<d> row;
+      row.a = rigidIndex(r.a, nullptr);
+      row.b = r.b.valid() ? rigidIndex(r.b, nullptr) : -1;
+      row.ga = r.ga;
+      row.gb = r.gb;
+      row.target = r.target;
+      allRows.push_back(row);
     }
   }
+  // Disjoint sets over the deformable bodies (nodes 0 .. bodyCount - 1) and the rigid unknowns
+  // (after them): a body with the rigid unknowns it uses, two unknowns sharing a row.
+  parent.resize(bodyCount + rigids.size());
+  for (std::size_t k = bodyCount; k < parent.size(); ++k) parent[k] = static_cast<int>(k);
+  auto unite = [&](int a, int b) {
+    a = findRoot(parent, a);
+    b = findRoot(parent, b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);  // the smallest node is the root
+  };
+  for (const auto& [k, c] : uses) unite(k, bodyCount + c);
+  for (const dm::DampingRigidRow<d>& r : allRows)
+    if (r.b >= 0) unite(bodyCount + r.a, bodyCount + r.b);
   // The rigid unknowns' twists at the start of the solve. Step I: v^{n+1/2} after the rigid
   // half kick. Step V solves for the average of v^{n+1/2} and v^{n+1} (backward Euler over dt/4,
   // then extrapolation), so the body's own kick over dt/4 is taken off again, as its particles'
@@ -266,9 +294,18 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
       }
       solveBodies.push_back(std::move(sb));
     }
+    std::vector<dm::DampingRigidRow<d>> rows;
+    for (const dm::DampingRigidRow<d>& row : allRows)
+      if (findRoot(parent, bodyCount + row.a) == root) {
+        dm::DampingRigidRow<d> local = row;
+        local.a = localRigid(row.a);
+        if (row.b >= 0) local.b = localRigid(row.b);
+        rows.push_back(local);
+      }
     std::vector<dm::DampingRigid<d>> solveRigids;
     for (int c : global) solveRigids.push_back(rigidStart[c]);
-    dm::CoupledDampingResult<d> r = dm::solveCoupledDamping<d>(std::move(solveBodies), std::move(solveRigids), std::move(holds), h);
+    dm::CoupledDampingResult<d> r =
+        dm::solveCoupledDamping<d>(std::move(solveBodies), std::move(solveRigids), std::move(holds), h, std::move(rows));
     iterations = std::max(iterations, r.report.iterations);
     for (std::size_t m = 0; m < members.size(); ++m) {
       Body& b = bodies[members[m]];
