@@ -1,5 +1,6 @@
 #include "systems/deformable_dynamics.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "components/cloth.h"
@@ -171,6 +172,7 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
   std::vector<std::vector<int>> heldRigid(bodyCount);
   std::vector<int> parent(bodyCount);
   std::vector<std::pair<int, int>> uses;  // (deformable body, rigid unknown)
+  std::vector<std::vector<dm::EmbeddedWeight>> embeddedIn(bodyCount);  // hostBody: index into bodies
   for (int k = 0; k < bodyCount; ++k) {
     parent[k] = k;
     const Body& b = bodies[k];
@@ -194,6 +196,16 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
         used.push_back(c);
       }
     }
+    // Embedded particles follow their host element inside the solve (their velocity the weighted
+    // host velocities), the host body solved together with this one.
+    if (embedding)
+      if (const EmbeddedBinding<d>* eb = world.template get<EmbeddedBinding<d>>(b.e))
+        forEachHostWeight<d>(world, *eb, [&](Entity host, int j, double w, int i) {
+          const Body* hb = bodyOf(host);
+          if (!hb || hb == &b) return;  // host coupled to a fluid: prescribed, its force handed over after
+          roles[k][i] = dm::ParticleRole::Embedded;
+          embeddedIn[k].push_back({i, static_cast<int>(hb - bodies.data()), j, w});
+        });
     if (contacts_) held[k] = contacts_->of(world, p, ctx.dt, half ? 0.0 : 0.5);
     for (const NormalConstraint<d>& c : held[k]) {
       int index = -1;
@@ -234,6 +246,8 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
     if (a != b) parent[std::max(a, b)] = std::min(a, b);  // the smallest node is the root
   };
   for (const auto& [k, c] : uses) unite(k, bodyCount + c);
+  for (int k = 0; k < bodyCount; ++k)
+    for (const dm::EmbeddedWeight& e : embeddedIn[k]) unite(k, e.hostBody);
   for (const dm::DampingRigidRow<d>& r : allRows)
     if (r.b >= 0) unite(bodyCount + r.a, bodyCount + r.b);
   // The rigid unknowns' twists at the start of the solve. Step I: v^{n+1/2} after the rigid
@@ -286,6 +300,9 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
       sb.rigid = boundTo[members[m]];
       for (int& c : sb.rigid)
         if (c >= 0) c = localRigid(c);
+      sb.embedded = embeddedIn[members[m]];
+      for (dm::EmbeddedWeight& e : sb.embedded)
+        e.hostBody = static_cast<int>(std::find(members.begin(), members.end(), e.hostBody) - members.begin());
       const auto& bodyHeld = held[members[m]];
       for (std::size_t j = 0; j < bodyHeld.size(); ++j) {
         const int c = heldRigid[members[m]][j];
@@ -325,8 +342,10 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
       body.L += duration * r.torque[c];
     }
   }
-  // The damping forces on embedded particles, over the same duration, to their hosts' particles
-  // in their weights (after every solve of the stage, as the bound particles' to their bodies).
+  // The damping forces on embedded particles whose host was not in their solve (a host coupled to
+  // a fluid), over the same duration, to their hosts' particles in their weights (after every
+  // solve of the stage). In the solve, an embedded particle's force is already its hosts' and its
+  // own entry of Du is zero.
   if (embedding)
     for (Body& b : bodies)
       if (const EmbeddedBinding<d>* eb = world.template get<EmbeddedBinding<d>>(b.e); eb && !b.Du.empty())

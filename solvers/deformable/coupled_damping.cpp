@@ -44,6 +44,12 @@ CoupledDampingSystem<d>::CoupledDampingSystem(std::vector<DampingBody<d>> bodies
   std::vector<std::vector<char>> taken(bodies_.size());
   for (std::size_t k = 0; k < bodies_.size(); ++k) taken[k].assign(bodies_[k].role.size(), 0);
   holdsOfRigid_.resize(rigids_.size());
+  for (const DampingBody<d>& b : bodies_)
+    for (const EmbeddedWeight& e : b.embedded)
+      if (e.hostBody < 0 || e.hostBody >= static_cast<int>(bodies_.size()) || b.role[e.particle] != ParticleRole::Embedded ||
+          bodies_[e.hostBody].role[e.hostParticle] == ParticleRole::Embedded)
+        throw std::invalid_argument("CoupledDampingSystem: an embedded weight names no host body, a particle not "
+                                    "embedded, or an embedded host particle");
   for (const DampingHold<d>& c : holds) {
     const DampingBody<d>& b = bodies_[c.body];
     if (b.role[c.particle] != ParticleRole::Free || taken[c.body][c.particle]) continue;
@@ -123,11 +129,15 @@ void CoupledDampingSystem<d>::expand(const Eigen::VectorXd& in, std::vector<std:
         const rm::AngVec<d> omega = in.template segment<rm::kAngularDim<d>>(ro + d);
         const VecD<d> vi = v + rm::angularCross<d>(omega, arm(static_cast<int>(k), i, c));
         for (int a = 0; a < d; ++a) w[k][d * i + a] = vi(a);
-      } else {
+      } else if (b.role[i] != ParticleRole::Embedded) {
         for (int a = 0; a < d; ++a) w[k][d * i + a] = in(o + d * i + a);
       }
     }
   }
+  // Embedded particles from their hosts' expanded velocities (hosts are never embedded).
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    for (const EmbeddedWeight& e : bodies_[k].embedded)
+      for (int a = 0; a < d; ++a) w[k][d * e.particle + a] += e.weight * w[e.hostBody][d * e.hostParticle + a];
 }
 
 template <int d>
@@ -138,6 +148,14 @@ void CoupledDampingSystem<d>::dampingForces(const std::vector<std::vector<double
     const DampingBody<d>& b = bodies_[k];
     Dw[k].assign(w[k].size(), 0.0);
     if (b.fm->dampingRows() > 0) addDampingForces<d>(*b.fm, *b.rotations, b.x, w[k].data(), Dw[k].data());
+  }
+  // The force on an embedded particle acts on its host particles with its weights (J^T).
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    const DampingBody<d>& b = bodies_[k];
+    for (const EmbeddedWeight& e : b.embedded)
+      for (int a = 0; a < d; ++a) Dw[e.hostBody][d * e.hostParticle + a] += e.weight * Dw[k][d * e.particle + a];
+    for (const EmbeddedWeight& e : b.embedded)
+      for (int a = 0; a < d; ++a) Dw[k][d * e.particle + a] = 0;
   }
 }
 
@@ -159,7 +177,7 @@ void CoupledDampingSystem<d>::apply(const Eigen::VectorXd& in, Eigen::VectorXd& 
         const VecD<d> f = Eigen::Map<const VecD<d>>(&Dw[k][d * i]);
         out.template segment<d>(ro) -= h_ * f;
         out.template segment<rm::kAngularDim<d>>(ro + d) -= h_ * rm::cross<d>(arm(static_cast<int>(k), i, c), f);
-      } else {
+      } else if (b.role[i] != ParticleRole::Embedded) {
         for (int a = 0; a < d; ++a) out(o + d * i + a) = b.m[i] * in(o + d * i + a) - h_ * Dw[k][d * i + a];
       }
     }
@@ -176,7 +194,8 @@ void CoupledDampingSystem<d>::applyMass(const Eigen::VectorXd& in, Eigen::Vector
   out.setZero(size_);
   for (std::size_t k = 0; k < bodies_.size(); ++k)
     for (int i = 0; i < static_cast<int>(bodies_[k].role.size()); ++i)
-      for (int a = 0; a < d; ++a) out(offset_[k] + d * i + a) = bodies_[k].m[i] * in(offset_[k] + d * i + a);
+      if (bodies_[k].role[i] != ParticleRole::Embedded)  // its mass is its hosts'
+        for (int a = 0; a < d; ++a) out(offset_[k] + d * i + a) = bodies_[k].m[i] * in(offset_[k] + d * i + a);
   for (std::size_t c = 0; c < rigids_.size(); ++c) {
     const int ro = rigidOffset(static_cast<int>(c));
     out.template segment<d>(ro) = rigids_[c].mass * in.template segment<d>(ro);
@@ -189,7 +208,8 @@ void CoupledDampingSystem<d>::applyInverseMass(const Eigen::VectorXd& in, Eigen:
   out.setZero(size_);
   for (std::size_t k = 0; k < bodies_.size(); ++k)
     for (int i = 0; i < static_cast<int>(bodies_[k].role.size()); ++i)
-      for (int a = 0; a < d; ++a) out(offset_[k] + d * i + a) = in(offset_[k] + d * i + a) / bodies_[k].m[i];
+      if (bodies_[k].role[i] != ParticleRole::Embedded)
+        for (int a = 0; a < d; ++a) out(offset_[k] + d * i + a) = in(offset_[k] + d * i + a) / bodies_[k].m[i];
   for (std::size_t c = 0; c < rigids_.size(); ++c) {
     const int ro = rigidOffset(static_cast<int>(c));
     out.template segment<d>(ro) = in.template segment<d>(ro) / rigids_[c].mass;
@@ -314,7 +334,7 @@ CoupledDampingResult<d> CoupledDampingSystem<d>::solve() const {
     for (int i = 0; i < static_cast<int>(b.role.size()); ++i)
       for (int a = 0; a < d; ++a) {
         const int j = offset_[k] + d * i + a;
-        if (b.role[i] == ParticleRole::Bound) continue;
+        if (b.role[i] == ParticleRole::Bound || b.role[i] == ParticleRole::Embedded) continue;
         y0(j) = b.v[d * i + a];
         if (b.role[i] == ParticleRole::Prescribed) yp(j) = b.v[d * i + a];
         else hf(j) = h_ * b.f[d * i + a];

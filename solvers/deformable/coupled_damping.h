@@ -9,7 +9,11 @@
 //    bodies, embedded particles);
 //  * bound to rigid unknown c: its velocity is J_i xi_c = v_c + w_c x r_i (r_i = x_i - x_c), so
 //    it is not an unknown itself: the damping force on it acts on the body through J_i^T
-//    (force and torque r_i x f). Its mass is the body's already (added at scene setup).
+//    (force and torque r_i x f). Its mass is the body's already (added at scene setup);
+//  * embedded in an element of another body of the solve (Sifakis et al. 2007 hard binding,
+//    thesis Sec. 4.8): its velocity is sum_j w_j u_j over the element's particles, so it is not an
+//    unknown either: the damping force on it acts on them with the same weights (J^T again). Its
+//    mass is theirs already (moved at scene setup).
 // The system is the backward Euler step of the damping alone,
 //   (M - h J^T D J) y = M y0 + h J^T f,
 // with M = diag(m_i, m_c, I_c) (the rigid bodies' world inertia) and J the map from the
@@ -66,7 +70,16 @@ namespace monolith::solvers::deformable {
 
 namespace rm = solvers::contact;
 
-enum class ParticleRole : char { Free = 0, Prescribed = 1, Bound = 2 };
+enum class ParticleRole : char { Free = 0, Prescribed = 1, Bound = 2, Embedded = 3 };
+
+// One barycentric weight of an embedded particle (Sifakis et al. 2007 hard binding): its velocity
+// is sum_j weight_j u_j over its host element's particles, in a body of the same solve.
+struct EmbeddedWeight {
+  int particle = 0;      // the embedded particle (in the body holding this list)
+  int hostBody = 0;      // index of the host body in the solve
+  int hostParticle = 0;  // a particle of the host element (free, prescribed or bound; not embedded)
+  double weight = 0;
+};
 
 // One deformable body in the solve. Arrays hold d numbers per particle (m: one).
 template <int d>
@@ -79,6 +92,7 @@ struct DampingBody {
   const double* f = nullptr;  // explicit forces (ignored on prescribed and bound particles)
   std::vector<ParticleRole> role;  // per particle
   std::vector<int> rigid;          // per particle: the rigid unknown of a bound particle, else -1
+  std::vector<EmbeddedWeight> embedded;  // the weights of the Embedded particles
 };
 
 // A dynamic rigid body as an unknown: mass, world inertia, centre of mass, and its twist at the
