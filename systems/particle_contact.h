@@ -142,8 +142,9 @@ class ParticlePenetration final : public System<d> {
 //
 // `rigidRows`: the rigid unknowns' own constraints in the same solves (Sec. 4.7.1, 4.7.3): their
 // contacts with other rigid bodies at the candidate poses (narrow-phase points within twice the
-// thickness or 1 % of the body's size, not separating), temporary normal-only joints on the
-// relative normal velocity at the point with the same `keep` rule as the particles', and the
+// thickness or 1 % of the body's size), temporary normal-only joints on the relative normal
+// velocity at the point with the same `keep` rule as the particles' (a separating point held at
+// its own relative normal velocity, so that the rest of a manifold is no pivot), and the
 // velocity rows of their joints (target zero: the joint stages post-stabilize to it). A dynamic
 // body touching or jointed to an unknown becomes an unknown too (appended to `unknowns`, in the
 // order found), so that a box resting on a box on a deformable slab is one consistent solve.
