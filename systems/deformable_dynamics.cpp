@@ -1,5 +1,6 @@
 #include "systems/deformable_dynamics.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "components/cloth.h"
@@ -169,7 +170,9 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
   std::vector<std::vector<int>> boundTo(bodyCount);
   std::vector<std::vector<NormalConstraint<d>>> held(bodyCount);
   std::vector<std::vector<int>> heldRigid(bodyCount);
-  std::vector<int> parent(bodyCount), owner;
+  std::vector<int> parent(bodyCount);
+  std::vector<std::pair<int, int>> uses;  // (deformable body, rigid unknown)
+  std::vector<std::vector<dm::EmbeddedWeight>> embeddedIn(bodyCount);  // hostBody: index into bodies
   for (int k = 0; k < bodyCount; ++k) {
     parent[k] = k;
     const Body& b = bodies[k];
@@ -193,6 +196,16 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
         used.push_back(c);
       }
     }
+    // Embedded particles follow their host element inside the solve (their velocity the weighted
+    // host velocities), the host body solved together with this one.
+    if (embedding)
+      if (const EmbeddedBinding<d>* eb = world.template get<EmbeddedBinding<d>>(b.e))
+        forEachHostWeight<d>(world, *eb, [&](Entity host, int j, double w, int i) {
+          const Body* hb = bodyOf(host);
+          if (!hb || hb == &b) return;  // host coupled to a fluid: prescribed, its force handed over after
+          roles[k][i] = dm::ParticleRole::Embedded;
+          embeddedIn[k].push_back({i, static_cast<int>(hb - bodies.data()), j, w});
+        });
     if (contacts_) held[k] = contacts_->of(world, p, ctx.dt, half ? 0.0 : 0.5);
     for (const NormalConstraint<d>& c : held[k]) {
       int index = -1;
@@ -202,12 +215,41 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
       }
       heldRigid[k].push_back(index);
     }
-    for (int c : used) {
-      if (static_cast<int>(owner.size()) <= c) owner.resize(c + 1, -1);
-      if (owner[c] < 0) owner[c] = k;
-      else parent[findRoot(parent, k)] = findRoot(parent, owner[c]);
+    for (int c : used) uses.push_back({k, c});
+  }
+  // The rigid unknowns' own contacts and joints (rows on their twists); dynamic bodies they reach
+  // join the unknowns.
+  std::vector<dm::DampingRigidRow<d>> allRows;
+  if (!rigids.empty()) {
+    std::vector<Entity> unknowns;
+    for (const Rigid& r : rigids) unknowns.push_back(r.e);
+    const std::vector<RigidConstraintRow<d>> found = contacts_->rigidRows(world, unknowns, ctx.dt, half ? 0.0 : 0.5);
+    for (std::size_t k = rigids.size(); k < unknowns.size(); ++k)
+      rigidIndex(unknowns[k], world.template get<RigidBody<d>>(unknowns[k]));
+    for (const RigidConstraintRow<d>& r : found) {
+      dm::DampingRigidRow<d> row;
+      row.a = rigidIndex(r.a, nullptr);
+      row.b = r.b.valid() ? rigidIndex(r.b, nullptr) : -1;
+      row.ga = r.ga;
+      row.gb = r.gb;
+      row.target = r.target;
+      allRows.push_back(row);
     }
   }
+  // Disjoint sets over the deformable bodies (nodes 0 .. bodyCount - 1) and the rigid unknowns
+  // (after them): a body with the rigid unknowns it uses, two unknowns sharing a row.
+  parent.resize(bodyCount + rigids.size());
+  for (std::size_t k = bodyCount; k < parent.size(); ++k) parent[k] = static_cast<int>(k);
+  auto unite = [&](int a, int b) {
+    a = findRoot(parent, a);
+    b = findRoot(parent, b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);  // the smallest node is the root
+  };
+  for (const auto& [k, c] : uses) unite(k, bodyCount + c);
+  for (int k = 0; k < bodyCount; ++k)
+    for (const dm::EmbeddedWeight& e : embeddedIn[k]) unite(k, e.hostBody);
+  for (const dm::DampingRigidRow<d>& r : allRows)
+    if (r.b >= 0) unite(bodyCount + r.a, bodyCount + r.b);
   // The rigid unknowns' twists at the start of the solve. Step I: v^{n+1/2} after the rigid
   // half kick. Step V solves for the average of v^{n+1/2} and v^{n+1} (backward Euler over dt/4,
   // then extrapolation), so the body's own kick over dt/4 is taken off again, as its particles'
@@ -258,6 +300,9 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
       sb.rigid = boundTo[members[m]];
       for (int& c : sb.rigid)
         if (c >= 0) c = localRigid(c);
+      sb.embedded = embeddedIn[members[m]];
+      for (dm::EmbeddedWeight& e : sb.embedded)
+        e.hostBody = static_cast<int>(std::find(members.begin(), members.end(), e.hostBody) - members.begin());
       const auto& bodyHeld = held[members[m]];
       for (std::size_t j = 0; j < bodyHeld.size(); ++j) {
         const int c = heldRigid[members[m]][j];
@@ -266,9 +311,18 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
       }
       solveBodies.push_back(std::move(sb));
     }
+    std::vector<dm::DampingRigidRow<d>> rows;
+    for (const dm::DampingRigidRow<d>& row : allRows)
+      if (findRoot(parent, bodyCount + row.a) == root) {
+        dm::DampingRigidRow<d> local = row;
+        local.a = localRigid(row.a);
+        if (row.b >= 0) local.b = localRigid(row.b);
+        rows.push_back(local);
+      }
     std::vector<dm::DampingRigid<d>> solveRigids;
     for (int c : global) solveRigids.push_back(rigidStart[c]);
-    dm::CoupledDampingResult<d> r = dm::solveCoupledDamping<d>(std::move(solveBodies), std::move(solveRigids), std::move(holds), h);
+    dm::CoupledDampingResult<d> r =
+        dm::solveCoupledDamping<d>(std::move(solveBodies), std::move(solveRigids), std::move(holds), h, std::move(rows));
     iterations = std::max(iterations, r.report.iterations);
     for (std::size_t m = 0; m < members.size(); ++m) {
       Body& b = bodies[members[m]];
@@ -288,8 +342,10 @@ void AdvanceDeformableVelocity<d>::run(World<d>& world, StepContext& ctx) {
       body.L += duration * r.torque[c];
     }
   }
-  // The damping forces on embedded particles, over the same duration, to their hosts' particles
-  // in their weights (after every solve of the stage, as the bound particles' to their bodies).
+  // The damping forces on embedded particles whose host was not in their solve (a host coupled to
+  // a fluid), over the same duration, to their hosts' particles in their weights (after every
+  // solve of the stage). In the solve, an embedded particle's force is already its hosts' and its
+  // own entry of Du is zero.
   if (embedding)
     for (Body& b : bodies)
       if (const EmbeddedBinding<d>* eb = world.template get<EmbeddedBinding<d>>(b.e); eb && !b.Du.empty())

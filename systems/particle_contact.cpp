@@ -11,6 +11,7 @@
 #include "solvers/contact/central_normal_contact.h"
 #include "solvers/contact/push_out.h"
 #include "systems/contact_workspace.h"
+#include "systems/joint_assembly.h"
 
 namespace monolith {
 
@@ -513,6 +514,151 @@ std::vector<NormalConstraint<d>> DampingSolveContacts<d>::of(World<d>& world, co
       else out.push_back({i, n, kept, b.entity});
       taken[i] = 1;
     }
+  return out;
+}
+
+template <int d>
+std::vector<RigidConstraintRow<d>> DampingSolveContacts<d>::rigidRows(World<d>& world, std::vector<Entity>& unknowns,
+                                                                     double dt, double keep) {
+  using Twist = solvers::deformable::DampingTwist<d>;
+  std::vector<RigidConstraintRow<d>> out;
+  if (unknowns.empty()) return out;
+  auto dynamic = [&](Entity e) {
+    const RigidBody<d>* b = world.template get<RigidBody<d>>(e);
+    return b && !b->isStatic && !world.template has<KinematicMotion<d>>(e);
+  };
+  auto known = [&](Entity e) { return std::find(unknowns.begin(), unknowns.end(), e) != unknowns.end(); };
+  auto row = [](const Vec<d>& n, const Vec<d>& r) {
+    Twist g;
+    g.template head<d>() = n;
+    g.template tail<cc::kAngularDim<d>>() = crossArm<d>(r, n);
+    return g;
+  };
+  // Contacts: every unknown against every body with a collider, at the candidate poses.
+  std::vector<BodyView<d>> bodies;
+  if (world.template count<Collider<d>>() > 0) bodies = bodiesOf(world, shapes_, dt, false);
+  auto viewOf = [&](Entity e) -> const BodyView<d>* {
+    for (const BodyView<d>& b : bodies)
+      if (b.entity == e) return &b;
+    return nullptr;
+  };
+  const double thickness = world.template resource<ContactSettings>().thickness;
+  const double tolerance = world.template resource<ContactSettings>().approachTolerance;
+  std::vector<col::ContactPoint<d>> points;
+  // Joints: the assembly's rows (3-D solver; a 2-D world's joints are planar: linear rows in the
+  // plane, angular rows about z).
+  std::unique_ptr<JointAssembly<d>> joints;
+  std::vector<solvers::JointRows> jointRows;
+  std::vector<char> jointDone;
+  if (world.template count<ArticulationJoint<d>>() > 0) {
+    joints = std::make_unique<JointAssembly<d>>(world);
+    jointRows = joints->rows();
+    jointDone.assign(jointRows.size(), 0);
+  }
+  auto lower = [](const Eigen::Vector3d& v) -> Vec<d> { return v.template head<d>(); };
+  auto angular = [](const Eigen::Vector3d& w) -> AngularVec<d> {
+    if constexpr (d == 3) return w;
+    else return AngularVec<2>(w.z());
+  };
+  for (std::size_t k = 0; k < unknowns.size(); ++k) {  // grows as bodies are found
+    const Entity a = unknowns[k];
+    if (const BodyView<d>* va = viewOf(a)) {
+      col::ContactQuery query;
+      query.margin = std::max(2 * thickness, kSupportMargin * va->geometry->minimumSize());
+      const Vec<d> vA = va->body->v;
+      const AngularVec<d> wA = va->body->omega();
+      for (const BodyView<d>& vb : bodies) {
+        if (vb.entity == a) continue;
+        const bool other = dynamic(vb.entity);
+        // A pair of unknowns once: from the one found first.
+        if (other && known(vb.entity) &&
+            std::find(unknowns.begin(), unknowns.end(), vb.entity) - unknowns.begin() < static_cast<std::ptrdiff_t>(k))
+          continue;
+        if (!va->geometry->unbounded() && !vb.geometry->unbounded() &&
+            (va->x - vb.x).norm() > va->geometry->boundingRadius() + vb.geometry->boundingRadius() + query.margin)
+          continue;
+        points.clear();
+        col::findContacts<d>(*va->geometry, {va->x, va->R}, *vb.geometry, {vb.x, vb.R}, query, points);
+        bool touching = false;
+        for (const col::ContactPoint<d>& c : points) {
+          const Vec<d> n = c.normal;  // out of b towards a
+          const Vec<d> ra = c.point - va->x, rb = c.point - vb.x;
+          const Vec<d> pointA = vA + angularAt<d>(wA, ra);
+          const Vec<d> pointB = vb.body->isStatic ? Vec<d>::Zero() : Vec<d>(vb.body->v + angularAt<d>(vb.body->omega(), rb));
+          const double approach = (pointA - pointB).dot(n);
+          // A separating point is held at its own relative normal velocity: left out, an equality
+          // on the other points of a manifold would let the body turn into the support about them
+          // inside the solve (a light box under a block, held at one or two of its four corners,
+          // tipped into the ground in the solve and the block's damping saw that motion).
+          const double gap = std::max(0.0, -c.depth);
+          const bool own = approach > tolerance || (other && keep > 0 && gap >= thickness);
+          const double kept = own ? approach : keep * std::min(approach, 0.0);
+          RigidConstraintRow<d> r;
+          r.a = a;
+          r.ga = row(n, ra);
+          if (other) {
+            r.b = vb.entity;
+            r.gb = -row(n, rb);
+            r.target = kept;
+          } else {
+            r.gb = Twist::Zero();
+            r.target = kept + pointB.dot(n);
+          }
+          out.push_back(r);
+          touching = true;
+        }
+        if (touching && other && !known(vb.entity)) unknowns.push_back(vb.entity);
+      }
+    }
+    if (!joints) continue;
+    for (std::size_t j = 0; j < jointRows.size(); ++j) {
+      if (jointDone[j]) continue;
+      const solvers::JointRows& jr = jointRows[j];
+      const Entity parent = joints->entity[jr.parent], child = joints->entity[jr.child];
+      if (parent != a && child != a) continue;
+      jointDone[j] = 1;
+      const bool parentFree = jr.parent != 0 && dynamic(parent), childFree = jr.child != 0 && dynamic(child);
+      const solvers::ConstraintBody& bp = joints->bodies[jr.parent];
+      const solvers::ConstraintBody& bc = joints->bodies[jr.child];
+      for (int i = 0; i < jr.rows(); ++i) {
+        // Row velocity: n . (v_c + w_c x r_c - v_p - w_p x r_p) or e . (w_c - w_p).
+        Twist gp = Twist::Zero(), gc = Twist::Zero();
+        if (i < jr.linear) {
+          const Vec<d> n = lower(jr.linearDirs.col(i));
+          gc = row(n, lower(jr.armChild));
+          gp = -row(n, lower(jr.armParent));
+        } else {
+          const AngularVec<d> e = angular(jr.angularDirs.col(i - jr.linear));
+          gc.template tail<cc::kAngularDim<d>>() = e;
+          gp.template tail<cc::kAngularDim<d>>() = -e;
+        }
+        auto twistOf = [&](const solvers::ConstraintBody& b) {
+          Twist t;
+          t.template head<d>() = lower(b.v);
+          t.template tail<cc::kAngularDim<d>>() = angular(b.w);
+          return t;
+        };
+        RigidConstraintRow<d> r;
+        if (childFree) {
+          r.a = child;
+          r.ga = gc;
+          if (parentFree) {
+            r.b = parent;
+            r.gb = gp;
+          } else {
+            r.target = -gp.dot(twistOf(bp));
+          }
+        } else {
+          r.a = parent;
+          r.ga = gp;
+          r.target = -gc.dot(twistOf(bc));
+        }
+        out.push_back(r);
+      }
+      const Entity otherEnd = parent == a ? child : parent;
+      if ((parent == a ? childFree : parentFree) && !known(otherEnd)) unknowns.push_back(otherEnd);
+    }
+  }
   return out;
 }
 

@@ -37,6 +37,7 @@
 #include "components/shape.h"
 #include "ecs/system.h"
 #include "solvers/collision/geometry.h"
+#include "solvers/deformable/coupled_damping.h"
 #include "systems/deformable_dynamics.h"
 
 namespace monolith {
@@ -138,10 +139,27 @@ class ParticlePenetration final : public System<d> {
 // holds contacts in Step V only; without Step I's (measured on density_ratio_heavy_box at dt =
 // 1e-4, beta = 0.01) the damping of the light top particles, free in the solve, lets the energy
 // rise 6 %.
+//
+// `rigidRows`: the rigid unknowns' own constraints in the same solves (Sec. 4.7.1, 4.7.3): their
+// contacts with other rigid bodies at the candidate poses (narrow-phase points within twice the
+// thickness or 1 % of the body's size), temporary normal-only joints on the relative normal
+// velocity at the point with the same `keep` rule as the particles' (a separating point held at
+// its own relative normal velocity, so that the rest of a manifold is no pivot), and the
+// velocity rows of their joints (target zero: the joint stages post-stabilize to it). A dynamic
+// body touching or jointed to an unknown becomes an unknown too (appended to `unknowns`, in the
+// order found), so that a box resting on a box on a deformable slab is one consistent solve.
+template <int d>
+struct RigidConstraintRow {
+  Entity a, b;  // b invalid: the other side is static, kinematic or the world (its velocity in target)
+  solvers::deformable::DampingTwist<d> ga, gb;
+  double target = 0;
+};
+
 template <int d>
 class DampingSolveContacts {
  public:
   std::vector<NormalConstraint<d>> of(World<d>& world, const Particles<d>& p, double dt, double keep);
+  std::vector<RigidConstraintRow<d>> rigidRows(World<d>& world, std::vector<Entity>& unknowns, double dt, double keep);
 
  private:
   PreparedShapes<d> shapes_;

@@ -1,6 +1,7 @@
 #include "solvers/deformable/coupled_damping.h"
 
 #include <Eigen/Dense>
+#include <cmath>
 #include <stdexcept>
 
 #include "solvers/fluid/krylov.h"
@@ -13,7 +14,7 @@ template <int d>
 constexpr int kTwist = d + rm::kAngularDim<d>;
 
 template <int d>
-using Twist = Eigen::Matrix<double, kTwist<d>, 1>;
+using Twist = DampingTwist<d>;
 
 // g = (n, r x n): the constraint's row on the rigid twist (the body point's normal velocity g . xi).
 template <int d>
@@ -28,8 +29,9 @@ Twist<d> jointRow(const VecD<d>& n, const VecD<d>& r) {
 
 template <int d>
 CoupledDampingSystem<d>::CoupledDampingSystem(std::vector<DampingBody<d>> bodies, std::vector<DampingRigid<d>> rigids,
-                                              std::vector<DampingHold<d>> holds, double h)
-    : bodies_(std::move(bodies)), rigids_(std::move(rigids)), h_(h) {
+                                              std::vector<DampingHold<d>> holds, double h,
+                                              std::vector<DampingRigidRow<d>> rows)
+    : bodies_(std::move(bodies)), rigids_(std::move(rigids)), h_(h), rows_(std::move(rows)) {
   int n = 0;
   for (const DampingBody<d>& b : bodies_) {
     offset_.push_back(n);
@@ -42,6 +44,12 @@ CoupledDampingSystem<d>::CoupledDampingSystem(std::vector<DampingBody<d>> bodies
   std::vector<std::vector<char>> taken(bodies_.size());
   for (std::size_t k = 0; k < bodies_.size(); ++k) taken[k].assign(bodies_[k].role.size(), 0);
   holdsOfRigid_.resize(rigids_.size());
+  for (const DampingBody<d>& b : bodies_)
+    for (const EmbeddedWeight& e : b.embedded)
+      if (e.hostBody < 0 || e.hostBody >= static_cast<int>(bodies_.size()) || b.role[e.particle] != ParticleRole::Embedded ||
+          bodies_[e.hostBody].role[e.hostParticle] == ParticleRole::Embedded)
+        throw std::invalid_argument("CoupledDampingSystem: an embedded weight names no host body, a particle not "
+                                    "embedded, or an embedded host particle");
   for (const DampingHold<d>& c : holds) {
     const DampingBody<d>& b = bodies_[c.body];
     if (b.role[c.particle] != ParticleRole::Free || taken[c.body][c.particle]) continue;
@@ -65,6 +73,39 @@ CoupledDampingSystem<d>::CoupledDampingSystem(std::vector<DampingBody<d>> bodies
     Eigen::Matrix<double, kTwist<d>, kTwist<d>> Kinv = K.ldlt().solve(Eigen::Matrix<double, kTwist<d>, kTwist<d>>::Identity());
     centralInverse_.push_back(0.5 * (Kinv + Kinv.transpose()));  // exactly symmetric
   }
+  if (rows_.empty()) return;
+  // The rigid rows: S = G K^{-1} G^T, scaled to unit diagonal (rows of metres and radians
+  // side by side), its pseudo-inverse on the scaled matrix (dependent rows: a zero eigenvalue),
+  // S^- = D S~^+ D, symmetric and reflexive (S S^- S = S, S^- S S^- = S^-).
+  const int twists = kTwist<d> * static_cast<int>(rigids_.size());
+  const int count = static_cast<int>(rows_.size());
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(count, twists), KinvGt = Eigen::MatrixXd::Zero(twists, count);
+  for (int k = 0; k < count; ++k) {
+    const DampingRigidRow<d>& r = rows_[k];
+    if (r.a < 0 || r.a >= static_cast<int>(rigids_.size()) || r.b >= static_cast<int>(rigids_.size()) || r.a == r.b)
+      throw std::invalid_argument("CoupledDampingSystem: a rigid row names no rigid unknown, or one twice");
+    G.row(k).template segment<kTwist<d>>(kTwist<d> * r.a) = r.ga.transpose();
+    KinvGt.col(k).template segment<kTwist<d>>(kTwist<d> * r.a) = centralInverse_[r.a] * r.ga;
+    if (r.b >= 0) {
+      G.row(k).template segment<kTwist<d>>(kTwist<d> * r.b) = r.gb.transpose();
+      KinvGt.col(k).template segment<kTwist<d>>(kTwist<d> * r.b) = centralInverse_[r.b] * r.gb;
+    }
+  }
+  Eigen::MatrixXd S = G * KinvGt;
+  S = 0.5 * (S + S.transpose());
+  Eigen::VectorXd scale(count);
+  for (int k = 0; k < count; ++k) scale(k) = S(k, k) > 0 ? 1 / std::sqrt(S(k, k)) : 0.0;
+  const Eigen::MatrixXd scaled = scale.asDiagonal() * S * scale.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled);
+  const double largest = eig.eigenvalues().cwiseAbs().maxCoeff();
+  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(count);
+  for (int k = 0; k < count; ++k)
+    if (eig.eigenvalues()(k) > 1e-10 * largest) inverse(k) = 1 / eig.eigenvalues()(k);
+  Eigen::MatrixXd Sminus = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
+  Sminus = scale.asDiagonal() * Sminus * scale.asDiagonal();
+  Sminus = 0.5 * (Sminus + Sminus.transpose());
+  rowParticular_ = KinvGt * Sminus;
+  rowCorrection_ = rowParticular_ * G;
 }
 
 template <int d>
@@ -88,11 +129,15 @@ void CoupledDampingSystem<d>::expand(const Eigen::VectorXd& in, std::vector<std:
         const rm::AngVec<d> omega = in.template segment<rm::kAngularDim<d>>(ro + d);
         const VecD<d> vi = v + rm::angularCross<d>(omega, arm(static_cast<int>(k), i, c));
         for (int a = 0; a < d; ++a) w[k][d * i + a] = vi(a);
-      } else {
+      } else if (b.role[i] != ParticleRole::Embedded) {
         for (int a = 0; a < d; ++a) w[k][d * i + a] = in(o + d * i + a);
       }
     }
   }
+  // Embedded particles from their hosts' expanded velocities (hosts are never embedded).
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    for (const EmbeddedWeight& e : bodies_[k].embedded)
+      for (int a = 0; a < d; ++a) w[k][d * e.particle + a] += e.weight * w[e.hostBody][d * e.hostParticle + a];
 }
 
 template <int d>
@@ -104,11 +149,20 @@ void CoupledDampingSystem<d>::dampingForces(const std::vector<std::vector<double
     Dw[k].assign(w[k].size(), 0.0);
     if (b.fm->dampingRows() > 0) addDampingForces<d>(*b.fm, *b.rotations, b.x, w[k].data(), Dw[k].data());
   }
+  // The force on an embedded particle acts on its host particles with its weights (J^T).
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    const DampingBody<d>& b = bodies_[k];
+    for (const EmbeddedWeight& e : b.embedded)
+      for (int a = 0; a < d; ++a) Dw[e.hostBody][d * e.hostParticle + a] += e.weight * Dw[k][d * e.particle + a];
+    for (const EmbeddedWeight& e : b.embedded)
+      for (int a = 0; a < d; ++a) Dw[k][d * e.particle + a] = 0;
+  }
 }
 
 template <int d>
 void CoupledDampingSystem<d>::apply(const Eigen::VectorXd& in, Eigen::VectorXd& out) const {
-  std::vector<std::vector<double>> w, Dw;
+  std::vector<std::vector<double>>& w = expanded_;
+  std::vector<std::vector<double>>& Dw = forces_;
   expand(in, w);
   dampingForces(w, Dw);
   out.setZero(size_);
@@ -123,7 +177,7 @@ void CoupledDampingSystem<d>::apply(const Eigen::VectorXd& in, Eigen::VectorXd& 
         const VecD<d> f = Eigen::Map<const VecD<d>>(&Dw[k][d * i]);
         out.template segment<d>(ro) -= h_ * f;
         out.template segment<rm::kAngularDim<d>>(ro + d) -= h_ * rm::cross<d>(arm(static_cast<int>(k), i, c), f);
-      } else {
+      } else if (b.role[i] != ParticleRole::Embedded) {
         for (int a = 0; a < d; ++a) out(o + d * i + a) = b.m[i] * in(o + d * i + a) - h_ * Dw[k][d * i + a];
       }
     }
@@ -140,7 +194,8 @@ void CoupledDampingSystem<d>::applyMass(const Eigen::VectorXd& in, Eigen::Vector
   out.setZero(size_);
   for (std::size_t k = 0; k < bodies_.size(); ++k)
     for (int i = 0; i < static_cast<int>(bodies_[k].role.size()); ++i)
-      for (int a = 0; a < d; ++a) out(offset_[k] + d * i + a) = bodies_[k].m[i] * in(offset_[k] + d * i + a);
+      if (bodies_[k].role[i] != ParticleRole::Embedded)  // its mass is its hosts'
+        for (int a = 0; a < d; ++a) out(offset_[k] + d * i + a) = bodies_[k].m[i] * in(offset_[k] + d * i + a);
   for (std::size_t c = 0; c < rigids_.size(); ++c) {
     const int ro = rigidOffset(static_cast<int>(c));
     out.template segment<d>(ro) = rigids_[c].mass * in.template segment<d>(ro);
@@ -153,7 +208,8 @@ void CoupledDampingSystem<d>::applyInverseMass(const Eigen::VectorXd& in, Eigen:
   out.setZero(size_);
   for (std::size_t k = 0; k < bodies_.size(); ++k)
     for (int i = 0; i < static_cast<int>(bodies_[k].role.size()); ++i)
-      for (int a = 0; a < d; ++a) out(offset_[k] + d * i + a) = in(offset_[k] + d * i + a) / bodies_[k].m[i];
+      if (bodies_[k].role[i] != ParticleRole::Embedded)
+        for (int a = 0; a < d; ++a) out(offset_[k] + d * i + a) = in(offset_[k] + d * i + a) / bodies_[k].m[i];
   for (std::size_t c = 0; c < rigids_.size(); ++c) {
     const int ro = rigidOffset(static_cast<int>(c));
     out.template segment<d>(ro) = in.template segment<d>(ro) / rigids_[c].mass;
@@ -162,32 +218,43 @@ void CoupledDampingSystem<d>::applyInverseMass(const Eigen::VectorXd& in, Eigen:
 }
 
 template <int d>
-void CoupledDampingSystem<d>::projectRigidHolds(int c, Eigen::VectorXd& y, bool forceSide) const {
+void CoupledDampingSystem<d>::centralSolution(int c, const Eigen::VectorXd& y, bool forceSide, Twist<d>& xi,
+                                              Twist<d>& dxi) const {
   const std::vector<int>& held = holdsOfRigid_[c];
-  if (held.empty()) return;
   const int ro = rigidOffset(c);
   // Velocities: y itself; forces: y = M^{-1} r on the blocks involved, and P^T r = M P M^{-1} r.
-  Twist<d> xi = y.template segment<kTwist<d>>(ro);
+  xi = y.template segment<kTwist<d>>(ro);
   if (forceSide) {
     xi.template head<d>() /= rigids_[c].mass;
     xi.template tail<rm::kAngularDim<d>>() = inverseInertia_[c] * xi.template tail<rm::kAngularDim<d>>();
   }
   Twist<d> rhs = Twist<d>::Zero();
-  std::vector<Twist<d>> g(held.size());
-  std::vector<double> un(held.size());
+  rows6_.resize(held.size());
+  normalSpeeds_.resize(held.size());
   for (std::size_t k = 0; k < held.size(); ++k) {
     const DampingHold<d>& o = holds_[held[k]];
     const double m = bodies_[o.body].m[o.particle];
-    g[k] = jointRow<d>(o.normal, arm(o.body, o.particle, c));
+    rows6_[k] = jointRow<d>(o.normal, arm(o.body, o.particle, c));
     const VecD<d> uo = y.template segment<d>(offset_[o.body] + d * o.particle);
-    un[k] = o.normal.dot(uo) / (forceSide ? m : 1.0);
-    rhs += m * (un[k] - g[k].dot(xi)) * g[k];
+    normalSpeeds_[k] = o.normal.dot(uo) / (forceSide ? m : 1.0);
+    rhs += m * (normalSpeeds_[k] - rows6_[k].dot(xi)) * rows6_[k];
   }
-  const Twist<d> dxi = centralInverse_[c] * rhs;
+  dxi = centralInverse_[c] * rhs;
+}
+
+template <int d>
+void CoupledDampingSystem<d>::projectRigidHolds(int c, Eigen::VectorXd& y, bool forceSide,
+                                                const Twist<d>* correction) const {
+  const std::vector<int>& held = holdsOfRigid_[c];
+  if (held.empty() && !correction) return;
+  const int ro = rigidOffset(c);
+  Twist<d> xi, dxi;
+  centralSolution(c, y, forceSide, xi, dxi);  // fills rows6_ and normalSpeeds_ for c
+  if (correction) dxi += *correction;
   for (std::size_t k = 0; k < held.size(); ++k) {
     const DampingHold<d>& o = holds_[held[k]];
     const double m = bodies_[o.body].m[o.particle];
-    const double lambda = m * (g[k].dot(xi + dxi) - un[k]);
+    const double lambda = m * (rows6_[k].dot(xi + dxi) - normalSpeeds_[k]);
     // Velocities: u_o += lambda n / m; forces: r_o += m (lambda n / m).
     y.template segment<d>(offset_[o.body] + d * o.particle) += (forceSide ? lambda : lambda / m) * o.normal;
   }
@@ -209,14 +276,31 @@ void CoupledDampingSystem<d>::project(Eigen::VectorXd& v, bool force) const {
     auto vi = v.template segment<d>(offset_[c.body] + d * c.particle);
     vi -= vi.dot(c.normal) * c.normal;
   }
-  for (int c = 0; c < static_cast<int>(rigids_.size()); ++c) projectRigidHolds(c, v, force);
+  const int rigidCount = static_cast<int>(rigids_.size());
+  if (rows_.empty()) {
+    for (int c = 0; c < rigidCount; ++c) projectRigidHolds(c, v, force, nullptr);
+    return;
+  }
+  // With rigid rows: every body's central solution xi*, the rows' correction of all of them at
+  // once, then each body and its held particles moved to the corrected twist.
+  stars_.resize(kTwist<d> * rigidCount);
+  for (int c = 0; c < rigidCount; ++c) {
+    Twist<d> xi, dxi;
+    centralSolution(c, v, force, xi, dxi);
+    stars_.template segment<kTwist<d>>(kTwist<d> * c) = xi + dxi;
+  }
+  corrections_.noalias() = -rowCorrection_ * stars_;
+  for (int c = 0; c < rigidCount; ++c) {
+    const Twist<d> correction = corrections_.template segment<kTwist<d>>(kTwist<d> * c);
+    projectRigidHolds(c, v, force, &correction);
+  }
 }
 
 template <int d>
 void CoupledDampingSystem<d>::applyProjected(const Eigen::VectorXd& in, Eigen::VectorXd& out) const {
-  Eigen::VectorXd y = in;
-  projectVelocity(y);
-  apply(y, out);
+  scratch_ = in;  // no allocation once sized
+  projectVelocity(scratch_);
+  apply(scratch_, out);
   projectForce(out);
 }
 
@@ -228,6 +312,11 @@ std::vector<double> CoupledDampingSystem<d>::constraintResiduals(const Eigen::Ve
     if (c.rigid >= 0)
       rel -= jointRow<d>(c.normal, arm(c.body, c.particle, c.rigid)).dot(y.template segment<kTwist<d>>(rigidOffset(c.rigid)));
     out.push_back(rel - c.target);
+  }
+  for (const DampingRigidRow<d>& r : rows_) {
+    double rel = r.ga.dot(y.template segment<kTwist<d>>(rigidOffset(r.a)));
+    if (r.b >= 0) rel += r.gb.dot(y.template segment<kTwist<d>>(rigidOffset(r.b)));
+    out.push_back(rel - r.target);
   }
   return out;
 }
@@ -245,7 +334,7 @@ CoupledDampingResult<d> CoupledDampingSystem<d>::solve() const {
     for (int i = 0; i < static_cast<int>(b.role.size()); ++i)
       for (int a = 0; a < d; ++a) {
         const int j = offset_[k] + d * i + a;
-        if (b.role[i] == ParticleRole::Bound) continue;
+        if (b.role[i] == ParticleRole::Bound || b.role[i] == ParticleRole::Embedded) continue;
         y0(j) = b.v[d * i + a];
         if (b.role[i] == ParticleRole::Prescribed) yp(j) = b.v[d * i + a];
         else hf(j) = h_ * b.f[d * i + a];
@@ -256,8 +345,19 @@ CoupledDampingResult<d> CoupledDampingSystem<d>::solve() const {
     y0.template segment<d>(ro) = rigids_[c].v;
     y0.template segment<rm::kAngularDim<d>>(ro + d) = rigids_[c].omega;
   }
-  for (const DampingHold<d>& c : holds_)
-    yp.template segment<d>(offset_[c.body] + d * c.particle) = c.target * c.normal;
+  // A particular solution: the rigid rows' targets met by the K-smallest twists, and each held
+  // particle's normal velocity at its target relative to its body's point.
+  if (!rows_.empty()) {
+    Eigen::VectorXd t(rows_.size());
+    for (std::size_t k = 0; k < rows_.size(); ++k) t(k) = rows_[k].target;
+    yp.segment(rigidStart_, kTwist<d> * rigids_.size()) = rowParticular_ * t;
+  }
+  for (const DampingHold<d>& c : holds_) {
+    double target = c.target;
+    if (c.rigid >= 0)
+      target += jointRow<d>(c.normal, arm(c.body, c.particle, c.rigid)).dot(yp.template segment<kTwist<d>>(rigidOffset(c.rigid)));
+    yp.template segment<d>(offset_[c.body] + d * c.particle) = target * c.normal;
+  }
 
   Eigen::VectorXd y = y0;
   if (damped) {
@@ -273,8 +373,9 @@ CoupledDampingResult<d> CoupledDampingSystem<d>::solve() const {
     settings.maxIterations = 2000;
     const solvers::LinearOperator op = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) { applyProjected(in, out); };
     // P M^{-1} P^T: symmetric, and it keeps the search directions in the range of P.
+    Eigen::VectorXd rp(n);
     const solvers::LinearOperator precondition = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
-      Eigen::VectorXd rp = r;
+      rp = r;
       projectForce(rp);
       applyInverseMass(rp, z);
       projectVelocity(z);
@@ -312,15 +413,18 @@ CoupledDampingResult<d> CoupledDampingSystem<d>::solve() const {
 
 template <int d>
 CoupledDampingResult<d> solveCoupledDamping(std::vector<DampingBody<d>> bodies, std::vector<DampingRigid<d>> rigids,
-                                            std::vector<DampingHold<d>> holds, double h) {
-  return CoupledDampingSystem<d>(std::move(bodies), std::move(rigids), std::move(holds), h).solve();
+                                            std::vector<DampingHold<d>> holds, double h,
+                                            std::vector<DampingRigidRow<d>> rows) {
+  return CoupledDampingSystem<d>(std::move(bodies), std::move(rigids), std::move(holds), h, std::move(rows)).solve();
 }
 
 template class CoupledDampingSystem<2>;
 template class CoupledDampingSystem<3>;
 template CoupledDampingResult<2> solveCoupledDamping<2>(std::vector<DampingBody<2>>, std::vector<DampingRigid<2>>,
-                                                        std::vector<DampingHold<2>>, double);
+                                                        std::vector<DampingHold<2>>, double,
+                                                        std::vector<DampingRigidRow<2>>);
 template CoupledDampingResult<3> solveCoupledDamping<3>(std::vector<DampingBody<3>>, std::vector<DampingRigid<3>>,
-                                                        std::vector<DampingHold<3>>, double);
+                                                        std::vector<DampingHold<3>>, double,
+                                                        std::vector<DampingRigidRow<3>>);
 
 }  // namespace monolith::solvers::deformable
