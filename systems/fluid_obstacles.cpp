@@ -292,12 +292,10 @@ std::vector<std::uint8_t> obstacleFaces(const solvers::MacLayout<d>& layout, con
   return marked;
 }
 
-// Per free face and direction into an obstacle face: the distance in cells to the wall
-// (FluidDomain::wallDistance) and, when some obstacle moves, the wall's velocity component along
-// the face's axis at that wall point, from the obstacle of smallest signed distance there
-// (grid.obstacleVelocityAt, from the motions of this step; FluidDomain::wallVelocity,
-// kNoWallVelocity for the pairs that end elsewhere; empty otherwise).
 // Free cut faces (open in part) whose centre lies inside some obstacle; all zero on a staircase.
+// A centre on the surface (to rounding, kInsideMargin cells) counts as outside, so that faces placed
+// symmetrically about a symmetric body are classified alike.
+constexpr double kInsideMargin = 1e-9;
 template <int d>
 std::vector<std::uint8_t> insideCutFaces(const solvers::MacLayout<d>& layout, const MacGrid<d>& grid,
                                          const ObstacleList<d>& obstacles, const CellBox<d>& box) {
@@ -306,11 +304,16 @@ std::vector<std::uint8_t> insideCutFaces(const solvers::MacLayout<d>& layout, co
   forEachFaceIn(layout, box, [&](int g, int a, const typename solvers::MacLayout<d>::Index& f) {
     if (!(grid.openFraction[g] < 1) || !gridFaceFree(layout, grid, g)) return;
     const auto x = layout.faceCenter(a, f);
-    for (const auto& obstacle : obstacles) inside[g] |= obstacle.contains(x);
+    for (const auto& obstacle : obstacles) inside[g] |= obstacle.signedDistance(x) < -kInsideMargin * layout.dx;
   });
   return inside;
 }
 
+// Per free face and direction into an obstacle face: the distance in cells to the wall
+// (FluidDomain::wallDistance) and, when some obstacle moves, the wall's velocity component along
+// the face's axis at that wall point, from the obstacle of smallest signed distance there
+// (grid.obstacleVelocityAt, from the motions of this step; FluidDomain::wallVelocity,
+// kNoWallVelocity for the pairs that end elsewhere; empty otherwise).
 template <int d>
 struct WallGeometry {
   std::vector<double> distance, velocity;
@@ -464,7 +467,7 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
       forEachFaceIn(layout, box, [&](int g, int a, const Index& fi) {
         if (wallDistance[solvers::FluidDomain<d>::wallDistanceIndex(g, 0, 0)] != 0) return;
         insideAny[g] = 1;
-        if (!geometry->contains(layout.faceCenter(a, fi))) return;
+        if (!(geometry->signedDistance(layout.faceCenter(a, fi)) < 0)) return;  // another obstacle's
         mine[g] = 1;
         const double theta = solvers::FluidDomain<d>::kMinWallDistance;
         const double wall = grid.obstacleWallVelocity.empty() ? grid.obstacleVelocityAt(layout.faceCenter(a, fi))[a]
