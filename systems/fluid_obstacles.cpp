@@ -292,6 +292,23 @@ std::vector<std::uint8_t> obstacleFaces(const solvers::MacLayout<d>& layout, con
   return marked;
 }
 
+// Free cut faces (open in part) whose centre lies inside some obstacle; all zero on a staircase.
+// A centre on the surface (to rounding, kInsideMargin cells) counts as outside, so that faces placed
+// symmetrically about a symmetric body are classified alike.
+constexpr double kInsideMargin = 1e-9;
+template <int d>
+std::vector<std::uint8_t> insideCutFaces(const solvers::MacLayout<d>& layout, const MacGrid<d>& grid,
+                                         const ObstacleList<d>& obstacles, const CellBox<d>& box) {
+  std::vector<std::uint8_t> inside(layout.totalFaces(), 0);
+  if (grid.openFraction.empty()) return inside;
+  forEachFaceIn(layout, box, [&](int g, int a, const typename solvers::MacLayout<d>::Index& f) {
+    if (!(grid.openFraction[g] < 1) || !gridFaceFree(layout, grid, g)) return;
+    const auto x = layout.faceCenter(a, f);
+    for (const auto& obstacle : obstacles) inside[g] |= obstacle.signedDistance(x) < -kInsideMargin * layout.dx;
+  });
+  return inside;
+}
+
 // Per free face and direction into an obstacle face: the distance in cells to the wall
 // (FluidDomain::wallDistance) and, when some obstacle moves, the wall's velocity component along
 // the face's axis at that wall point, from the obstacle of smallest signed distance there
@@ -332,7 +349,22 @@ WallGeometry<d> wallGeometry(const World<d>& world, const MacGrid<d>& grid, cons
     point[b] += dir * wall.distance[k] * layout.dx;
     wall.velocity[k] = grid.obstacleVelocityAt(point)[a];
   };
-  forEachPairIntoMarkedFaces(layout, isFree, obstacleFaces(layout, grid, box), visit, &box);
+  // Cut faces: a free face whose centre lies inside an obstacle is the obstacle's wall for the
+  // viscous rows (FluidDomain::wallDistance, 0 in every direction): its neighbours measure their
+  // shear against the true surface between them, and it is held to the obstacle's velocity.
+  const std::vector<std::uint8_t> inside = insideCutFaces(layout, grid, obstacles, box);
+  std::vector<std::uint8_t> marked = obstacleFaces(layout, grid, box);
+  for (std::size_t g = 0; g < marked.size(); ++g) marked[g] |= inside[g];
+  const auto isOutsideFree = [&](int g) { return !inside[g] && isFree(g); };
+  forEachPairIntoMarkedFaces(layout, isOutsideFree, marked, visit, &box);
+  forEachFaceIn(layout, box, [&](int g, int a, const Index& f) {
+    if (!inside[g]) return;
+    for (int k = 0; k < 2 * d; ++k) {
+      wall.distance[static_cast<std::size_t>(g) * 2 * d + k] = 0.0;
+      if (!wall.velocity.empty())
+        wall.velocity[static_cast<std::size_t>(g) * 2 * d + k] = grid.obstacleVelocityAt(layout.faceCenter(a, f))[a];
+    }
+  });
   return wall;
 }
 
@@ -427,7 +459,24 @@ ObstacleForce<d> obstacleForce(const World<d>& world, Entity obstacle, const Mac
   // staircase the normal rows do not vanish as du_n/dn = 0 would make them on a smooth wall).
   if (viscosity > 0) {
     const std::vector<double>& wallDistance = grid.obstacleWallDistance;
-    const auto isFree = [&](int g) { return gridFaceFree(layout, grid, g); };
+    // Cut faces with the centre inside an obstacle (wall distance 0) are walls themselves: the
+    // rows from outside faces into this obstacle's end there, and each of its own faces is held
+    // to it by one row w (U - u) / sqrt(kMinWallDistance) (operators.cpp).
+    std::vector<std::uint8_t> insideAny(layout.totalFaces(), 0);
+    if (!wallDistance.empty() && !grid.openFraction.empty())
+      forEachFaceIn(layout, box, [&](int g, int a, const Index& fi) {
+        if (wallDistance[solvers::FluidDomain<d>::wallDistanceIndex(g, 0, 0)] != 0) return;
+        insideAny[g] = 1;
+        if (!(geometry->signedDistance(layout.faceCenter(a, fi)) < 0)) return;  // another obstacle's
+        mine[g] = 1;
+        const double theta = solvers::FluidDomain<d>::kMinWallDistance;
+        const double wall = grid.obstacleWallVelocity.empty() ? grid.obstacleVelocityAt(layout.faceCenter(a, fi))[a]
+                                                              : grid.obstacleWallVelocity[solvers::FluidDomain<d>::wallDistanceIndex(g, 0, 0)];
+        const double f = viscosity * (grid.u[g] - wall) / (theta * layout.dx) * area;
+        result.viscous[a] += f;
+        addTorque<d>(result.viscousTorque, layout.faceCenter(a, fi) - geometry->body().x, a, f);
+      });
+    const auto isFree = [&](int g) { return !insideAny[g] && gridFaceFree(layout, grid, g); };
     Eigen::Vector3d spin = Eigen::Vector3d::Zero();  // the body's angular velocity (z only in 2-D)
     if (!geometry->body().isStatic) {
       if constexpr (d == 3) spin = geometry->body().omega();

@@ -14,10 +14,14 @@
 //    With "obstacle_cells": "cut" it instead measures the open part of every face near an obstacle
 //    (grid.openFraction, solvers::cutFaces) and marks solid only the cells whose faces are all
 //    covered: the pressure then sees the body's true surface (second order, Ng, Min & Gibou 2009).
+//    A cut face whose centre lies inside an obstacle is marked with wall distance 0 in every
+//    direction: the viscous rows take it for the obstacle's wall (solvers/fluid/operators.h), and
+//    the rays from its neighbours measure to the surface between them and it.
 //  - obstacle_forces: the fluid's force on each obstacle: the pressure of the fluid cell on every
 //    fluid-solid face (on the covered part of every cut face), plus the viscous stress exactly as the viscous operator applies it,
 //    mu (u - u_wall) / (theta dx) for every free face and axis whose neighbour face that way is
-//    an obstacle face (the body's share of the discrete momentum balance); diagnostics obstacle_<name>_force_x, _y (, _z), and its pressure part
+//    an obstacle face or a cut face inside it, plus the row holding each such inside face to the
+//    body (the body's share of the discrete momentum balance); diagnostics obstacle_<name>_force_x, _y (, _z), and its pressure part
 //    obstacle_<name>_pressure_force_x, ...; the torque about the body's position,
 //    obstacle_<name>_torque_z in 2-D (_x, _y, _z in 3-D).
 #include "components/mac_grid.h"

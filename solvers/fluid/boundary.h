@@ -79,6 +79,9 @@ struct FluidDomain {
   // -e_b, 1 towards +e_b) is the distance, in cells, from the centre of a Free face to an
   // obstacle's surface in that direction, in [kMinWallDistance, 1], 1 meaning "at the next face".
   // The viscous operator reads it for pairs whose other end is a prescribed face (operators.h).
+  // With cut faces, 0 in every direction marks a Free face whose centre lies inside an obstacle:
+  // the viscous operator takes it for the obstacle's wall (the pairs from outside faces into it
+  // carry their distance to the surface between, and it is held to the obstacle's velocity).
   std::vector<double> wallDistance;
   static constexpr double kMinWallDistance = 0.1;  // bounds the wall term's weight by 1/0.1
   // Optional, with wallDistance; empty: the wall moves with the prescribed face's velocity. Else,

@@ -3,6 +3,7 @@
 
 #include "solvers/fluid/parallel.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -130,6 +131,15 @@ void buildViscousRows(FluidOperators<d>& ops) {
     return;
   }
   const double w = ops.viscousWeight;
+  // Free cut faces whose centre lies inside an obstacle (wallDistance 0, boundary.h): the
+  // obstacle's wall for the viscous rows.
+  std::vector<uint8_t> inside(nu, 0);
+  if (!domain.wallDistance.empty())
+    for (int v = 0; v < nu; ++v) {
+      const int face = ops.dofs.velocityToFace[v];
+      if (!domain.structureFace.empty() && domain.structureFace[face]) continue;
+      for (int k = 0; k < 2 * d; ++k) inside[v] |= domain.wallDistance[static_cast<std::size_t>(face) * 2 * d + k] == 0;
+    }
   for (int a = 0; a < d; ++a)
     for (int b = 0; b < d; ++b) {
       // Pair k = (f1 - e_b, f1) for f1 over the face index space of axis a, extended by one layer
@@ -149,6 +159,22 @@ void buildViscousRows(FluidOperators<d>& ops) {
         PairEnd e0 = pairEnd<d>(domain, ops.dofs, a, b, f0);
         PairEnd e1 = pairEnd<d>(domain, ops.dofs, a, b, f1);
         if (e0.kind == PairEnd::Drop || e1.kind == PairEnd::Drop) continue;
+        // A pair with a face inside an obstacle: the wall lies between the two faces. The other
+        // face, if it is outside, sees it as it sees a covered face (below); the inside face has
+        // its own row (after the loop).
+        const bool in0 = e0.kind == PairEnd::Unknown && inside[e0.velocity];
+        const bool in1 = e1.kind == PairEnd::Unknown && inside[e1.velocity];
+        if (in0 && in1) continue;
+        if (in0) {
+          if (e1.kind != PairEnd::Unknown) continue;
+          e0.kind = PairEnd::Known;
+          e0.value = domain.faceVelocity[ops.dofs.velocityToFace[e0.velocity]];
+        }
+        if (in1) {
+          if (e0.kind != PairEnd::Unknown) continue;
+          e1.kind = PairEnd::Known;
+          e1.value = domain.faceVelocity[ops.dofs.velocityToFace[e1.velocity]];
+        }
         if (e0.kind != PairEnd::Unknown && e1.kind != PairEnd::Unknown) continue;
         if (!domain.structureFace.empty() && e0.kind == PairEnd::Unknown && e1.kind == PairEnd::Unknown &&
             domain.structureFace[ops.dofs.velocityToFace[e0.velocity]] &&
@@ -160,9 +186,11 @@ void buildViscousRows(FluidOperators<d>& ops) {
           // instead of one, so the row is w (U - u_f) / sqrt(theta) (theta = 1/2 is the mirrored
           // ghost above); G_mu^T G_mu keeps its symmetric form. (Pairs ending on a domain wall's
           // normal face have theta = 1: the wall is at that face.)
+          // (A coupling face inside an obstacle keeps the marker 0 of an inside face: the closest wall.)
           const auto theta = [&](const PairEnd& unknown, int towardsUpper) {
-            return domain.wallDistance[FluidDomain<d>::wallDistanceIndex(ops.dofs.velocityToFace[unknown.velocity], b,
-                                                                         towardsUpper)];
+            return std::max(FluidDomain<d>::kMinWallDistance,
+                            domain.wallDistance[FluidDomain<d>::wallDistanceIndex(ops.dofs.velocityToFace[unknown.velocity], b,
+                                                                                  towardsUpper)]);
           };
           // A moving wall: its velocity where it is (domain.wallVelocity), not at the face beyond.
           const auto wallVelocity = [&](const PairEnd& unknown, int towardsUpper, double faceValue) {
@@ -209,6 +237,23 @@ void buildViscousRows(FluidOperators<d>& ops) {
         known.push_back(h);
       }
     }
+  // A face inside an obstacle moves with it: one row w (U - u) / sqrt(kMinWallDistance), as if the
+  // wall were at the closest distance any row measures (the open part of such a face lies within
+  // half a cell of the surface). Its pairs were dropped above, so the row takes the first slot.
+  for (int v = 0; v < nu; ++v) {
+    if (!inside[v]) continue;
+    const std::size_t k = static_cast<std::size_t>(ops.dofs.velocityToFace[v]) * 2 * d;
+    const double U = domain.wallVelocity.empty() || domain.wallVelocity[k] == FluidDomain<d>::kNoWallVelocity
+                         ? domain.faceVelocity[ops.dofs.velocityToFace[v]]
+                         : domain.wallVelocity[k];
+    const double c = w / std::sqrt(FluidDomain<d>::kMinWallDistance);
+    ViscousRow row;
+    row.u1 = v;
+    row.c1 = c;
+    ops.faceViscousRows[v][0] = static_cast<int>(ops.viscousRows.size());
+    ops.viscousRows.push_back(row);
+    known.push_back(-c * U);
+  }
   ops.viscousKnown = Eigen::Map<Eigen::VectorXd>(known.data(), static_cast<Eigen::Index>(known.size()));
 }
 

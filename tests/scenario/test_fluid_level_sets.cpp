@@ -398,15 +398,17 @@ std::string couetteShellLevelSet(double lo, double spacing, int n) {
 // non-convex level set, sampled at 0.01), mu = 1, Stokes (no advection), 64 x 64 cells over
 // [-0.55, 0.55]^2: the torques on both bodies at t = 0.2 (steady to 6 digits). `spinning`:
 // which body turns at 1 rad/s (kinematic), the other is static.
-std::pair<double, double> couetteTorques(const std::string& wall, bool innerSpins) {
+std::pair<double, double> couetteTorques(const std::string& wall, bool innerSpins, int cells = 64,
+                                        const std::string& obstacleCells = "staircase") {
   const std::string spin = R"("rigid_body": { "mass": 1, "inertia": 1, "position": [0.0013, -0.0007] }, "kinematic": { "angular_velocity": 1 })";
   const std::string still = R"("rigid_body": { "static": true, "position": [0.0013, -0.0007] })";
   const Registry registry = builtins();
   Simulation<2> sim(parseScene(R"({ "dimension": 2, "time": { "dt": 0.005, "end": 0.2 },
-    "solvers": { "fluid": { "advection": "none", "tolerance": 1e-10, "obstacle_cells": "staircase", "obstacle_wall": ")" +
-                                   wall + R"(" } },
+    "solvers": { "fluid": { "advection": "none", "tolerance": 1e-10, "obstacle_cells": ")" + obstacleCells +
+                                   R"(", "obstacle_wall": ")" + wall + R"(" } },
     "entities": [
-      { "name": "fluid", "mac_grid": { "cells": [64, 64], "domain_min": [-0.55, -0.55], "domain_max": [0.55, 0.55],
+      { "name": "fluid", "mac_grid": { "cells": [)" + std::to_string(cells) + ", " + std::to_string(cells) +
+                                   R"(], "domain_min": [-0.55, -0.55], "domain_max": [0.55, 0.55],
           "boundaries": { "x_min": { "type": "wall" }, "x_max": { "type": "wall" }, "y_min": { "type": "wall" }, "y_max": { "type": "wall" } } },
         "fluid_material": { "density": 1, "viscosity": 1 } },
       { "name": "inner", "shape": { "type": "disk", "radius": 0.25 }, )" + (innerSpins ? spin : still) + R"(, "fluid_obstacle": {} },
@@ -446,6 +448,22 @@ TEST(LevelSets, CouetteTorqueOnTheSpinningAndTheStillCylinder) {
     EXPECT_NEAR(sign * faceInner, T, 0.04 * T);
     EXPECT_NEAR(surfaceInner + surfaceOuter, 0.0, 1e-3 * T);
     EXPECT_NEAR(sign * surfaceInner, T, 0.02 * T);
+  }
+}
+
+TEST(LevelSets, CutCellCouetteTorqueIsAccurateAtEveryAlignment) {
+  // The still disk inside the spinning ring, both cut cells with the wall at the surface, on three
+  // grids that place the surfaces differently among the faces. A cut face whose centre lies inside
+  // a body is that body's wall for the viscous rows (its neighbours measure their shear against the
+  // surface between them, it moves with the body): measured 1.0012, 1.0013, 1.0005 T at 32, 40, 48
+  // cells. Before, such a face was a fluid unknown one cell from its neighbours and the torque
+  // jumped with the alignment: 0.9755, 0.9563, 0.9662 T.
+  const double T = 4 * M_PI * 0.0625 * 0.25 / (0.25 - 0.0625);
+  for (const int cells : {32, 40, 48}) {
+    const auto [inner, outer] = couetteTorques("surface", false, cells, "cut");
+    std::printf("Couette, cut cells at %d^2: still disk %.5f T, spinning ring %.5f T\n", cells, inner / T, outer / T);
+    EXPECT_NEAR(inner + outer, 0.0, 1e-3 * T);
+    EXPECT_NEAR(inner, T, 2e-3 * T) << cells;
   }
 }
 
