@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "solvers/contact/push_out_rounds.h"
+#include "solvers/contact/stable_key_sort.h"
 
 namespace monolith::solvers::contact {
 
@@ -135,7 +136,7 @@ int PushOutRounds<d>::pushApart(Host& host, const ContactSettings& s, const Cont
     };
     for (int p : host.islands.pairs[island])
       if ((host.pairs[p].processed || s.pushOutNewOverlaps) && taken(host.pairs[p])) list.push_back(p);
-    std::stable_sort(list.begin(), list.end(), [&](int x, int y) { return pairLevel_[x] < pairLevel_[y]; });
+    stableSortByKey(list, [&](int p) { return pairLevel_[p]; });
     // A focused round works on the bodies of the listed pairs only: (level, body), ascending.
     auto& focusByLevel = plan.focusByLevel;
     focusByLevel.clear();
@@ -165,7 +166,7 @@ int PushOutRounds<d>::pushApart(Host& host, const ContactSettings& s, const Cont
         bodyPair.emplace_back(p.a, list[k]);
         if (p.b != p.a) bodyPair.emplace_back(p.b, list[k]);
       }
-      std::stable_sort(bodyPair.begin(), bodyPair.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+      stableSortByKey(bodyPair, [](const std::pair<int, int>& x) { return x.first; });
       levelMembers.clear();
       if (!focused) {
         for (int c : levels.nodes[level])
