@@ -267,13 +267,18 @@ int PushOutRounds<d>::pushApart(Host& host, const ContactSettings& s, const Cont
       chunkBegin = tasks.size();
     };
     std::size_t nextFocus = 0;
-    // Room to record without moving what the running chunk reads (the bounds above hold; this
-    // only guards them).
+    // Room to record without moving what the running chunk reads or writes (the bounds above
+    // hold; this only guards them).
     const auto roomFor = [&](const auto& storage) {
       if (chunkRunning && storage.size() == storage.capacity()) running.wait(), chunkRunning = false;
     };
+    const auto roomForTask = [&] {
+      if (!chunked || (tasks.size() < tasks.capacity() && tasks.size() < solves.size())) return;
+      if (chunkRunning) running.wait(), chunkRunning = false;
+      if (tasks.size() >= solves.size()) solves.resize(2 * tasks.size() + 1, 0);
+    };
     auto freeze = [&](int m) {
-      roomFor(tasks);
+      roomForTask();
       tasks.push_back({-1, m, 0, 0, 0});
       host.addOrdered(*recording, frozen, &m, 1);
       frozen[host.memberIndex(m)] = 1;
@@ -326,7 +331,7 @@ int PushOutRounds<d>::pushApart(Host& host, const ContactSettings& s, const Cont
             const auto& p = host.pairs[centralPairs[q]];
             touched.push_back(p.a == c ? p.b : p.a);
           }
-          roomFor(tasks);
+          roomForTask();
           tasks.push_back({c, -1, range[m].first, range[m].second, fraction});
           host.addOrdered(*recording, frozen, touched.data(), static_cast<int>(touched.size()));
         }
