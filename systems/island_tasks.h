@@ -114,8 +114,8 @@ class IslandTasks {
       return;
     }
     // Room for every touched body, filled by index (this runs once per recorded task, on the
-    // recording thread while the other waits: the usual few bodies fit on the stack, with no
-    // thread-local lookup).
+    // recording thread, whose time the other thread mostly waits for: the usual few bodies fit
+    // on the stack, with no thread-local lookup).
     std::array<int, kTouchedOnStack> writesOnStack, readsOnStack;
     int* writes = writesOnStack.data();
     int* reads = readsOnStack.data();

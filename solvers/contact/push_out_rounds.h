@@ -103,8 +103,8 @@ class PushOutRounds {
     std::vector<std::pair<int, int>> range;     // per level member: its pairs in centralPairs
     std::vector<int> pairsByLevel;  // the island's pairs to push apart, ascending level
     std::vector<std::pair<int, int>> focusByLevel;  // a focused round's bodies: (level, body)
-    // The plan is recorded and run in chunks: one chunk's tasks run while the next is recorded
-    // (pushApart), each chunk's dependencies in the order its parity picks.
+    // The plan is recorded and run in chunks, one running while the next is recorded (pushApart):
+    // the chunks' dependencies are recorded into these two in turn.
     parallel::OrderedTasks order, nextOrder;
   };
 
