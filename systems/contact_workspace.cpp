@@ -16,6 +16,7 @@
 #include "solvers/contact/energy_clamp.h"
 #include "solvers/contact/impulse.h"
 #include "solvers/contact/manifold_problem.h"
+#include "solvers/contact/stable_key_sort.h"
 
 namespace monolith {
 
@@ -571,14 +572,17 @@ int ContactWorkspace<d>::pairContacts(const ContactPairState& pair, bool firstIs
 
 template <int d>
 void ContactWorkspace<d>::sortIslandPairsByLevel() {
+  // Each island's list in its own slot (the islands at once), sorted by counting levels.
   islandPairsByLevel.resize(islands.pairs.size());
-  for (std::size_t i = 0; i < islands.pairs.size(); ++i) {
-    auto& list = islandPairsByLevel[i];
-    list.clear();
-    for (int p : islands.pairs[i])
-      if (pairs[p].processed) list.push_back(p);
-    std::stable_sort(list.begin(), list.end(), [&](int x, int y) { return pairs[x].level < pairs[y].level; });
-  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, islands.pairs.size(), 16), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      auto& list = islandPairsByLevel[i];
+      list.clear();
+      for (int p : islands.pairs[i])
+        if (pairs[p].processed) list.push_back(p);
+      con::stableSortByKey(list, [&](int p) { return pairs[p].level; });
+    }
+  });
 }
 
 template <int d>

@@ -14,7 +14,9 @@
 // What a task does is the caller's: it passes a runner, called as run(task) -> TaskCounts, when
 // the tasks are run. On one thread, or for a sequence too short to be shared, the tasks run as
 // they are recorded and nothing is tracked (OrderedTasks's `track`).
+#include <array>
 #include <cstddef>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -111,9 +113,13 @@ class IslandTasks {
       order.add(nullptr, 0, nullptr, 0);
       return;
     }
-    // Room for every touched body, filled by index (this runs once per recorded task).
-    thread_local std::vector<int> writes, reads;
-    if (writes.size() < static_cast<std::size_t>(count)) writes.resize(count), reads.resize(count);
+    // Room for every touched body, filled by index (this runs once per recorded task, on the
+    // recording thread, whose time the other thread mostly waits for: the usual few bodies fit
+    // on the stack, with no thread-local lookup).
+    std::array<int, kTouchedOnStack> writesOnStack, readsOnStack;
+    int* writes = writesOnStack.data();
+    int* reads = readsOnStack.data();
+    if (count > kTouchedOnStack) std::tie(writes, reads) = heapBuffers(count);
     int writeCount = 0, readCount = 0;
     for (int i = 0; i < count; ++i) {
       if ((*immovable_)[touched[i]]) continue;
@@ -121,7 +127,7 @@ class IslandTasks {
       if (frozen[local]) reads[readCount++] = local;
       else writes[writeCount++] = local;
     }
-    order.add(writes.data(), writeCount, reads.data(), readCount);
+    order.add(writes, writeCount, reads, readCount);
   }
 
   // The island's sequence, started anew (no tasks, nothing frozen); the sums go to the caller's
@@ -179,6 +185,14 @@ class IslandTasks {
   }
 
  private:
+  static constexpr int kTouchedOnStack = 32;
+  // addOrdered's room for a task touching more than kTouchedOnStack bodies: this thread's.
+  [[gnu::noinline]] static std::pair<int*, int*> heapBuffers(int count) {
+    thread_local std::vector<int> writes, reads;
+    if (writes.size() < static_cast<std::size_t>(count)) writes.resize(count), reads.resize(count);
+    return {writes.data(), reads.data()};
+  }
+
   const solvers::contact::Islands* islands_ = nullptr;
   const std::vector<char>* immovable_ = nullptr;
   std::vector<int> memberIndex_;

@@ -233,6 +233,70 @@ template <int d>
   return sweepComponents(bodies.size(), points, sweeps, tolerance, sweepOver);
 }
 
+// One point's row as the in-order sweeps read it, packed with what they read of its bodies: the
+// sweeps over one connected jam stay on one thread (they have no order-keeping parallelism),
+// so they read one contiguous record per point instead of the point, its row and its bodies'
+// masses from three places. The arithmetic is separationGained's and moveBodies' own.
+template <int d>
+struct SweepRow {
+  int a = -1, b = -1;
+  double inverseMassA = 0, inverseMassB = 0, depth = 0, inverseMass = 0;
+  Vec<d> n = Vec<d>::Zero();
+  AngVec<d> ca = AngVec<d>::Zero(), cb = AngVec<d>::Zero(), inertiaCa = AngVec<d>::Zero(),
+            inertiaCb = AngVec<d>::Zero();
+};
+
+// solveJointPushOut's Gauss-Seidel sweeps over all points in their order (the points whose row
+// has no mass are never swept), stopped after the first sweep in which no point's separation
+// changes by more than `tolerance`, or after `sweeps`.
+template <int d>
+void sweepInOrder(const std::vector<JointBody<d>>& bodies, const std::vector<JointPoint<d>>& points,
+                  const std::vector<Row<d>>& rows, int sweeps, double tolerance, std::vector<JointMove<d>>& moves) {
+  thread_local std::vector<SweepRow<d>> packed;
+  thread_local std::vector<double> lambda;
+  packed.clear();
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (!(rows[k].inverseMass > 0)) continue;
+    const JointPoint<d>& p = points[k];
+    SweepRow<d>& q = packed.emplace_back();
+    q.a = p.a;
+    q.b = p.b;
+    if (p.a >= 0) q.inverseMassA = bodies[p.a].inverseMass;
+    if (p.b >= 0) q.inverseMassB = bodies[p.b].inverseMass;
+    q.depth = p.depth;
+    q.inverseMass = rows[k].inverseMass;
+    q.n = p.n;
+    q.ca = rows[k].ca;
+    q.cb = rows[k].cb;
+    q.inertiaCa = rows[k].inertiaCa;
+    q.inertiaCb = rows[k].inertiaCb;
+  }
+  lambda.assign(packed.size(), 0.0);
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    double largest = 0;  // the largest correction of a point's separation in this sweep
+    for (std::size_t k = 0; k < packed.size(); ++k) {
+      const SweepRow<d>& q = packed[k];
+      double gained = 0;
+      if (q.a >= 0) gained += q.n.dot(moves[q.a].dx) + q.ca.dot(moves[q.a].dtheta);
+      if (q.b >= 0) gained -= q.n.dot(moves[q.b].dx) + q.cb.dot(moves[q.b].dtheta);
+      const double next = std::max(0.0, lambda[k] + (q.depth - gained) * q.inverseMass);
+      const double change = next - lambda[k];
+      if (change == 0) continue;
+      largest = std::max(largest, std::abs(change) / q.inverseMass);
+      lambda[k] = next;
+      if (q.a >= 0) {
+        moves[q.a].dx += change * q.inverseMassA * q.n;
+        moves[q.a].dtheta += change * q.inertiaCa;
+      }
+      if (q.b >= 0) {
+        moves[q.b].dx -= change * q.inverseMassB * q.n;
+        moves[q.b].dtheta -= change * q.inertiaCb;
+      }
+    }
+    if (largest <= tolerance) break;
+  }
+}
+
 }  // namespace
 
 template <int d>
@@ -263,19 +327,7 @@ double solveJointPushOut(const std::vector<JointBody<d>>& bodies, const std::vec
     solveDense<d>(bodies, points, rows, lambda);
     for (std::size_t k = 0; k < points.size(); ++k) apply(k, lambda[k]);
   } else if (!sweepJamsAtOnce<d>(bodies, points, rows, sweeps, tolerance, lambda, moves)) {
-    for (int sweep = 0; sweep < sweeps; ++sweep) {
-      double largest = 0;  // the largest correction of a point's separation in this sweep
-      for (std::size_t k = 0; k < points.size(); ++k) {
-        if (!(rows[k].inverseMass > 0)) continue;
-        const double next = std::max(0.0, lambda[k] + (points[k].depth - gained(k)) * rows[k].inverseMass);
-        const double change = next - lambda[k];
-        if (change == 0) continue;
-        largest = std::max(largest, std::abs(change) / rows[k].inverseMass);
-        lambda[k] = next;
-        apply(k, change);
-      }
-      if (largest <= tolerance) break;
-    }
+    sweepInOrder<d>(bodies, points, rows, sweeps, tolerance, moves);
   }
   double violation = 0;
   for (std::size_t k = 0; k < points.size(); ++k) violation = std::max(violation, points[k].depth - gained(k));

@@ -103,10 +103,19 @@ class PushOutRounds {
     std::vector<std::pair<int, int>> range;     // per level member: its pairs in centralPairs
     std::vector<int> pairsByLevel;  // the island's pairs to push apart, ascending level
     std::vector<std::pair<int, int>> focusByLevel;  // a focused round's bodies: (level, body)
-    parallel::OrderedTasks order;
+    // The plan is recorded and run in chunks, one running while the next is recorded (pushApart):
+    // the chunks' dependencies are recorded into these two in turn.
+    parallel::OrderedTasks order, nextOrder;
   };
 
  private:
+  // One central-body task of a plan: the body pushed apart from the bodies of its pairs on its
+  // level (App. B), pushOutBodyIterations times at most. Returns the solves.
+  template <class Host>
+  int pushCentral(Host& host, const ContactSettings& s, const PushTask& task, const std::vector<int>& centralPairs,
+                  bool focused);
+  // A plan is recorded in about this many chunks, each of at least kPushChunkTasks tasks.
+  static constexpr std::size_t kPushChunks = 4, kPushChunkTasks = 256;
   // Per pair: its deepest overlap (m) and that over the smaller body's size, as last measured.
   // `which(k)` picks the pairs measured again; the others keep their values.
   template <class Host, typename Which>

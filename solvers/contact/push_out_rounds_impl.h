@@ -3,6 +3,7 @@
 // its host (systems/interpenetration.cpp).
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <utility>
 
 #include "solvers/contact/push_out_rounds.h"
+#include "solvers/contact/stable_key_sort.h"
 
 namespace monolith::solvers::contact {
 
@@ -95,6 +97,83 @@ const ContactLevels& PushOutRounds<d>::pushLevels(const Host& host, int newOverl
 
 template <int d>
 template <class Host>
+int PushOutRounds<d>::pushCentral(Host& host, const ContactSettings& s, const PushTask& task,
+                                  const std::vector<int>& centralPairs, bool focused) {
+  thread_local std::vector<collision::ContactPoint<d>> scratch;
+  thread_local std::vector<PushOutOuter<d>> outers;
+  thread_local std::vector<int> outerIndex;
+  thread_local PushOutResult<d> r;  // kept: its lists' storage carries over
+  const collision::ContactQuery query;
+  const int c = task.central;
+  auto& C = host.bodies[c];
+  if (C.infinite()) return 0;
+  int count = 0;
+  for (int iteration = 0; iteration < s.pushOutBodyIterations; ++iteration) {
+    outers.clear();
+    outerIndex.clear();
+    for (int q = task.begin; q < task.end; ++q) {
+      const auto& p = host.pairs[centralPairs[q]];
+      const int o = p.a == c ? p.b : p.a;
+      auto& O = host.bodies[o];
+      scratch.clear();
+      // Normal out of c towards o.
+      collision::findContacts(*O.geometry, O.candidate, *C.geometry, C.candidate, query, scratch);
+      const collision::ContactPoint<d>* deepest = nullptr;
+      for (const auto& cp : scratch)
+        if (cp.depth > s.pushOutTolerance && (!deepest || cp.depth > deepest->depth)) deepest = &cp;
+      if (!deepest) continue;
+      const auto addOuter = [&](const collision::ContactPoint<d>& at) {
+        PushOutOuter<d> out;
+        out.isStatic = O.infinite();
+        out.r = at.point - C.x0;
+        out.q = at.point - O.x0;
+        // A body of infinite mass here (static, kinematic or frozen below) weighs as the
+        // unit K_hat_s the original code gives every static contact (notes 1.7), whatever
+        // its real mass: weighted by its real mass, a heavy frozen neighbour that the
+        // central body barely touches outweighs the ground and a wall it is sunk into, and
+        // the statics' fit (B.3.2) leaves it there (26-103 % of a body's size in random
+        // drops).
+        out.mass = O.infinite() ? std::numeric_limits<double>::infinity() : O.mass;
+        out.inertia = O.inertia0;
+        // d_o: from the point on c's surface to the point on o's surface (App. B.1).
+        out.displacement = -task.fraction * at.depth * at.normal;
+        outers.push_back(out);
+        outerIndex.push_back(o);
+      };
+      // The thesis's rule: the deepest point of each body. In the rounds after the first,
+      // a body of infinite mass contributes every point that overlaps, each a static
+      // contact of B.3.2 (as the original code takes every particle inside the central
+      // body): with the deepest point only, a slab sunk into the ground at both ends, or
+      // into the ground and a wall, is turned out at one end and into the ground at the
+      // other, the two ends taking turns as the deepest, solve after solve, and stays 20-44 %
+      // of its thickness deep (random drops 37, 142).
+      if (focused && O.infinite()) {
+        for (const auto& cp : scratch)
+          if (cp.depth > s.pushOutTolerance) addOuter(cp);
+      } else {
+        addOuter(*deepest);
+      }
+    }
+    if (outers.empty()) break;
+    if (focused) host.escapeOpposedStatics(c, task.fraction, s.pushOutTolerance, outers, outerIndex);
+    PushOutCentral<d> central;
+    central.mass = C.mass;
+    central.inertia = C.inertia0;
+    central.lengthScale = C.geometry->boundingRadius();
+    solvePushOut(central, outers, r);
+    host.setBasePose(c, C.x0 + r.centralDisplacement, host.rotated(C.q0, r.centralRotation));
+    for (std::size_t k = 0; k < outers.size(); ++k) {
+      auto& O = host.bodies[outerIndex[k]];
+      if (O.infinite()) continue;
+      host.setBasePose(outerIndex[k], O.x0 + r.outerDisplacements[k], host.rotated(O.q0, r.outerRotations[k]));
+    }
+    ++count;
+  }
+  return count;
+}
+
+template <int d>
+template <class Host>
 int PushOutRounds<d>::pushApart(Host& host, const ContactSettings& s, const ContactLevels& levels,
                                 bool focused) {
   std::vector<int> pushes(host.islands.members.size(), 0);
@@ -115,7 +194,8 @@ int PushOutRounds<d>::pushApart(Host& host, const ContactSettings& s, const Cont
     tasks.clear();
     centralPairs.clear();
     // At most one task per body and level iteration, and one freeze per body.
-    host.startOrder(order, island, host.islands.members[island].size() * (s.pushOutLevelIterations + 1));
+    const std::size_t taskBound = host.islands.members[island].size() * (s.pushOutLevelIterations + 1);
+    host.startOrder(order, island, taskBound);
     const auto& members = host.islands.members[island];
     auto& frozen = plan.frozen;
     frozen.assign(members.size(), 0);
@@ -135,7 +215,7 @@ int PushOutRounds<d>::pushApart(Host& host, const ContactSettings& s, const Cont
     };
     for (int p : host.islands.pairs[island])
       if ((host.pairs[p].processed || s.pushOutNewOverlaps) && taken(host.pairs[p])) list.push_back(p);
-    std::stable_sort(list.begin(), list.end(), [&](int x, int y) { return pairLevel_[x] < pairLevel_[y]; });
+    stableSortByKey(list, [&](int p) { return pairLevel_[p]; });
     // A focused round works on the bodies of the listed pairs only: (level, body), ascending.
     auto& focusByLevel = plan.focusByLevel;
     focusByLevel.clear();
@@ -146,10 +226,61 @@ int PushOutRounds<d>::pushApart(Host& host, const ContactSettings& s, const Cont
       std::sort(focusByLevel.begin(), focusByLevel.end());
       focusByLevel.erase(std::unique(focusByLevel.begin(), focusByLevel.end()), focusByLevel.end());
     }
+    // With the dependencies tracked (two threads, a plan long enough to share), the plan is
+    // recorded in chunks of whole levels, and each chunk runs (on the other thread, and on this
+    // one once it has recorded the next) while the next chunk is recorded: the recording no
+    // longer keeps the other thread waiting. A chunk starts after the one before has finished,
+    // so every task still sees the state of the tasks before it in the plan's order, and the
+    // tasks' storage is reserved for the whole plan, so that recording never moves what a
+    // running task reads.
+    const bool chunked = order.tracking();
+    auto& solves = plan.solves;
+    solves.assign(chunked ? taskBound : 0, 0);
+    if (chunked) {
+      tasks.reserve(taskBound);
+      centralPairs.reserve(2 * list.size());
+    }
+    parallel::OrderedTasks* recording = &order;
+    std::size_t chunkBegin = 0;  // the first task of the chunk being recorded
+    const std::size_t chunkTarget = std::max<std::size_t>(taskBound / kPushChunks, kPushChunkTasks);
+    tbb::task_group running;     // the chunk recorded last, while it runs
+    bool chunkRunning = false;
+    const auto runTask = [&](std::size_t t) {
+      const PushTask& task = tasks[t];
+      if (task.central < 0) {
+        host.bodies[task.frozenBody].frozen = true;
+        return;
+      }
+      const int count = pushCentral(host, s, task, centralPairs, focused);
+      if (count) solves[t] = count;
+    };
+    // The chunk recorded so far starts once the one before it has finished (this thread helps
+    // it finish); the next chunk is recorded into the other order.
+    const auto startChunk = [&] {
+      if (chunkRunning) running.wait();
+      parallel::OrderedTasks* chunk = recording;
+      const std::size_t begin = chunkBegin;
+      running.run([chunk, begin, &runTask] { chunk->run([&](int k) { runTask(begin + static_cast<std::size_t>(k)); }); });
+      chunkRunning = true;
+      recording = chunk == &order ? &plan.nextOrder : &order;
+      host.startOrder(*recording, island, taskBound);
+      chunkBegin = tasks.size();
+    };
     std::size_t nextFocus = 0;
+    // Room to record without moving what the running chunk reads or writes (the bounds above
+    // hold; this only guards them).
+    const auto roomFor = [&](const auto& storage) {
+      if (chunkRunning && storage.size() == storage.capacity()) running.wait(), chunkRunning = false;
+    };
+    const auto roomForTask = [&] {
+      if (!chunked || (tasks.size() < tasks.capacity() && tasks.size() < solves.size())) return;
+      if (chunkRunning) running.wait(), chunkRunning = false;
+      if (tasks.size() >= solves.size()) solves.resize(2 * tasks.size() + 1, 0);
+    };
     auto freeze = [&](int m) {
+      roomForTask();
       tasks.push_back({-1, m, 0, 0, 0});
-      host.addOrdered(order, frozen, &m, 1);
+      host.addOrdered(*recording, frozen, &m, 1);
       frozen[host.memberIndex(m)] = 1;
     };
     for (std::size_t begin = 0; begin < list.size();) {
@@ -165,7 +296,7 @@ int PushOutRounds<d>::pushApart(Host& host, const ContactSettings& s, const Cont
         bodyPair.emplace_back(p.a, list[k]);
         if (p.b != p.a) bodyPair.emplace_back(p.b, list[k]);
       }
-      std::stable_sort(bodyPair.begin(), bodyPair.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+      stableSortByKey(bodyPair, [](const std::pair<int, int>& x) { return x.first; });
       levelMembers.clear();
       if (!focused) {
         for (int c : levels.nodes[level])
@@ -184,7 +315,10 @@ int PushOutRounds<d>::pushApart(Host& host, const ContactSettings& s, const Cont
         for (std::size_t m = 0; m < levelMembers.size(); ++m) {
           while (g < bodyPair.size() && bodyPair[g].first < levelMembers[m]) ++g;
           range[m].first = static_cast<int>(centralPairs.size());
-          for (; g < bodyPair.size() && bodyPair[g].first == levelMembers[m]; ++g) centralPairs.push_back(bodyPair[g].second);
+          for (; g < bodyPair.size() && bodyPair[g].first == levelMembers[m]; ++g) {
+            roomFor(centralPairs);
+            centralPairs.push_back(bodyPair[g].second);
+          }
           range[m].second = static_cast<int>(centralPairs.size());
         }
       }
@@ -197,94 +331,24 @@ int PushOutRounds<d>::pushApart(Host& host, const ContactSettings& s, const Cont
             const auto& p = host.pairs[centralPairs[q]];
             touched.push_back(p.a == c ? p.b : p.a);
           }
+          roomForTask();
           tasks.push_back({c, -1, range[m].first, range[m].second, fraction});
-          host.addOrdered(order, frozen, touched.data(), static_cast<int>(touched.size()));
+          host.addOrdered(*recording, frozen, touched.data(), static_cast<int>(touched.size()));
         }
       }
       for (int m : levelMembers) freeze(m);
       if (focused) nextFocus += levelMembers.size();
       begin = end;
+      if (chunked && tasks.size() - chunkBegin >= chunkTarget && begin < list.size()) startChunk();
     }
-    auto& solves = plan.solves;
-    solves.assign(tasks.size(), 0);
-    order.run([&](int t) {
-      const PushTask& task = tasks[t];
-      if (task.central < 0) {
-        host.bodies[task.frozenBody].frozen = true;
-        return;
-      }
-      thread_local std::vector<collision::ContactPoint<d>> scratch;
-      thread_local std::vector<PushOutOuter<d>> outers;
-      thread_local std::vector<int> outerIndex;
-      thread_local PushOutResult<d> r;  // kept: its lists' storage carries over
-      const collision::ContactQuery query;
-      const int c = task.central;
-      auto& C = host.bodies[c];
-      if (C.infinite()) return;
-      int count = 0;
-      for (int iteration = 0; iteration < s.pushOutBodyIterations; ++iteration) {
-        outers.clear();
-        outerIndex.clear();
-        for (int q = task.begin; q < task.end; ++q) {
-          const auto& p = host.pairs[centralPairs[q]];
-          const int o = p.a == c ? p.b : p.a;
-          auto& O = host.bodies[o];
-          scratch.clear();
-          // Normal out of c towards o.
-          collision::findContacts(*O.geometry, O.candidate, *C.geometry, C.candidate, query, scratch);
-          const collision::ContactPoint<d>* deepest = nullptr;
-          for (const auto& cp : scratch)
-            if (cp.depth > s.pushOutTolerance && (!deepest || cp.depth > deepest->depth)) deepest = &cp;
-          if (!deepest) continue;
-          const auto addOuter = [&](const collision::ContactPoint<d>& at) {
-            PushOutOuter<d> out;
-            out.isStatic = O.infinite();
-            out.r = at.point - C.x0;
-            out.q = at.point - O.x0;
-            // A body of infinite mass here (static, kinematic or frozen below) weighs as the
-            // unit K_hat_s the original code gives every static contact (notes 1.7), whatever
-            // its real mass: weighted by its real mass, a heavy frozen neighbour that the
-            // central body barely touches outweighs the ground and a wall it is sunk into, and
-            // the statics' fit (B.3.2) leaves it there (26-103 % of a body's size in random
-            // drops).
-            out.mass = O.infinite() ? std::numeric_limits<double>::infinity() : O.mass;
-            out.inertia = O.inertia0;
-            // d_o: from the point on c's surface to the point on o's surface (App. B.1).
-            out.displacement = -task.fraction * at.depth * at.normal;
-            outers.push_back(out);
-            outerIndex.push_back(o);
-          };
-          // The thesis's rule: the deepest point of each body. In the rounds after the first,
-          // a body of infinite mass contributes every point that overlaps, each a static
-          // contact of B.3.2 (as the original code takes every particle inside the central
-          // body): with the deepest point only, a slab sunk into the ground at both ends, or
-          // into the ground and a wall, is turned out at one end and into the ground at the
-          // other, the two ends taking turns as the deepest, solve after solve, and stays 20-44 %
-          // of its thickness deep (random drops 37, 142).
-          if (focused && O.infinite()) {
-            for (const auto& cp : scratch)
-              if (cp.depth > s.pushOutTolerance) addOuter(cp);
-          } else {
-            addOuter(*deepest);
-          }
-        }
-        if (outers.empty()) break;
-        if (focused) host.escapeOpposedStatics(c, task.fraction, s.pushOutTolerance, outers, outerIndex);
-        PushOutCentral<d> central;
-        central.mass = C.mass;
-        central.inertia = C.inertia0;
-        central.lengthScale = C.geometry->boundingRadius();
-        solvePushOut(central, outers, r);
-        host.setBasePose(c, C.x0 + r.centralDisplacement, host.rotated(C.q0, r.centralRotation));
-        for (std::size_t k = 0; k < outers.size(); ++k) {
-          auto& O = host.bodies[outerIndex[k]];
-          if (O.infinite()) continue;
-          host.setBasePose(outerIndex[k], O.x0 + r.outerDisplacements[k], host.rotated(O.q0, r.outerRotations[k]));
-        }
-        ++count;
-      }
-      if (count) solves[t] = count;
-    });
+    if (chunked) {
+      // The last chunk, on both threads once the one before it has finished.
+      if (chunkRunning) running.wait();
+      recording->run([&](int k) { runTask(chunkBegin + static_cast<std::size_t>(k)); });
+    } else {
+      solves.assign(tasks.size(), 0);
+      order.run([&](int t) { runTask(static_cast<std::size_t>(t)); });
+    }
     for (int n : solves) pushes[island] += n;
     for (int m : members) host.bodies[m].frozen = false;
   });

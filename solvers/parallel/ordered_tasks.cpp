@@ -18,7 +18,7 @@ void OrderedTasks::reset(int objectCount, int grain, bool track) {
   depth_.clear();
   predecessorCount_.clear();
   edges_.clear();
-  openDependencies_.clear();
+  dependedOnBy_.clear();
   criticalPath_ = 0;
   if (!track) return;
   lastWriter_.assign(static_cast<std::size_t>(objectCount), -1);
@@ -26,12 +26,13 @@ void OrderedTasks::reset(int objectCount, int grain, bool track) {
   for (auto& r : readers_) r.clear();
 }
 
-// Makes the open (last) block wait for `block`, unless that is itself or already a predecessor.
+// Makes the open (last) block wait for `block`, unless that is itself or already a predecessor
+// (marked per block, so that recording a task costs the same however many predecessors its block
+// has: the recording runs on one thread before the tasks are shared).
 void OrderedTasks::depend(int block) {
   const int open = blocks() - 1;
-  if (block < 0 || block == open) return;
-  if (std::find(openDependencies_.begin(), openDependencies_.end(), block) != openDependencies_.end()) return;
-  openDependencies_.push_back(block);
+  if (block < 0 || block == open || dependedOnBy_[block] == open) return;
+  dependedOnBy_[block] = open;
   edges_.emplace_back(block, open);
   ++predecessorCount_[open];
   depth_[open] = std::max(depth_[open], depth_[block] + 1);
@@ -56,7 +57,7 @@ int OrderedTasks::add(const int* writes, int writeCount, const int* reads, int r
   if (k % grain_ == 0) {  // a new block
     depth_.push_back(1);
     predecessorCount_.push_back(0);
-    openDependencies_.clear();
+    dependedOnBy_.push_back(-1);
     criticalPath_ = std::max(criticalPath_, 1);
   }
   const int block = blocks() - 1;

@@ -63,7 +63,7 @@ class OrderedTasks {
   std::vector<int> depth_;                 // per block: 1 + the deepest predecessor's depth
   std::vector<int> predecessorCount_;      // per block
   std::vector<std::pair<int, int>> edges_;  // (predecessor, successor) blocks, in order of adding
-  std::vector<int> openDependencies_;      // predecessors of the last block, while it fills
+  std::vector<int> dependedOnBy_;          // per block: the last block that recorded it as a predecessor
   int criticalPath_ = 0;
   int size_ = 0;
   int grain_ = 1;

@@ -335,7 +335,9 @@ void expectSameStateOnOneAndTwoThreads(const std::string& sceneName, const std::
 }  // namespace
 
 TEST(ContactDeterminism, SameStateOnOneAndTwoThreads) {
-  // Many islands, handed to the threads whole.
+  // Many islands, handed to the threads whole; the pile's push-out plans (up to 250 bodies) are
+  // recorded in chunks, each running while the next is recorded (push_out_rounds.h): 42 chunks
+  // start by 0.5 s.
   expectSameStateOnOneAndTwoThreads("pour_spheres_250.json", "0.5");
 }
 
