@@ -412,7 +412,8 @@ bool rebuildFront(TwoPhaseState& state, const MacLayout<2>& layout, const TwoPha
 }
 
 // A moved level set made a distance again beyond levelSetKeep cells (the particles correct it once
-// more after fast marching and take their new radii), and the mesh rebuilt from it.
+// more after fast marching and take their new radii), and the mesh rebuilt from it; the particles
+// are reseeded every particleSettings.reseedEvery steps.
 void redistanceLevelSet(TwoPhaseState& state, const MacLayout<2>& layout, const TwoPhaseSettings& settings,
                         TwoPhaseStepReport& report) {
   if (settings.levelSetRedistancing == LevelSetRedistancing::FastMarching) {
@@ -422,6 +423,11 @@ void redistanceLevelSet(TwoPhaseState& state, const MacLayout<2>& layout, const 
   if (settings.particleLevelSet) adjustParticleRadii(layout, state.phi, state.levelSetParticles, settings.particleSettings);
   if (rebuildFront(state, layout, settings, report) && settings.levelSetRedistancing == LevelSetRedistancing::ToMesh)
     redistanceToFront(layout, state.front, state.phi, 5, settings.levelSetKeep);
+  // Reseeding against the redistanced phi; the step number seeds it, so restarts reseed alike.
+  const int reseedEvery = settings.particleSettings.reseedEvery;
+  if (settings.particleLevelSet && reseedEvery > 0 && (state.step + 1) % reseedEvery == 0)
+    reseedParticles(layout, state.phi, state.levelSetParticles, static_cast<std::uint64_t>(state.step + 1),
+                    settings.particleSettings);
 }
 }  // namespace
 
