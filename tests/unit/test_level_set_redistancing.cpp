@@ -159,9 +159,8 @@ TEST(ParticleLevelSet, ReseedingKeepsTheCountsOfAStretchedInterfaceInBounds) {
   // The single vortex without reversal (n = 64, T = 2): the circle winds into a spiral whose length
   // keeps growing, so the first seeding's particles thin out along it. Measured: at T/2, 596 of the
   // 987 (cell, sign) pairs hold under half their target without reseeding, 22 with reseeding every
-  // 16 steps (and none over twice it); the area error at T is -27.3 % without and -8.4 % with.
-  // The area gain is not general: on the reversing vortex and at n = 128 reseeding measured neutral
-  // or worse (docs/benchmarks_surface_tension.md), so only this stretched case asserts it.
+  // 16 steps (none over twice it); at T, 1132 of 1510 and 108 of 1535. The area is not asserted: here reseeding measured -8.4 % at T
+  // against -27.3 % without, but at n = 128 -12.1 % against -2.4 % (docs/benchmarks_surface_tension.md).
   const VortexDeformationResult kept = runVortexDeformation(64, 2.0, true, 0, false);
   const VortexDeformationResult reseeded = runVortexDeformation(64, 2.0, true, 16, false);
   EXPECT_EQ(kept.particles, kept.halfParticles);
@@ -170,5 +169,7 @@ TEST(ParticleLevelSet, ReseedingKeepsTheCountsOfAStretchedInterfaceInBounds) {
   EXPECT_EQ(reseeded.halfBounds.crowded, 0);
   EXPECT_GT(reseeded.halfParticles, kept.halfParticles);
   EXPECT_GT(reseeded.reseeded.added, 0);
-  EXPECT_LT(std::abs(reseeded.areaError), 0.5 * std::abs(kept.areaError));
+  EXPECT_GT(reseeded.finalBounds.counted, reseeded.halfBounds.counted);  // the spiral grew
+  EXPECT_LT(reseeded.finalBounds.sparse, 0.1 * reseeded.finalBounds.counted);
+  EXPECT_GT(kept.finalBounds.sparse, 0.6 * kept.finalBounds.counted);
 }
