@@ -165,8 +165,25 @@ ReseedReport reseedParticles(const MacLayout<2>& layout, const std::vector<doubl
   particles.resize(kept);
 
   // Add: sparse cells are filled up to the target with new particles at pseudo-random positions in
-  // them, attracted to a level they can take there. The generator starts from the seed and the pass, so the positions do not
+  // them, attracted to a level they can take there, unless an older particle contradicts them. The generator starts from the seed and the pass, so the positions do not
   // depend on anything else (threads, restarts).
+  // Existing particles by cell, for the test below.
+  const std::size_t existing = particles.size();
+  std::vector<std::vector<int>> inCell(layout.cellCount());
+  for (std::size_t k = 0; k < existing; ++k) inCell[cellOf(particles[k].x)].push_back(static_cast<int>(k));
+  // True when an existing particle of the other sign lies within `reach` of x. A new particle at
+  // level l says the interface is l away; an older particle of the other sign nearer than that says
+  // phi has lost the shape there, and the new particle would hold the lost shape against it.
+  auto contradicted = [&](const Eigen::Vector2d& x, int sign, double reach) {
+    const Eigen::Vector2d g = (x - layout.origin) / dx;
+    const int ci = static_cast<int>(std::floor(g.x())), cj = static_cast<int>(std::floor(g.y()));
+    const int span = static_cast<int>(std::ceil(reach / dx));
+    for (int j = std::max(0, cj - span); j <= std::min(layout.cells.y() - 1, cj + span); ++j)
+      for (int i = std::max(0, ci - span); i <= std::min(layout.cells.x() - 1, ci + span); ++i)
+        for (int k : inCell[layout.cellIndex(Eigen::Vector2i(i, j))])
+          if (particles[k].sign != sign && (particles[k].x - x).norm() < reach) return true;
+    return false;
+  };
   std::seed_seq sequence{settings.seed, static_cast<std::uint32_t>(pass), static_cast<std::uint32_t>(pass >> 32)};
   std::mt19937 random(sequence);
   auto uniform = [&random] { return random() * (1.0 / 4294967296.0); };
@@ -182,7 +199,9 @@ ReseedReport reseedParticles(const MacLayout<2>& layout, const std::vector<doubl
         p.x = corner + dx * Eigen::Vector2d(uniform(), uniform());
         const double goal = sign * (from + (to - from) * uniform());
         if (!attractToLevel(layout, phi, p, goal, low, high)) continue;
-        p.radius = std::clamp(sign * sampleCellField(layout, phi, p.x), settings.minRadius * dx, settings.maxRadius * dx);
+        const double level = sign * sampleCellField(layout, phi, p.x);
+        if (contradicted(p.x, sign, level)) continue;
+        p.radius = std::clamp(level, settings.minRadius * dx, settings.maxRadius * dx);
         particles.push_back(p);
         ++report.added;
       }

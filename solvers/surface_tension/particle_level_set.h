@@ -20,7 +20,9 @@
 // that have left the band (escaped ones too, when they are that far on the wrong side); then each
 // band cell and sign has a target count, perCell times the share of the cell where that sign's
 // levels [rMin, seedBand dx] lie (about the density of the first seeding). A cell with fewer than
-// reseedSparse x target is filled up to it with new particles seeded as above; one with more than
+// reseedSparse x target is filled up to it with new particles seeded as above, except where an older
+// particle of the other sign lies nearer than the new one's level (phi has lost the shape there, and
+// the new particle would assert the lost shape against the older one); one with more than
 // reseedCrowded x target loses those farthest from the interface down to it. Escaped particles near
 // the band are never deleted: they hold the features the grid lost, and deleting those escaped by
 // more than 1.5 radii (Enright, Losasso & Fedkiw 2005) or every excess particle (hysteresis 1, 1)

@@ -157,19 +157,21 @@ TEST(ParticleLevelSet, ReseedingAfterSeedingAddsNoEscapedParticleAndIsDeterminis
 
 TEST(ParticleLevelSet, ReseedingKeepsTheCountsOfAStretchedInterfaceInBounds) {
   // The single vortex without reversal (n = 64, T = 2): the circle winds into a spiral whose length
-  // keeps growing, so the first seeding's particles thin out along it. Measured: at T/2, 596 of the
-  // 987 (cell, sign) pairs hold under half their target without reseeding, 22 with reseeding every
-  // 16 steps (none over twice it); at T, 1132 of 1510 and 108 of 1535. The area is not asserted: here reseeding measured -8.4 % at T
-  // against -27.3 % without, but at n = 128 -12.1 % against -2.4 % (docs/benchmarks_surface_tension.md).
+  // keeps growing, so the first seeding's particles thin out along it. Measured: without reseeding
+  // 596 of the 987 (cell, sign) pairs hold under half their target at T/2 and 1132 of 1510 at T;
+  // reseeded every 16 steps 231 of 980 and 498 of 1542 (the rest where older particles of the
+  // other sign forbid new ones), none over twice it at T/2. The area is not asserted: reseeding
+  // measured -14.0 % at T against -27.3 % without here, but -3.1 % against -2.4 % at n = 128 and
+  // +4.3 % against -6.3 % at n = 128, T = 3 (docs/benchmarks_surface_tension.md).
   const VortexDeformationResult kept = runVortexDeformation(64, 2.0, true, 0, false);
   const VortexDeformationResult reseeded = runVortexDeformation(64, 2.0, true, 16, false);
   EXPECT_EQ(kept.particles, kept.halfParticles);
-  EXPECT_GT(kept.halfBounds.sparse, 0.4 * kept.halfBounds.counted);
-  EXPECT_LT(reseeded.halfBounds.sparse, 0.05 * reseeded.halfBounds.counted);
+  EXPECT_GT(kept.halfBounds.sparse, 0.5 * kept.halfBounds.counted);
+  EXPECT_LT(reseeded.halfBounds.sparse, 0.3 * reseeded.halfBounds.counted);
   EXPECT_EQ(reseeded.halfBounds.crowded, 0);
   EXPECT_GT(reseeded.halfParticles, kept.halfParticles);
   EXPECT_GT(reseeded.reseeded.added, 0);
   EXPECT_GT(reseeded.finalBounds.counted, reseeded.halfBounds.counted);  // the spiral grew
-  EXPECT_LT(reseeded.finalBounds.sparse, 0.1 * reseeded.finalBounds.counted);
+  EXPECT_LT(reseeded.finalBounds.sparse, 0.4 * reseeded.finalBounds.counted);
   EXPECT_GT(kept.finalBounds.sparse, 0.6 * kept.finalBounds.counted);
 }
