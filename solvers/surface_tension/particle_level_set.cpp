@@ -26,6 +26,14 @@ Eigen::Vector2d clampToDomain(const MacLayout<2>& layout, const Eigen::Vector2d&
   return x.cwiseMax(layout.origin).cwiseMin(upper);
 }
 
+// The cell whose square holds x (clamped to the grid).
+int cellContaining(const MacLayout<2>& layout, const Eigen::Vector2d& x) {
+  const Eigen::Vector2d g = (x - layout.origin) / layout.dx;
+  const int i = std::clamp(static_cast<int>(std::floor(g.x())), 0, layout.cells.x() - 1);
+  const int j = std::clamp(static_cast<int>(std::floor(g.y())), 0, layout.cells.y() - 1);
+  return layout.cellIndex(Eigen::Vector2i(i, j));
+}
+
 // Moves p along the normal of phi toward the level `goal` on its side ([47], Sec. 3.1); true when it
 // ends with its level s phi in [low, high].
 bool attractToLevel(const MacLayout<2>& layout, const std::vector<double>& phi, LevelSetParticle& p, double goal, double low,
@@ -92,10 +100,7 @@ ParticleCountBounds particleCountBounds(const MacLayout<2>& layout, const std::v
   std::vector<int> count(2 * static_cast<std::size_t>(layout.cellCount()), 0);
   for (const LevelSetParticle& p : particles) {
     if (p.sign * sampleCellField(layout, phi, p.x) < 0) continue;  // escaped: not counted
-    const Eigen::Vector2d g = (p.x - layout.origin) / layout.dx;
-    const int i = std::clamp(static_cast<int>(std::floor(g.x())), 0, layout.cells.x() - 1);
-    const int j = std::clamp(static_cast<int>(std::floor(g.y())), 0, layout.cells.y() - 1);
-    ++count[2 * layout.cellIndex(Eigen::Vector2i(i, j)) + (p.sign > 0)];
+    ++count[2 * cellContaining(layout, p.x) + (p.sign > 0)];
   }
   for (int c = 0; c < layout.cellCount(); ++c)
     for (int side = 0; side < 2; ++side) {
@@ -108,28 +113,12 @@ ParticleCountBounds particleCountBounds(const MacLayout<2>& layout, const std::v
   return bounds;
 }
 
-std::vector<int> particlesPerCell(const MacLayout<2>& layout, const std::vector<LevelSetParticle>& particles) {
-  std::vector<int> count(2 * static_cast<std::size_t>(layout.cellCount()), 0);
-  for (const LevelSetParticle& p : particles) {
-    const Eigen::Vector2d g = (p.x - layout.origin) / layout.dx;
-    const int i = std::clamp(static_cast<int>(std::floor(g.x())), 0, layout.cells.x() - 1);
-    const int j = std::clamp(static_cast<int>(std::floor(g.y())), 0, layout.cells.y() - 1);
-    ++count[2 * layout.cellIndex(Eigen::Vector2i(i, j)) + (p.sign > 0)];
-  }
-  return count;
-}
-
 ReseedReport reseedParticles(const MacLayout<2>& layout, const std::vector<double>& phi,
                              std::vector<LevelSetParticle>& particles, std::uint64_t pass,
                              const ParticleLevelSetSettings& settings) {
   const double dx = layout.dx, low = settings.minRadius * dx, high = settings.seedBand * dx;
   ReseedReport report;
-  auto cellOf = [&](const Eigen::Vector2d& x) {
-    const Eigen::Vector2d g = (x - layout.origin) / dx;
-    const int i = std::clamp(static_cast<int>(std::floor(g.x())), 0, layout.cells.x() - 1);
-    const int j = std::clamp(static_cast<int>(std::floor(g.y())), 0, layout.cells.y() - 1);
-    return layout.cellIndex(Eigen::Vector2i(i, j));
-  };
+  auto cellOf = [&layout](const Eigen::Vector2d& x) { return cellContaining(layout, x); };
   auto target = [&](int c, int sign) { return reseedTarget(layout, phi, c, sign, settings); };
 
   // Delete the particles outside the band (escaped ones too, when that far on the wrong side).
@@ -165,9 +154,9 @@ ReseedReport reseedParticles(const MacLayout<2>& layout, const std::vector<doubl
   particles.resize(kept);
 
   // Add: sparse cells are filled up to the target with new particles at pseudo-random positions in
-  // them, attracted to a level they can take there, unless an older particle contradicts them. The generator starts from the seed and the pass, so the positions do not
-  // depend on anything else (threads, restarts).
-  // Existing particles by cell, for the test below.
+  // them, attracted to a level they can take there, unless an older particle contradicts them. The
+  // generator starts from the seed and the pass, so the positions depend on nothing else (threads,
+  // restarts). The older particles by cell, for that test:
   const std::size_t existing = particles.size();
   std::vector<std::vector<int>> inCell(layout.cellCount());
   for (std::size_t k = 0; k < existing; ++k) inCell[cellOf(particles[k].x)].push_back(static_cast<int>(k));

@@ -83,9 +83,6 @@ ParticleCountBounds particleCountBounds(const MacLayout<2>& layout, const std::v
                                         const std::vector<LevelSetParticle>& particles,
                                         const ParticleLevelSetSettings& settings = {});
 
-// Particles of each sign per cell (by position), [2 * cell + (sign > 0)].
-std::vector<int> particlesPerCell(const MacLayout<2>& layout, const std::vector<LevelSetParticle>& particles);
-
 // Step 2 above; returns the number of escaped particles that changed phi.
 int correctWithParticles(const MacLayout<2>& layout, const std::vector<LevelSetParticle>& particles,
                          std::vector<double>& phi);
