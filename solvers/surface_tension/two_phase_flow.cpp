@@ -9,8 +9,8 @@
 #include <utility>
 
 #include "solvers/advection/eno.h"
-#include "solvers/fluid/parallel.h"
 #include "solvers/advection/semi_lagrangian.h"
+#include "solvers/fluid/parallel.h"
 #include "solvers/surface_tension/face_extrapolation.h"
 #include "solvers/surface_tension/level_set_front.h"
 #include "solvers/surface_tension/fast_marching.h"
