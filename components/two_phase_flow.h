@@ -41,6 +41,7 @@ struct TwoPhaseFlow {
   std::uint8_t levelSetRedistancing = 0;         // level-set fronts: 0 to the mesh, 1 fast marching, 2 none
   double levelSetKeep = 3;                       // cells within this many dx keep their advected phi
   std::uint8_t particleLevelSet = 0;             // 1: the particle level set corrects phi
+  int particleReseedEvery = 0;                   // particleLevelSet: steps between reseedings (0: never)
 
   // --- state ---
   std::vector<double> u;               // face velocities, MAC layout order
@@ -92,6 +93,7 @@ struct TwoPhaseFlow {
     visit("level_set_keep", levelSetKeep);
     visit("particle_level_set", particleLevelSet);
     visit("level_set_particles", levelSetParticles);
+    visit("particle_reseed_every", particleReseedEvery);
   }
 };
 

@@ -132,6 +132,10 @@ void parseTwoPhaseFlow(World<d>& world, Entity e, const Config& c) {
     if (flow.particleLevelSet && flow.levelSetFront == 2)
       f.failAt("particles", "false with \"tracking\": \"level_set_implicit\" (its phi is not advected, so no particle corrects it)",
                "true");
+    if (f.has("reseed_every") && !flow.particleLevelSet)
+      f.failAt("reseed_every", "no \"reseed_every\" without \"particles\": true (it reseeds the particle level set's particles)",
+               "\"reseed_every\" without particles");
+    flow.particleReseedEvery = static_cast<int>(f.integer("reseed_every", 0, 0, 1000000000));
     solvers::Front2 front = parseFront(f, flow.dx);
     const Eigen::Vector2d upper = flow.origin + flow.dx * flow.cells.cast<double>();
     for (const auto& x : front.points)
@@ -184,7 +188,7 @@ void registerSurfaceTensionComponents(Registry& r) {
       "one- or two-phase flow with surface tension on a Lagrangian front (2-D): cells, domain_min/max, phases "
       "(one|two), density_inside/outside, viscosity, surface_tension, treatment (implicit|explicit), gravity, "
       "advection, coupling_velocity (sampled|carried), front {shape: circle|polygon, tracking: "
-      "front|level_set|level_set_implicit, redistancing: to_mesh|fast_marching|none, keep, particles}, probes [{name, position}]",
+      "front|level_set|level_set_implicit, redistancing: to_mesh|fast_marching|none, keep, particles, reseed_every}, probes [{name, position}]",
       parseTwoPhaseFlow<d>);
 }
 

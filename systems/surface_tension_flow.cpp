@@ -73,6 +73,7 @@ void SurfaceTensionFlow<d>::run(World<d>& world, StepContext& ctx) {
                                                                 : solvers::LevelSetRedistancing::ToMesh;
       s.levelSetKeep = flow.levelSetKeep;
       s.particleLevelSet = flow.particleLevelSet != 0;
+      s.particleSettings.reseedEvery = flow.particleReseedEvery;
 
       const Eigen::Vector2d centroidBefore = solvers::measureFront(state.front).centroid;
       const solvers::TwoPhaseStepReport r = solvers::advanceTwoPhase(state, s, ctx.dt);

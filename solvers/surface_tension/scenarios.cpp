@@ -95,6 +95,7 @@ void applyLevelSetOptions(TwoPhaseSettings& settings, const LevelSetFrontOptions
   settings.levelSetRedistancing = options.redistancing;
   settings.levelSetKeep = options.keep;
   settings.particleLevelSet = options.particles;
+  settings.particleSettings.reseedEvery = options.reseedEvery;
   settings.levelSetNodeSnap = options.nodeSnap;
 }
 // Steps a static circle until the end or a blow-up (advance returns true), then takes the
@@ -425,7 +426,7 @@ StabilityCase runStabilityCase(int n, double dt, bool implicit, bool ellipse, in
                            [&](TwoPhaseState& s) { return advanceTwoPhase(s, settings, dt); });
 }
 
-VortexDeformationResult runVortexDeformation(int n, double period, bool particles) {
+VortexDeformationResult runVortexDeformation(int n, double period, bool particles, int reseedEvery, bool reverses) {
   const double dx = 1.0 / n;
   const MacLayout<2> layout(Eigen::Vector2i(n, n), dx);
   const Eigen::Vector2d centre(0.5, 0.75);
@@ -433,6 +434,7 @@ VortexDeformationResult runVortexDeformation(int n, double period, bool particle
   std::vector<double> phi(layout.cellCount());
   for (int c = 0; c < layout.cellCount(); ++c) phi[c] = (layout.cellCenter(layout.cellCoord(c)) - centre).norm() - radius;
   ParticleLevelSetSettings settings;
+  settings.reseedEvery = reseedEvery;
   std::vector<LevelSetParticle> markers;
   if (particles) markers = seedParticles(layout, phi, settings);
   VortexDeformationResult result;
@@ -446,7 +448,7 @@ VortexDeformationResult runVortexDeformation(int n, double period, bool particle
   const double dt = period / steps;
   Eigen::VectorXd u(layout.totalFaces());
   for (int step = 0; step < steps; ++step) {
-    const double time = (step + 0.5) * dt, scale = std::cos(M_PI * time / period);
+    const double time = (step + 0.5) * dt, scale = reverses ? std::cos(M_PI * time / period) : 1.0;
     for (int f = 0; f < layout.totalFaces(); ++f) {
       const auto [axis, coord] = layout.faceCoord(f);
       const Eigen::Vector2d x = layout.faceCenter(axis, coord);
@@ -455,6 +457,13 @@ VortexDeformationResult runVortexDeformation(int n, double period, bool particle
     }
     if (particles) {
       result.escapedTotal += particleLevelSetStep(layout, u, dt, phi, markers, settings);
+      if (settings.reseedEvery > 0 && (step + 1) % settings.reseedEvery == 0) {
+        const ReseedReport r = reseedParticles(layout, phi, markers, static_cast<std::uint64_t>(step + 1), settings);
+        result.reseeded.added += r.added;
+        result.reseeded.removedOutsideBand += r.removedOutsideBand;
+        result.reseeded.removedEscaped += r.removedEscaped;
+        result.reseeded.removedCrowded += r.removedCrowded;
+      }
     } else {
       phi = advectCellField(layout, phi, u, dt);
       fastMarchingRedistance(layout, phi, settings.redistanceBand);
@@ -462,8 +471,12 @@ VortexDeformationResult runVortexDeformation(int n, double period, bool particle
     if (step + 1 == steps / 2) {
       result.fronts.push_back(front());
       result.halfArea = enclosedArea(result.fronts.back());
+      result.halfParticles = static_cast<int>(markers.size());
+      if (particles) result.halfBounds = particleCountBounds(layout, phi, markers, settings);
     }
   }
+  result.finalParticles = static_cast<int>(markers.size());
+  if (particles) result.finalBounds = particleCountBounds(layout, phi, markers, settings);
   result.fronts.push_back(front());
   result.finalArea = enclosedArea(result.fronts.back());
   result.areaError = (result.finalArea - result.initialArea) / result.initialArea;

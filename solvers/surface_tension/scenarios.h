@@ -46,6 +46,7 @@ struct LevelSetFrontOptions {
   LevelSetRedistancing redistancing = LevelSetRedistancing::ToMesh;
   double keep = 3;
   bool particles = false;
+  int reseedEvery = 0;     // particles: steps between reseedings (0: never)
   bool frozen = false;
   double nodeSnap = 1e-4;  // TwoPhaseSettings::levelSetNodeSnap
 };
@@ -151,12 +152,20 @@ StabilityCase runPressureJumpStabilityCase(int n, double dt, bool ellipse, int s
 // set (particle_level_set.h). The area is that of the front built from phi (fourth-order crossings, no
 // sliver merging);
 // areaError = (A(T) - A(0)) / A(0). fronts: the fronts at t = 0, T/2 and T (for the figure).
+// reverses = false drops the factor cos(pi t / T): the spiral winds up until T and never comes back,
+// so the interface keeps stretching (its area is still conserved exactly by the flow).
+// reseedEvery > 0 reseeds the particles every that many steps (reseedParticles, pass = the step).
+// The particle counts per cell and sign are checked against reseeding's bounds (particleCountBounds)
+// at T/2 and T, with or without reseeding.
 struct VortexDeformationResult {
   double initialArea = 0, halfArea = 0, finalArea = 0, areaError = 0, halfAreaError = 0;
   double maxShapeError = 0;  // max over the final front's points of | |x - c| - r |
   int steps = 0, particles = 0, escapedTotal = 0;
+  int halfParticles = 0, finalParticles = 0;  // particle counts at T/2 and T
+  ParticleCountBounds halfBounds, finalBounds;
+  ReseedReport reseeded;                      // summed over the run
   std::vector<Front2> fronts;
 };
-VortexDeformationResult runVortexDeformation(int n, double period, bool particles);
+VortexDeformationResult runVortexDeformation(int n, double period, bool particles, int reseedEvery = 0, bool reverses = true);
 
 }  // namespace monolith::solvers

@@ -10,6 +10,7 @@
 
 #include "solvers/advection/eno.h"
 #include "solvers/advection/semi_lagrangian.h"
+#include "solvers/fluid/parallel.h"
 #include "solvers/surface_tension/face_extrapolation.h"
 #include "solvers/surface_tension/level_set_front.h"
 #include "solvers/surface_tension/fast_marching.h"
@@ -412,7 +413,8 @@ bool rebuildFront(TwoPhaseState& state, const MacLayout<2>& layout, const TwoPha
 }
 
 // A moved level set made a distance again beyond levelSetKeep cells (the particles correct it once
-// more after fast marching and take their new radii), and the mesh rebuilt from it.
+// more after fast marching and take their new radii), and the mesh rebuilt from it; the particles
+// are reseeded every particleSettings.reseedEvery steps.
 void redistanceLevelSet(TwoPhaseState& state, const MacLayout<2>& layout, const TwoPhaseSettings& settings,
                         TwoPhaseStepReport& report) {
   if (settings.levelSetRedistancing == LevelSetRedistancing::FastMarching) {
@@ -422,6 +424,11 @@ void redistanceLevelSet(TwoPhaseState& state, const MacLayout<2>& layout, const 
   if (settings.particleLevelSet) adjustParticleRadii(layout, state.phi, state.levelSetParticles, settings.particleSettings);
   if (rebuildFront(state, layout, settings, report) && settings.levelSetRedistancing == LevelSetRedistancing::ToMesh)
     redistanceToFront(layout, state.front, state.phi, 5, settings.levelSetKeep);
+  // Reseeding against the redistanced phi; the step number seeds it, so restarts reseed alike.
+  const int reseedEvery = settings.particleSettings.reseedEvery;
+  if (settings.particleLevelSet && reseedEvery > 0 && (state.step + 1) % reseedEvery == 0)
+    reseedParticles(layout, state.phi, state.levelSetParticles, static_cast<std::uint64_t>(state.step + 1),
+                    settings.particleSettings);
 }
 }  // namespace
 
@@ -492,11 +499,15 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
     K.setFromTriplets(k.begin(), k.end());
   }
   const Eigen::VectorXd betaInv = D.beta.cwiseInverse();
-  Eigen::SparseMatrix<double> A = K * betaInv.asDiagonal() * K.transpose();
-  for (int r = np; r < np + nv + ns; ++r) A.coeffRef(r, r) += 1.0;
-  A.makeCompressed();
+  // The operator is applied as P z + K (beta^-1 (K^T z)), not assembled: K has about 2-4 entries a
+  // row and K beta^-1 K^T about 10-20 (each face couples its two pressures and its four viscous
+  // rows), so the two products read a third of the memory, and the solve is most of a step's time.
+  // Both are stored row-major and applied row by row (each row written by one task: deterministic).
+  using RowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+  const RowMatrix Krows = K, KtRows = K.transpose();
+  const int rows = np + nv + ns;
   const Eigen::VectorXd b = K * ustar;
-  Eigen::VectorXd z = Eigen::VectorXd::Zero(np + nv + ns);
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(rows);
   for (int c = 0; c < layout.cellCount(); ++c) {  // warm start from the last pressures
     if (D.insideDof[c] >= 0) z[D.insideDof[c]] = dt * state.pInside[c];
     if (D.outsideDof[c] >= 0) z[D.outsideDof[c]] = dt * state.pOutside[c];
@@ -510,10 +521,25 @@ TwoPhaseStepReport advanceTwoPhase(TwoPhaseState& state, const TwoPhaseSettings&
     };
     project(z);
   }
-  Eigen::VectorXd diagonal = A.diagonal();
-  for (int i = 0; i < diagonal.size(); ++i)
-    if (!(diagonal[i] > 0)) diagonal[i] = 1;
-  const LinearOperator apply = [&A](const Eigen::VectorXd& in, Eigen::VectorXd& out) { out = A * in; };
+  Eigen::VectorXd diagonal(rows);
+  parallel::forRows(rows, [&](int r) {
+    double sum = r >= np ? 1.0 : 0.0;
+    for (RowMatrix::InnerIterator it(Krows, r); it; ++it) sum += it.value() * it.value() * betaInv[it.index()];
+    diagonal[r] = sum > 0 ? sum : 1.0;
+  });
+  Eigen::VectorXd scaled(nu);
+  const LinearOperator apply = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
+    parallel::forRows(nu, [&](int q) {
+      double sum = 0;
+      for (RowMatrix::InnerIterator it(KtRows, q); it; ++it) sum += it.value() * in[it.index()];
+      scaled[q] = sum * betaInv[q];
+    });
+    parallel::forRows(rows, [&](int r) {
+      double sum = r >= np ? in[r] : 0.0;
+      for (RowMatrix::InnerIterator it(Krows, r); it; ++it) sum += it.value() * scaled[it.index()];
+      out[r] = sum;
+    });
+  };
   report.solve = conjugateGradient(apply, jacobiPreconditioner(diagonal), project, b, z, settings.solve);
   const Eigen::VectorXd unew = ustar - betaInv.cwiseProduct(K.transpose() * z);
 

@@ -95,7 +95,8 @@ struct TwoPhaseSettings {
   // (docs/benchmarks_surface_tension.md). 0 turns it off.
   double levelSetNodeSnap = 1e-4;
   // The particle level set [47] (particle_level_set.h) corrects the advected phi before and after
-  // redistancing; its particles live in TwoPhaseState::levelSetParticles (seeded on the first step).
+  // redistancing; its particles live in TwoPhaseState::levelSetParticles (seeded on the first step,
+  // reseeded every particleSettings.reseedEvery steps, counted by TwoPhaseState::step).
   bool particleLevelSet = false;
   ParticleLevelSetSettings particleSettings;
   // Front tracking, beyond the thesis (which does not say where a coupling face's u* comes from):

@@ -6,7 +6,7 @@
 //   bench_surface_tension epsilon N [eps=E...]        Table 6.4 epsilon test
 //   bench_surface_tension rising_stability [N]        Sec. 6.4.4 (implicit and explicit, dt = 3 and 7 s)
 //   bench_surface_tension stability_map               Fig. 6.6-style sweep
-//   bench_surface_tension vortex [T] [N...]            particle level set against the plain one
+//   bench_surface_tension vortex [T] [N...] [reseed=K...]  particle level set (reseeded every K steps) against the plain one
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -178,10 +178,15 @@ int main(int argc, char** argv) {
     const int n = argc > 2 ? std::atoi(argv[2]) : 80;
     const bool eno = argc > 3 && std::string(argv[3]).rfind("eno", 0) == 0;
     const double advectionCfl = argc > 3 && std::string(argv[3]) == "eno_sub" ? 0.9 : 0.0;
-    // ls_fmm: fast marching instead of the distance to the mesh; pls: the particle level set with it.
-    const std::string tracking = argc > 4 ? argv[4] : "front";
-    const bool ls = tracking == "ls" || tracking == "ls_fmm" || tracking == "pls";
+    // ls_fmm: fast marching instead of the distance to the mesh; pls: the particle level set with it;
+    // plsK: the same, reseeded every K steps.
+    std::string tracking = argc > 4 ? argv[4] : "front";
     LevelSetFrontOptions lsOptions;
+    if (tracking.rfind("pls", 0) == 0 && tracking.size() > 3) {
+      lsOptions.reseedEvery = std::atoi(tracking.c_str() + 3);
+      tracking = "pls";
+    }
+    const bool ls = tracking == "ls" || tracking == "ls_fmm" || tracking == "pls";
     if (tracking != "ls") lsOptions.redistancing = LevelSetRedistancing::FastMarching;
     lsOptions.particles = tracking == "pls";
     std::vector<double> dts;
@@ -191,7 +196,9 @@ int main(int argc, char** argv) {
                 "| dt | variant | stable | steps | max speed | max CFL | capillary dt | dt / capillary | area drift | blow-up | wall s |\n"
                 "|---|---|---|---|---|---|---|---|---|---|---|\n",
                 n, 2 * n, eno ? (advectionCfl > 0 ? "ENO/RK3 in substeps of CFL <= 0.9" : "ENO/RK3") : "semi-Lagrangian",
-                ls ? (tracking == "pls" ? "particle level set (fast marching)" : tracking == "ls_fmm" ? "level set (fast marching)" : "level-set front")
+                ls ? (tracking == "pls" ? (lsOptions.reseedEvery > 0 ? "particle level set (fast marching), reseeded"
+                                                                      : "particle level set (fast marching)")
+                                        : tracking == "ls_fmm" ? "level set (fast marching)" : "level-set front")
                    : "front tracking");
     for (double dt : dts) {
       for (bool implicit : {true, false}) {
@@ -306,32 +313,47 @@ int main(int argc, char** argv) {
     // vortex [T] [N...] [fronts=PREFIX]: the single-vortex test of the particle level set [47], plain
     // level set (semi-Lagrangian + fast marching) against the particle level set. fronts=PREFIX writes
     // PREFIX_N.csv: scheme, time label (0, half, end), x, y per point of each segment's start.
+    // reseed=K adds the particle level set reseeded every K steps; no_reversal keeps the field steady.
     const double period = argc > 2 ? std::atof(argv[2]) : 2.0;
     std::string frontsPrefix;
-    std::vector<int> ns;
+    std::vector<int> ns, reseeds = {0};
+    bool reverses = true;
     for (int i = 3; i < argc; ++i) {
       const std::string a = argv[i];
-      if (a.rfind("fronts=", 0) == 0) frontsPrefix = a.substr(7);
+      if (a == "no_reversal") reverses = false;
+      else if (a.rfind("fronts=", 0) == 0) frontsPrefix = a.substr(7);
+      else if (a.rfind("reseed=", 0) == 0) reseeds.push_back(std::atoi(a.c_str() + 7));
       else ns.push_back(std::atoi(a.c_str()));
     }
     if (ns.empty()) ns = {32, 64, 128};
-    std::printf("single vortex, circle r = 0.15 at (0.5, 0.75), T = %g, dt = dx\n"
-                "| N | scheme | area error at T/2 | area error at T | max radius error at T | particles | escaped (sum over steps) | steps | wall s |\n"
-                "|---|---|---|---|---|---|---|---|\n",
-                period);
+    std::printf("single vortex%s, circle r = 0.15 at (0.5, 0.75), T = %g, dt = dx; cells (cell, sign) below half / above twice reseeding's target\n"
+                "| N | scheme | area error at T/2 | area error at T | max radius error at T | particles at 0 / T/2 / T | "
+                "sparse / crowded of counted at T/2 | at T | escaped (sum over steps) | "
+                "reseeding: added, removed outside / escaped / crowded | steps | wall s |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+                reverses ? "" : " without reversal", period);
     for (int n : ns) {
       FILE* out = frontsPrefix.empty() ? nullptr : std::fopen((frontsPrefix + "_" + std::to_string(n) + ".csv").c_str(), "w");
-      for (bool particles : {false, true}) {
+      std::vector<std::pair<bool, int>> schemes = {{false, 0}};
+      for (int k : reseeds) schemes.emplace_back(true, k);
+      for (const auto& [particles, reseed] : schemes) {
         const auto start = std::chrono::steady_clock::now();
-        const VortexDeformationResult r = runVortexDeformation(n, period, particles);
-        std::printf("| %d | %s | %+.3e | %+.3e | %.3e | %d | %d | %d | %.1f |\n", n, particles ? "particle level set" : "level set",
-                    r.halfAreaError, r.areaError, r.maxShapeError, r.particles, r.escapedTotal, r.steps, seconds(start));
+        const VortexDeformationResult r = runVortexDeformation(n, period, particles, reseed, reverses);
+        const std::string name = !particles ? "level set"
+                                 : reseed > 0 ? "particle level set, reseeded every " + std::to_string(reseed)
+                                              : "particle level set";
+        std::printf("| %d | %s | %+.3e | %+.3e | %.3e | %d / %d / %d | %d / %d of %d | %d / %d of %d | %d | %d, %d / %d / %d | %d | %.1f |\n", n,
+                    name.c_str(), r.halfAreaError, r.areaError, r.maxShapeError, r.particles, r.halfParticles, r.finalParticles,
+                    r.halfBounds.sparse, r.halfBounds.crowded, r.halfBounds.counted, r.finalBounds.sparse, r.finalBounds.crowded,
+                    r.finalBounds.counted, r.escapedTotal, r.reseeded.added,
+                    r.reseeded.removedOutsideBand, r.reseeded.removedEscaped, r.reseeded.removedCrowded, r.steps, seconds(start));
         std::fflush(stdout);
         const char* labels[] = {"0", "half", "end"};
+        const std::string label = !particles ? "plain" : reseed > 0 ? "reseeded" + std::to_string(reseed) : "particles";
         if (out)
           for (std::size_t k = 0; k < r.fronts.size(); ++k)
             for (const auto& e : r.fronts[k].elements)
-              std::fprintf(out, "%s,%s,%.9g,%.9g,%.9g,%.9g\n", particles ? "particles" : "plain", labels[k], r.fronts[k].points[e[0]].x(),
+              std::fprintf(out, "%s,%s,%.9g,%.9g,%.9g,%.9g\n", label.c_str(), labels[k], r.fronts[k].points[e[0]].x(),
                            r.fronts[k].points[e[0]].y(), r.fronts[k].points[e[1]].x(), r.fronts[k].points[e[1]].y());
       }
       if (out) std::fclose(out);

@@ -123,17 +123,21 @@ TEST(SurfaceTensionScenes, CarriedCouplingVelocitiesRestartBitwise) {
 
 TEST(SurfaceTensionScenes, ParticleLevelSetRestartsBitwiseAndThreadsAgree) {
   // The level-set-tracked drop with the particle level set and fast marching: its particles are
-  // state (level_set_particles), so a run resumed at step 20 ends bitwise equal to the straight one,
-  // and 1 and 2 threads agree. Without particles the run differs, so the option reaches the solver.
+  // state (level_set_particles), reseeded every 15 steps (at steps 15 and 30, either side of the
+  // restart), so a run resumed at step 20 ends bitwise equal to the straight one, and 1 and 2 threads
+  // agree. Without particles, or without reseeding, the run differs, so the options reach the solver.
   TempDir tmp;
   const std::vector<std::string> levelSet = {"--set", "entities.0.two_phase_flow.coupling_velocity=sampled", "--set",
                                              "entities.0.two_phase_flow.front.tracking=level_set", "--set",
                                              "entities.0.two_phase_flow.front.redistancing=fast_marching"};
   std::vector<std::string> particles = levelSet;
   particles.insert(particles.end(), {"--set", "entities.0.two_phase_flow.front.particles=true"});
+  const std::vector<std::string> withoutReseeding = particles;
+  particles.insert(particles.end(), {"--set", "entities.0.two_phase_flow.front.reseed_every=15"});
   std::vector<std::string> a = particles, c = particles;
   a.insert(a.end(), {"--checkpoint-every", "20", "--threads", "2"});
   c.insert(c.end(), {"--threads", "1"});
+  ASSERT_EQ(runSmallOscillatingDrop(tmp, "noreseed", withoutReseeding).exitCode, 0);
   ASSERT_EQ(runSmallOscillatingDrop(tmp, "A", a).exitCode, 0);
   ASSERT_EQ(runSmallOscillatingDrop(tmp, "C", c).exitCode, 0);
   ASSERT_EQ(runSmallOscillatingDrop(tmp, "plain", levelSet).exitCode, 0);
@@ -144,6 +148,7 @@ TEST(SurfaceTensionScenes, ParticleLevelSetRestartsBitwiseAndThreadsAgree) {
   EXPECT_EQ(ra["state_hash"], Json::parse(slurp(tmp.path() / "B" / "summary.json"))["state_hash"]);
   EXPECT_EQ(ra["state_hash"], Json::parse(slurp(tmp.path() / "C" / "summary.json"))["state_hash"]);
   EXPECT_NE(ra["state_hash"], Json::parse(slurp(tmp.path() / "plain" / "summary.json"))["state_hash"]);
+  EXPECT_NE(ra["state_hash"], Json::parse(slurp(tmp.path() / "noreseed" / "summary.json"))["state_hash"]);
   EXPECT_LT(lastValue(tmp.path() / "A" / "metrics.csv", "p1_u"), 0.0);  // the drop's first half-period
   EXPECT_LT(std::abs(lastValue(tmp.path() / "A" / "metrics.csv", "front_area_drift")), 0.01);
 }
@@ -258,8 +263,11 @@ TEST(SurfaceTensionScenes, ValidationNamesFilePathAndExpectation) {
   expectRefused(implicitParticles, {"two_phase_flow.front.particles", "level_set_implicit"});
   const CommandResult particleLevelSet = validate("pls_ok.json", "{" + base + R"("density_outside": 1,
       "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, "tracking": "level_set", "particles": true,
-                 "redistancing": "fast_marching", "keep": 0 } })");
+                 "redistancing": "fast_marching", "keep": 0, "reseed_every": 20 } })");
   EXPECT_EQ(particleLevelSet.exitCode, 0) << particleLevelSet.err;
+  const CommandResult reseedWithoutParticles = validate("reseed.json", "{" + base + R"("density_outside": 1,
+      "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, "tracking": "level_set", "reseed_every": 20 } })");
+  expectRefused(reseedWithoutParticles, {"reseed.json", "two_phase_flow.front.reseed_every", "\"particles\": true"});
   // The options of this page are accepted.
   const CommandResult options = validate("ok.json", "{" + base + R"("density_outside": 1, "advection": "eno_rk3",
       "remesh": false, "coupling_velocity": "sampled", "front": { "shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, "tracking": "level_set_implicit" } })");
