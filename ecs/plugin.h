@@ -16,7 +16,7 @@
 namespace monolith {
 
 // Bump whenever a type crossing the plugin boundary changes layout or meaning.
-inline constexpr std::uint32_t kPluginAbiVersion = 8;
+inline constexpr std::uint32_t kPluginAbiVersion = 9;
 
 struct PluginAbi {
   std::uint32_t abiVersion;
